@@ -1,0 +1,33 @@
+"""Error hierarchy of wrist-env.
+
+Every error names the rule that failed and the offending value; input errors
+also name the file. Each class inherits a builtin so callers can catch either.
+"""
+
+
+class WristEnvError(Exception):
+    """Base class of every wrist-env error."""
+
+
+class InputError(WristEnvError, ValueError):
+    """Bad user input: a file, a value or a shape that breaks a stated rule."""
+
+
+class MeshError(InputError):
+    """A bone mesh that cannot be used (units, watertightness, degeneracy, NaN)."""
+
+
+class TrialError(InputError):
+    """A kinematic trial that cannot be used (rotations, frame counts, bones, NaN)."""
+
+
+class ParticipantError(InputError):
+    """A participant folder or name that cannot be used."""
+
+
+class DesignError(InputError):
+    """A design vector or action outside its shape or bounds."""
+
+
+class BuildError(WristEnvError, RuntimeError):
+    """The participant build could not produce a valid model."""
