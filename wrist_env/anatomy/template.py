@@ -1,0 +1,137 @@
+"""The anatomy template: myo-sim bones in the radius coordinate system (RCS).
+
+RCS (modified ISB, right wrist): origin at the centre of the distal radius
+articular surface, x volar, y proximal (along the shaft), z radial. It is
+defined from landmarks, not assumed from the mesh frame:
+
+- y: principal axis of the radius shaft, pointing away from the carpus;
+- x: from the extensor to the flexor tendons crossing the wrist (MJCF sites),
+  made orthogonal to y;
+- z = x × y (radial for a right wrist; tests check the radial styloid and
+  the scaphoid lie radial);
+- origin: centre of the rebuilt articular surface (scaphoid + lunate fossae).
+
+Bones: the carpal meshes as shipped (watertight, ~0.7 mm edges); the radius
+is the rebuilt articular solid (≤ 0.5 mm grid) plus the distal 45 mm of the
+shaft subdivided to ≤ 1.5 mm (for ligament sites and display); the ulna is its
+distal 45 mm subdivided likewise.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+import trimesh
+
+from wrist_env.anatomy.myosim import BONES, load_myosim_anatomy
+from wrist_env.anatomy.radius_cap import build_radius_cap
+
+CARPALS = ("scaphoid", "lunate", "capitate")
+JOINT_SPACE_MM = 1.5  # radiocarpal bone-to-bone joint space of the rebuilt fossae
+SHAFT_LENGTH_MM = 45.0
+SHAFT_EDGE_MM = 1.5
+
+
+@dataclass(frozen=True)
+class BoneSurface:
+    """One rigid bone surface in the RCS.
+
+    vertices: array of shape (n, 3), mm. faces: array of shape (m, 3), int64.
+    solid: bool array of shape (n,): vertices of the watertight part that
+        carries contact and mass (all True for carpal bones; the rebuilt
+        articular solid for the radius; none for the ulna).
+    """
+
+    name: str
+    vertices: np.ndarray
+    faces: np.ndarray
+    solid: np.ndarray
+
+    def trimesh(self, solid_only: bool = False) -> trimesh.Trimesh:
+        """The surface as a trimesh (optionally only its watertight part)."""
+        faces = self.faces
+        if solid_only:
+            faces = faces[self.solid[faces].all(axis=1)]
+        mesh = trimesh.Trimesh(self.vertices, faces, process=False)
+        if solid_only:
+            mesh.remove_unreferenced_vertices()
+        return mesh
+
+
+@dataclass(frozen=True)
+class Template:
+    """The five template bones in the RCS (mm), neutral pose.
+
+    rcs_from_myosim: 4x4 transform from the myo-sim radius body frame (mm) to the RCS.
+    """
+
+    bones: dict
+    rcs_from_myosim: np.ndarray
+
+
+def rcs_rotation(radius: trimesh.Trimesh, carpus_centroid, flexor_sites, extensor_sites) -> np.ndarray:
+    """Rows x (volar), y (proximal), z (radial) of the RCS in the myo-sim frame."""
+    centred = radius.vertices - radius.vertices.mean(axis=0)
+    y = np.linalg.svd(centred, full_matrices=False)[2][0]
+    if np.dot(radius.vertices.mean(axis=0) - carpus_centroid, y) < 0:
+        y = -y
+    volar = flexor_sites.mean(axis=0) - extensor_sites.mean(axis=0)
+    x = volar - np.dot(volar, y) * y
+    x /= np.linalg.norm(x)
+    z = np.cross(x, y)
+    return np.vstack([x, y, z])
+
+
+def _distal_part(mesh: trimesh.Trimesh, y_max: float) -> trimesh.Trimesh:
+    """Faces of `mesh` with any vertex below `y_max`, subdivided to ≤ SHAFT_EDGE_MM."""
+    keep = (mesh.vertices[mesh.faces][:, :, 1] < y_max).any(axis=1)
+    verts, faces = trimesh.remesh.subdivide_to_size(mesh.vertices, mesh.faces[keep], max_edge=SHAFT_EDGE_MM)
+    part = trimesh.Trimesh(verts, faces, process=True)
+    part.remove_unreferenced_vertices()
+    return part
+
+
+def _transform(mesh: trimesh.Trimesh, T: np.ndarray) -> trimesh.Trimesh:
+    out = mesh.copy()
+    out.apply_transform(T)
+    return out
+
+
+@functools.lru_cache(maxsize=1)
+def load_template() -> Template:
+    """The anatomy template (built once per process, ~1 s)."""
+    anatomy = load_myosim_anatomy()
+    meshes = anatomy.meshes
+    carpus = np.mean([meshes[b].centroid for b in CARPALS], axis=0)
+    R = rcs_rotation(meshes["radius"], carpus, anatomy.flexor_sites, anatomy.extensor_sites)
+    oriented = np.eye(4)
+    oriented[:3, :3] = R
+    m = {b: _transform(meshes[b], oriented) for b in BONES}
+    cap, articular = build_radius_cap([m["scaphoid"], m["lunate"]], m["radius"], joint_space_mm=JOINT_SPACE_MM)
+    top = cap.vertices[articular]
+    origin = top[np.argmin(np.linalg.norm(top[:, [0, 2]] - top[:, [0, 2]].mean(axis=0), axis=1))]
+    to_rcs = np.eye(4)
+    to_rcs[:3, 3] = -origin
+    rcs_from_myosim = to_rcs @ oriented
+    m = {b: _transform(mesh, to_rcs) for b, mesh in m.items()}
+    cap = _transform(cap, to_rcs)
+
+    y_cut = SHAFT_LENGTH_MM
+    shaft = _distal_part(m["radius"], y_cut)
+    radius_vertices = np.vstack([cap.vertices, shaft.vertices])
+    radius_faces = np.vstack([cap.faces, shaft.faces + len(cap.vertices)])
+    radius_solid = np.arange(len(radius_vertices)) < len(cap.vertices)
+    ulna = _distal_part(m["ulna"], y_cut)
+    bones = {
+        "radius": BoneSurface("radius", radius_vertices, radius_faces.astype(np.int64), radius_solid),
+        "ulna": BoneSurface("ulna", ulna.vertices.copy(), ulna.faces.astype(np.int64), np.zeros(len(ulna.vertices), bool)),
+    }
+    for b in CARPALS:
+        bones[b] = BoneSurface(b, m[b].vertices.copy(), m[b].faces.astype(np.int64), np.ones(len(m[b].vertices), bool))
+    for bone in bones.values():
+        for arr in (bone.vertices, bone.faces, bone.solid):
+            arr.setflags(write=False)
+    rcs_from_myosim.setflags(write=False)
+    return Template(bones=bones, rcs_from_myosim=rcs_from_myosim)
