@@ -1,0 +1,113 @@
+"""Author the template annotations (`wrist_env/anatomy/data/annotations.json`).
+
+Each ligament site is placed on the template bones (RCS: x volar, y proximal,
+z radial) by an anatomical rule quoted from the descriptions the preprint
+cites (Table 2): Berger 2001 (SLIL regions, RSC, LRL), Nagao 2005 (SRL, DRC,
+UL), Mizuseki 1989 (DRC), Ringler 2013 (RCL), Apergis 2013 (SCL), Moritomo
+2013 (UCL). A rule picks the extreme vertex of a bone region along an
+anatomical direction; the patch is the bone surface within `radius_mm` of it.
+Cartilage coverage is the part of each bone facing its partner within a gap.
+
+The output is plain data, reviewed in `experiments/figures/template_annotations.png`
+(`wrist-bench figure annotations`). Run: `python experiments/make_annotations.py`.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from wrist_env.anatomy.template import load_template
+from wrist_env.design import LIGAMENTS
+
+OUT = Path(__file__).resolve().parents[1] / "wrist_env" / "anatomy" / "data" / "annotations.json"
+
+
+def unit(*v):
+    v = np.asarray(v, float)
+    return v / np.linalg.norm(v)
+
+
+def extreme(points, direction, where=None):
+    """The point of `points` (restricted to `where`) furthest along `direction`."""
+    idx = np.arange(len(points)) if where is None else np.flatnonzero(where)
+    return points[idx[np.argmax(points[idx] @ unit(*direction))]]
+
+
+def patch_radius(bone: str, lig) -> float:
+    """Site radius (mm): wider on the coarser forearm bones and for the RSC membrane and 7-fibre bundles."""
+    if lig.name == "RSC":
+        return 3.5
+    if bone in ("radius", "ulna"):
+        return 3.0
+    return 2.5 if lig.fibres >= 7 else 2.0
+
+
+def main() -> None:
+    bones = load_template().bones
+    V = {b: bones[b].vertices for b in bones}
+    near = lambda a, b, gap: cKDTree(V[b]).query(V[a])[0] < gap  # noqa: E731
+    s_sl, l_sl = near("scaphoid", "lunate", 3.0), near("lunate", "scaphoid", 3.0)
+    distal_radius = V["radius"][:, 1] < 6.0
+    distal_ulna = V["ulna"][:, 1] < V["ulna"][:, 1].min() + 8.0
+    cap_waist = np.abs(V["capitate"][:, 1] - V["capitate"][:, 1].mean()) < 3.0
+    lun_c, sca_c = V["lunate"].mean(axis=0), V["scaphoid"].mean(axis=0)
+
+    site = {
+        # Berger 2001: the SLIL is C-shaped, volar, proximal (membranous) and dorsal regions
+        # spanning the rims of the scapholunate interval.
+        "SLIL_v": (("scaphoid", extreme(V["scaphoid"], (1, 0, 0), s_sl)), ("lunate", extreme(V["lunate"], (1, 0, 0), l_sl))),
+        "SLIL_p": (("scaphoid", extreme(V["scaphoid"], (0, 1, 0), s_sl)), ("lunate", extreme(V["lunate"], (0, 1, 0), l_sl))),
+        "SLIL_d": (("scaphoid", extreme(V["scaphoid"], (-1, 0, 0), s_sl)), ("lunate", extreme(V["lunate"], (-1, 0, 0), l_sl))),
+        # Berger 2001: RSC from the volar radial styloid, volar to the scaphoid waist, to the
+        # volar capitate waist.
+        "RSC": (("radius", extreme(V["radius"], (1, 0, 1), V["radius"][:, 1] < -2.0)), ("capitate", extreme(V["capitate"], (1, 0, 0.3), cap_waist))),
+        # Berger 2001, Nagao 2005: LRL from the volar rim of the scaphoid fossa, ulnar to the
+        # RSC, to the volar-radial horn of the lunate.
+        "LRL": (("radius", extreme(V["radius"], (1, -0.2, 0), distal_radius & (V["radius"][:, 2] > 1) & (V["radius"][:, 2] < 6))),
+                ("lunate", extreme(V["lunate"], (1, 0, 0.6)))),
+        # Nagao 2005: SRL from the volar rim of the lunate fossa to the volar-ulnar lunate.
+        "SRL": (("radius", extreme(V["radius"], (1, -0.2, 0), distal_radius & (V["radius"][:, 2] < -3) & (V["radius"][:, 2] > -10))),
+                ("lunate", extreme(V["lunate"], (1, 0.5, -0.3), V["lunate"][:, 1] > lun_c[1]))),
+        # Nagao 2005, Mizuseki 1989: DRC from the dorsal rim of the radius (Lister's region)
+        # to the dorsal lunate (its fibres continue to the triquetrum, not modelled).
+        "DRC": (("radius", extreme(V["radius"], (-1, -0.2, 0), distal_radius & (np.abs(V["radius"][:, 2]) < 5))),
+                ("lunate", extreme(V["lunate"], (-1, 0, 0)))),
+        # Ringler 2013: RCL from the tip of the radial styloid to the radial scaphoid waist.
+        "RCL": (("radius", extreme(V["radius"], (0, -1, 1.2), distal_radius)),
+                ("scaphoid", extreme(V["scaphoid"], (0, 0, 1), np.abs(V["scaphoid"][:, 1] - sca_c[1]) < 3))),
+        # Apergis 2013: SCL from the volar-ulnar distal pole of the scaphoid to the volar-radial capitate waist.
+        "SCL": (("scaphoid", extreme(V["scaphoid"], (1, -1, -0.5))), ("capitate", extreme(V["capitate"], (0.6, 0, 1), cap_waist))),
+        # Moritomo 2013: UCL from the ulnar fovea/styloid base, volar to the lunate, to the volar capitate.
+        "UCL": (("ulna", extreme(V["ulna"], (1, -0.3, 0), distal_ulna)), ("capitate", extreme(V["capitate"], (1, 0, -0.5), cap_waist))),
+        # Nagao 2005: UL from the volar ulnar head/TFCC to the volar-ulnar lunate.
+        "UL": (("ulna", extreme(V["ulna"], (1, -0.5, 0.5), distal_ulna)), ("lunate", extreme(V["lunate"], (1, 0, -1)))),
+    }
+    ligaments = {}
+    for lig in LIGAMENTS:
+        (ob, oc), (ib, ic) = site[lig.name]
+        ligaments[lig.name] = {
+            "origin": {"bone": ob, "centre_mm": np.round(oc, 3).tolist(), "radius_mm": patch_radius(ob, lig)},
+            "insertion": {"bone": ib, "centre_mm": np.round(ic, 3).tolist(), "radius_mm": patch_radius(ib, lig)},
+        }
+    cartilage = {
+        "radioscaphoid": {"bones": ["radius", "scaphoid"], "max_gap_mm": 2.5},
+        "radiolunate": {"bones": ["radius", "lunate"], "max_gap_mm": 2.5},
+        "scapholunate": {"bones": ["scaphoid", "lunate"], "max_gap_mm": 2.5},
+        "scaphocapitate": {"bones": ["scaphoid", "capitate"], "max_gap_mm": 3.0},
+        "lunocapitate": {"bones": ["lunate", "capitate"], "max_gap_mm": 2.5},
+    }
+    data = {
+        "about": "wrist-env template annotations in the template RCS (mm); written by experiments/make_annotations.py",
+        "cartilage": cartilage,
+        "ligaments": ligaments,
+    }
+    OUT.write_text(json.dumps(data, indent=2) + "\n")
+    print(f"wrote {OUT}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,173 @@
+"""The 27 ligament design variables (preprint Table 2): the one owner.
+
+Order: for the eleven ligaments of Table 2, in its order, the stiffness
+(N/mm) and reference strain (dimensionless, l_ref / l0) of each (22), then the
+injury scalars of SLIL_v, SLIL_p, SLIL_d, RSC, LRL (5).
+
+Normalized action a in [-1, 1]^27 ↔ physical value:
+    material = mean + 3·SD·a           (Table 2; reference strain 1.0 ± 0.1)
+    injury   = a                       (a < 0: complete tear; population: +1)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from wrist_env.errors import DesignError
+
+
+@dataclass(frozen=True)
+class Ligament:
+    """One Table 2 ligament: name, fibre count (0 for the 2D RSC membrane), stiffness N/mm."""
+
+    name: str
+    full_name: str
+    fibres: int
+    stiffness_mean: float
+    stiffness_sd: float
+    injurable: bool
+    source: str
+
+
+LIGAMENTS = (
+    Ligament("SLIL_v", "volar scapholunate interosseous ligament", 7, 33.0, 10.0, True, "Berger 2001"),
+    Ligament("SLIL_p", "proximal (membranous) scapholunate interosseous ligament", 7, 25.0, 7.5, True, "Berger 2001"),
+    Ligament("SLIL_d", "dorsal scapholunate interosseous ligament", 7, 79.0, 24.0, True, "Berger 2001"),
+    Ligament("RSC", "radioscaphocapitate ligament", 0, 10.0, 3.0, True, "Berger 2001"),
+    Ligament("LRL", "long radiolunate ligament", 4, 75.0, 23.0, True, "Berger 2001; Nagao 2005"),
+    Ligament("SRL", "short radiolunate ligament", 4, 75.0, 23.0, False, "Nagao 2005"),
+    Ligament("DRC", "dorsal radiocarpal ligament", 3, 75.0, 23.0, False, "Nagao 2005; Mizuseki 1989"),
+    Ligament("RCL", "radial collateral ligament", 3, 10.0, 3.0, False, "Ringler 2013"),
+    Ligament("SCL", "scaphocapitate ligament", 7, 40.0, 12.0, False, "Apergis 2013"),
+    Ligament("UCL", "ulnocapitate ligament", 3, 75.0, 23.0, False, "Moritomo 2013"),
+    Ligament("UL", "ulnolunate ligament", 3, 40.0, 12.0, False, "Nagao 2005"),
+)
+LIGAMENT_NAMES = tuple(lig.name for lig in LIGAMENTS)
+INJURABLE = tuple(lig.name for lig in LIGAMENTS if lig.injurable)
+N_LIGAMENTS = len(LIGAMENTS)
+N_MATERIAL = 2 * N_LIGAMENTS
+N_DESIGN = N_MATERIAL + len(INJURABLE)
+REFERENCE_STRAIN_MEAN = 1.0
+REFERENCE_STRAIN_SD = 0.1
+SPAN_SD = 3.0  # the action's ±1 spans ±3 SD
+
+NAMES = tuple(
+    [f"{n}.stiffness" for n in LIGAMENT_NAMES]
+    + [f"{n}.reference_strain" for n in LIGAMENT_NAMES]
+    + [f"{n}.injury" for n in INJURABLE]
+)
+"""Variable names in vector order: 11 stiffnesses, 11 reference strains, 5 injury scalars."""
+
+MEAN = np.concatenate([[l.stiffness_mean for l in LIGAMENTS], np.full(N_LIGAMENTS, REFERENCE_STRAIN_MEAN), np.ones(len(INJURABLE))])
+SD = np.concatenate([[l.stiffness_sd for l in LIGAMENTS], np.full(N_LIGAMENTS, REFERENCE_STRAIN_SD), np.full(len(INJURABLE), np.nan)])
+for _a in (MEAN, SD):
+    _a.setflags(write=False)
+
+
+@dataclass(frozen=True)
+class Design:
+    """A design in physical units.
+
+    stiffness: array of shape (11,), N/mm, Table 2 order.
+    reference_strain: array of shape (11,), l_ref / l0 (>1 taut, <1 slack in the neutral pose).
+    injury: array of shape (5,), scalars of SLIL_v, SLIL_p, SLIL_d, RSC, LRL; < 0 is a complete tear.
+    """
+
+    stiffness: np.ndarray
+    reference_strain: np.ndarray
+    injury: np.ndarray
+
+    def __post_init__(self):
+        for name, size in (("stiffness", N_LIGAMENTS), ("reference_strain", N_LIGAMENTS), ("injury", len(INJURABLE))):
+            arr = np.array(getattr(self, name), dtype=np.float64)
+            if arr.shape != (size,):
+                raise DesignError(f"`{name}` must have shape ({size},), but got {arr.shape}.")
+            if not np.all(np.isfinite(arr)):
+                raise DesignError(f"`{name}` must be finite, but got {arr.tolist()}.")
+            arr.setflags(write=False)
+            object.__setattr__(self, name, arr)
+        if np.any(self.stiffness <= 0):
+            raise DesignError(f"stiffness must be > 0 N/mm, but got {self.stiffness.tolist()}.")
+        if np.any(self.reference_strain <= 0):
+            raise DesignError(f"reference_strain must be > 0, but got {self.reference_strain.tolist()}.")
+
+    @property
+    def vector(self) -> np.ndarray:
+        """The 27 physical values in `NAMES` order."""
+        return np.concatenate([self.stiffness, self.reference_strain, self.injury])
+
+    @property
+    def torn(self) -> np.ndarray:
+        """Bool array of shape (11,): which ligaments are torn (Table 2 order)."""
+        out = np.zeros(N_LIGAMENTS, bool)
+        out[[LIGAMENT_NAMES.index(n) for n in INJURABLE]] = self.injury < 0
+        return out
+
+    @classmethod
+    def from_vector(cls, values) -> "Design":
+        """From the 27 physical values in `NAMES` order."""
+        v = np.asarray(values, dtype=np.float64)
+        if v.shape != (N_DESIGN,):
+            raise DesignError(f"a design vector must have shape ({N_DESIGN},), but got {v.shape}.")
+        return cls(v[:N_LIGAMENTS], v[N_LIGAMENTS:N_MATERIAL], v[N_MATERIAL:])
+
+    def as_dict(self) -> dict:
+        """JSON-able {name: value} in `NAMES` order."""
+        return {n: float(x) for n, x in zip(NAMES, self.vector)}
+
+    @classmethod
+    def from_dict(cls, data: dict) -> "Design":
+        missing = [n for n in NAMES if n not in data]
+        if missing:
+            raise DesignError(f"design is missing variables {missing}.")
+        return cls.from_vector([data[n] for n in NAMES])
+
+
+def check_action(action) -> np.ndarray:
+    """The action as float64 of shape (27,) in [-1, 1], or a DesignError naming the offending entries."""
+    a = np.asarray(action, dtype=np.float64)
+    if a.shape != (N_DESIGN,):
+        raise DesignError(f"an action must have shape ({N_DESIGN},), but got {a.shape}.")
+    bad = ~np.isfinite(a) | (np.abs(a) > 1.0 + 1e-9)
+    if bad.any():
+        detail = ", ".join(f"{NAMES[i]}={a[i]!r}" for i in np.flatnonzero(bad))
+        raise DesignError(f"actions must be finite and in [-1, 1], but got {detail}.")
+    return np.clip(a, -1.0, 1.0)
+
+
+def from_action(action) -> Design:
+    """Physical design of a normalized action in [-1, 1]^27."""
+    a = check_action(action)
+    values = MEAN + SPAN_SD * np.nan_to_num(SD) * a
+    values[N_MATERIAL:] = a[N_MATERIAL:]
+    return Design.from_vector(values)
+
+
+def to_action(design: Design) -> np.ndarray:
+    """Normalized action of a physical design (injury scalars clipped to [-1, 1])."""
+    v = design.vector
+    a = np.empty(N_DESIGN)
+    a[:N_MATERIAL] = (v[:N_MATERIAL] - MEAN[:N_MATERIAL]) / (SPAN_SD * SD[:N_MATERIAL])
+    a[N_MATERIAL:] = np.clip(v[N_MATERIAL:], -1.0, 1.0)
+    return a
+
+
+def population() -> Design:
+    """Table 2 means, all ligaments intact."""
+    return Design.from_vector(MEAN)
+
+
+def z_scores(design: Design) -> np.ndarray:
+    """Material values in Table 2 SD units, array of shape (22,)."""
+    return (design.vector[:N_MATERIAL] - MEAN[:N_MATERIAL]) / SD[:N_MATERIAL]
+
+
+def sample_materials(n: int, seed: int | None, *, truncate_sd: float = SPAN_SD) -> np.ndarray:
+    """Normalized material actions of shape (n, 22) drawn from Table 2's normals truncated at ±`truncate_sd`."""
+    from scipy.stats import truncnorm
+
+    rng = np.random.default_rng(seed)
+    z = truncnorm.rvs(-truncate_sd, truncate_sd, size=(n, N_MATERIAL), random_state=rng)
+    return z / SPAN_SD
