@@ -1,0 +1,94 @@
+"""Template annotations: cartilage coverage and ligament attachment sites.
+
+The data file `data/annotations.json` (authored by
+`experiments/make_annotations.py`, reviewed in a figure) gives, in the
+template RCS (mm): for each articulation its two bones and the largest
+bone-to-bone gap that cartilage covers; for each Table 2 ligament the bone,
+centre and radius of its origin and insertion sites. This module resolves
+them to vertex masks on the template bones.
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.resources
+import json
+from dataclasses import dataclass
+
+import igl
+import numpy as np
+
+from wrist_env.anatomy.template import load_template
+from wrist_env.design import LIGAMENT_NAMES
+
+ARTICULATIONS = ("radioscaphoid", "radiolunate", "scapholunate", "scaphocapitate", "lunocapitate")
+
+
+@dataclass(frozen=True)
+class Site:
+    """A ligament attachment site: bone name and vertex mask of shape (n_vertices,)."""
+
+    bone: str
+    mask: np.ndarray
+
+
+@dataclass(frozen=True)
+class Annotations:
+    """Resolved annotations on one set of bones.
+
+    coverage: articulation -> (bone_a, bone_b, mask_a, mask_b), masks over vertices.
+    sites: ligament -> (origin Site, insertion Site).
+    """
+
+    coverage: dict
+    sites: dict
+
+
+def read_annotation_data() -> dict:
+    """The raw annotation data (JSON) shipped with the package."""
+    path = importlib.resources.files("wrist_env.anatomy") / "data" / "annotations.json"
+    return json.loads(path.read_text())
+
+
+def facing_within(vertices, normals, partner_vertices, partner_faces, max_gap_mm) -> np.ndarray:
+    """Bool mask: vertices within `max_gap_mm` of the partner surface whose normal faces it."""
+    d2, _, closest = igl.point_mesh_squared_distance(
+        np.ascontiguousarray(vertices, dtype=np.float64), partner_vertices, partner_faces
+    )
+    towards = np.einsum("ij,ij->i", normals, closest - vertices)
+    return (np.sqrt(d2) < max_gap_mm) & (towards > 0)
+
+
+def resolve(bones: dict, data: dict | None = None) -> Annotations:
+    """Resolve annotation data on `bones` (name -> BoneSurface in the template RCS)."""
+    data = read_annotation_data() if data is None else data
+    solids = {name: b.trimesh(solid_only=True) for name, b in bones.items() if b.solid.any()}
+    coverage = {}
+    for art in ARTICULATIONS:
+        spec = data["cartilage"][art]
+        a, b = spec["bones"]
+        masks = []
+        for me, other in ((a, b), (b, a)):
+            surface = bones[me].trimesh()
+            mask = facing_within(
+                surface.vertices, surface.vertex_normals, solids[other].vertices,
+                solids[other].faces.astype(np.int64), spec["max_gap_mm"],
+            )
+            masks.append(mask & bones[me].solid)
+        coverage[art] = (a, b, masks[0], masks[1])
+    sites = {}
+    for lig in LIGAMENT_NAMES:
+        pair = []
+        for end in ("origin", "insertion"):
+            spec = data["ligaments"][lig][end]
+            v = bones[spec["bone"]].vertices
+            mask = np.linalg.norm(v - np.asarray(spec["centre_mm"]), axis=1) <= spec["radius_mm"]
+            pair.append(Site(spec["bone"], mask))
+        sites[lig] = tuple(pair)
+    return Annotations(coverage=coverage, sites=sites)
+
+
+@functools.lru_cache(maxsize=1)
+def template_annotations() -> Annotations:
+    """Annotations resolved on the anatomy template."""
+    return resolve(load_template().bones)

@@ -1,0 +1,240 @@
+"""Build a participant `Model` from its bones (preprint 2.2.1–2.2.2), as a recipe.
+
+morph the annotated template → transfer coverage and ligament sites →
+cartilage thickness, overclosure removal, wedges → ligament fibres and the RSC
+membrane → contact law → signed-distance grids and contact samples → mass.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import trimesh
+from scipy.spatial import cKDTree
+
+from wrist_env.anatomy.annotations import ARTICULATIONS, template_annotations
+from wrist_env.anatomy.template import load_template
+from wrist_env.build import cartilage, contact_law, fibres, mass, morph, sdf
+from wrist_env.design import LIGAMENTS, LIGAMENT_NAMES
+from wrist_env.errors import BuildError
+from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model, offsets
+
+BUILDER_VERSION = 1
+GRID_BONES = ("radius", "scaphoid", "lunate", "capitate")
+
+
+@dataclass(frozen=True)
+class BuildParams:
+    """Build parameters (all lengths mm)."""
+
+    contact_spacing_mm: float = 1.0
+    grid_spacing_mm: float = 0.5
+    grid_margin_mm: float = 3.0
+    grnn_bandwidth_mm: float = 1.0
+    max_thickness_mm: float = 1.1
+    min_total_thickness_mm: float = 0.2
+    membrane_along: int = 9
+    membrane_across: int = 5
+    seed: int = 0
+
+
+def source_hash(name: str, bones: dict, params: BuildParams) -> str:
+    """Hash of everything a build depends on: bones, parameters, builder and annotation versions."""
+    h = hashlib.sha256()
+    h.update(json.dumps({"name": name, "params": asdict(params), "builder": BUILDER_VERSION}, sort_keys=True).encode())
+    from wrist_env.anatomy.annotations import read_annotation_data
+
+    h.update(json.dumps(read_annotation_data(), sort_keys=True).encode())
+    for bone in BONES:
+        h.update(np.ascontiguousarray(np.round(bones[bone].vertices, 6)).tobytes())
+        h.update(np.ascontiguousarray(bones[bone].faces).tobytes())
+    return h.hexdigest()[:16]
+
+
+def _morph_all(bones: dict, seed: int) -> tuple[dict, dict]:
+    template = load_template().bones
+    results, report = {}, {}
+    for bone in BONES:
+        t, p = template[bone], bones[bone]
+        results[bone] = morph.morph(t.vertices, t.faces, p.vertices, p.faces, seed=seed)
+        report[bone] = {"mean": round(results[bone].error_mean_mm, 4), "max": round(results[bone].error_max_mm, 4)}
+    return results, report
+
+
+def _transfer(morphs: dict, bones: dict) -> tuple[dict, dict]:
+    """Coverage and ligament site masks on the participant's bones."""
+    ann = template_annotations()
+    coverage = {}
+    for art, (a, b, ma, mb) in ann.coverage.items():
+        coverage[art] = (a, b,
+                         morph.transfer_mask(morphs[a], ma, bones[a].vertices) & bones[a].solid,
+                         morph.transfer_mask(morphs[b], mb, bones[b].vertices) & bones[b].solid)
+    sites = {}
+    for lig, (o, i) in ann.sites.items():
+        sites[lig] = tuple((s.bone, morph.transfer_mask(morphs[s.bone], s.mask, bones[s.bone].vertices)) for s in (o, i))
+    return coverage, sites
+
+
+def _ligaments(bones: dict, sites: dict, params: BuildParams):
+    bundles, membrane = [], None
+    for k, lig in enumerate(LIGAMENTS):
+        (ob, om), (ib, im) = sites[lig.name]
+        if lig.fibres == 0:
+            scaphoid = trimesh.Trimesh(bones["scaphoid"].vertices, bones["scaphoid"].faces, process=False)
+            membrane = fibres.build_membrane(bones[ob].vertices[om], bones[ib].vertices[im], scaphoid,
+                                             n_along=params.membrane_along, n_across=params.membrane_across)
+            continue
+        bundles.append((k, ob, ib, fibres.build_bundle(
+            lig.name, bones[ob].vertices[om], bones[ib].vertices[im], lig.fibres, params.seed + k,
+            origin_vertex_ids=np.flatnonzero(om), insertion_vertex_ids=np.flatnonzero(im))))
+    return bundles, membrane
+
+
+def _vertex_areas(vertices, faces) -> np.ndarray:
+    area = trimesh.triangles.area(vertices[faces])
+    out = np.zeros(len(vertices))
+    np.add.at(out, faces.ravel(), np.repeat(area / 3.0, 3))
+    return out
+
+
+def _thin(points, spacing_mm) -> np.ndarray:
+    """Indices of one point per `spacing_mm` voxel (the one nearest its voxel centre)."""
+    cell = np.floor(points / spacing_mm).astype(np.int64)
+    d = np.linalg.norm(points / spacing_mm - cell - 0.5, axis=1)
+    order = np.lexsort((d, cell[:, 2], cell[:, 1], cell[:, 0]))
+    c = cell[order]
+    first = np.ones(len(order), bool)
+    first[1:] = np.any(c[1:] != c[:-1], axis=1)
+    return order[first], order, np.cumsum(first) - 1
+
+
+def _contact_samples(bones, thickness, coverage, params):
+    """Pair-sorted contact samples on each pair's sample bone (see `Model`)."""
+    pts, nrm, area, h, sizes = [], [], [], [], []
+    displaced = {b: cartilage.displaced_vertices(bones[b].vertices, bones[b].faces, thickness[b]) for b in GRID_BONES}
+    for p, art in enumerate(PAIRS):
+        a, b = BONES[PAIR_BONES[p][0]], BONES[PAIR_BONES[p][1]]
+        ca, cb = coverage[art][2], coverage[art][3]
+        if coverage[art][0] != a:
+            ca, cb = cb, ca
+        idx = np.flatnonzero(ca)
+        if len(idx) == 0:
+            raise BuildError(f"articulation {art} has no cartilage coverage on the {a}")
+        mesh = trimesh.Trimesh(displaced[a], bones[a].faces, process=False)
+        vertex_area = _vertex_areas(displaced[a], bones[a].faces)[idx]
+        keep, order, group = _thin(displaced[a][idx], params.contact_spacing_mm)
+        sample_area = np.bincount(group, weights=vertex_area[order])
+        chosen = idx[keep]
+        partner = np.flatnonzero(cb)
+        _, nearest = cKDTree(displaced[b][partner]).query(displaced[a][chosen])
+        total = thickness[a][chosen] + thickness[b][partner[nearest]]
+        pts.append(displaced[a][chosen])
+        nrm.append(mesh.vertex_normals[chosen])
+        area.append(sample_area)
+        h.append(np.maximum(total, params.min_total_thickness_mm))
+        sizes.append(len(chosen))
+    return displaced, np.vstack(pts), np.vstack(nrm), np.concatenate(area), np.concatenate(h), offsets(sizes)
+
+
+def build_model(name: str, bones: dict, params: BuildParams | None = None) -> Model:
+    """Build the participant model from its bones (name -> BoneSurface, RCS mm, neutral pose)."""
+    params = params or BuildParams()
+    missing = [b for b in BONES if b not in bones]
+    if missing:
+        raise BuildError(f"participant {name!r} lacks bones {missing}")
+    clock = time.perf_counter()
+    timings = {}
+
+    def lap(step):
+        nonlocal clock
+        now = time.perf_counter()
+        timings[step] = round(now - clock, 3)
+        clock = now
+
+    morphs, morph_report = _morph_all(bones, params.seed)
+    lap("morph")
+    coverage, sites = _transfer(morphs, bones)
+    articulations = {(a, b): (ma, mb) for (a, b, ma, mb) in coverage.values()}
+    verts = {b: bones[b].vertices for b in BONES}
+    faces = {b: bones[b].faces for b in BONES}
+    thickness, cart_report = cartilage.build_cartilage(
+        verts, faces, articulations, bandwidth_mm=params.grnn_bandwidth_mm, max_thickness_mm=params.max_thickness_mm)
+    thickness = {b: thickness.get(b, np.zeros(len(verts[b]))) for b in BONES}
+    lap("cartilage")
+    bundles, membrane = _ligaments(bones, sites, params)
+    lap("ligaments")
+    law = contact_law.fit_contact_law()
+    lap("contact_law")
+    displaced, s_pts, s_nrm, s_area, s_h, s_off = _contact_samples(bones, thickness, coverage, params)
+    grids = {}
+    for b in GRID_BONES:
+        f = bones[b].faces[bones[b].solid[bones[b].faces].all(axis=1)]
+        grids[b] = sdf.signed_distance_grid(displaced[b], f, spacing_mm=params.grid_spacing_mm, margin_mm=params.grid_margin_mm)
+    lap("grids")
+    masses = [mass.mass_properties(*_solid(bones[b])) if bones[b].solid.any() else (0.0, np.zeros(3), np.zeros((3, 3))) for b in BONES]
+    lap("mass")
+
+    empty = np.zeros((0, 0, 0), np.float32)
+    grid_list = [grids.get(b) for b in BONES]
+    ref_len = np.array([next((bd.reference_length_mm for k2, _, _, bd in bundles if k2 == k), np.nan) for k in range(len(LIGAMENTS))])
+    rsc = LIGAMENT_NAMES.index("RSC")
+    along = membrane.connector_kind == 0
+    ref_len[rsc] = float(np.mean(membrane.reference_length_mm[along]))
+    membrane_bone = np.full(len(membrane.nodes), -1, np.int64)
+    membrane_bone[membrane.radius_nodes] = BONES.index("radius")
+    membrane_bone[membrane.capitate_nodes] = BONES.index("capitate")
+
+    report = {
+        "name": name,
+        "build_seconds": round(sum(timings.values()), 2),
+        "timings_s": timings,
+        "morph_error_mm": morph_report,
+        "fibres": {LIGAMENTS[k].name: int(len(bd.origin)) for k, _, _, bd in bundles} | {"RSC": int(len(membrane.connectors))},
+        "reference_length_mm": {n: round(float(x), 3) for n, x in zip(LIGAMENT_NAMES, ref_len)},
+        "contact_law_r2": round(float(law.r2), 5),
+        "contact_samples": {p: int(s_off[i + 1] - s_off[i]) for i, p in enumerate(PAIRS)},
+        **cart_report,
+    }
+    return Model(
+        name=name,
+        source_hash=source_hash(name, bones, params),
+        vertices=np.vstack([bones[b].vertices for b in BONES]),
+        vertex_offsets=offsets([len(bones[b].vertices) for b in BONES]),
+        faces=np.vstack([bones[b].faces for b in BONES]).astype(np.int64),
+        face_offsets=offsets([len(bones[b].faces) for b in BONES]),
+        thickness=np.concatenate([thickness[b] for b in BONES]),
+        mass=np.array([m[0] for m in masses]),
+        com=np.array([m[1] for m in masses]),
+        inertia=np.array([m[2] for m in masses]),
+        grid_origin=np.array([g.origin if g else np.zeros(3) for g in grid_list]),
+        grid_spacing=np.array([g.spacing_mm if g else 0.0 for g in grid_list]),
+        grid_shape=np.array([g.values.shape if g else (0, 0, 0) for g in grid_list], dtype=np.int64),
+        grid_values=np.concatenate([(g.values if g else empty).ravel() for g in grid_list]),
+        grid_offsets=offsets([(g.values if g else empty).size for g in grid_list]),
+        sample_points=s_pts,
+        sample_normals=s_nrm,
+        sample_area=s_area,
+        sample_thickness=s_h,
+        sample_offsets=s_off,
+        contact_law=law.law.as_array(),
+        fibre_ligament=np.concatenate([np.full(len(bd.origin), k) for k, _, _, bd in bundles]).astype(np.int64),
+        fibre_bones=np.concatenate([np.tile([BONES.index(o), BONES.index(i)], (len(bd.origin), 1)) for _, o, i, bd in bundles]).astype(np.int64),
+        fibre_origin=np.vstack([bd.origin for *_, bd in bundles]),
+        fibre_insertion=np.vstack([bd.insertion for *_, bd in bundles]),
+        reference_length=ref_len,
+        membrane_nodes=membrane.nodes,
+        membrane_bone=membrane_bone,
+        membrane_connectors=membrane.connectors.astype(np.int64),
+        membrane_kind=membrane.connector_kind.astype(np.int64),
+        membrane_length=membrane.reference_length_mm,
+        report=report,
+    )
+
+
+def _solid(bone):
+    f = bone.faces[bone.solid[bone.faces].all(axis=1)]
+    return bone.vertices, f

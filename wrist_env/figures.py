@@ -1,0 +1,138 @@
+"""Figures of models and annotations (matplotlib, PNG)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection  # noqa: E402
+
+from wrist_env.design import LIGAMENT_NAMES  # noqa: E402
+
+FIGURES = Path("experiments") / "figures"
+BONE_COLOUR = {"radius": "#d9cfc1", "ulna": "#d9cfc1", "scaphoid": "#e8dcc8", "lunate": "#e3d5bd", "capitate": "#eadfcf"}
+VIEWS = (("volar view", 0, 0), ("radial view", 0, 90), ("oblique", 25, 40))
+LIGAMENT_COLOURS = dict(zip(LIGAMENT_NAMES, plt.get_cmap("tab10").colors + ("#000000",)))
+
+
+def _to_plot(p):
+    """RCS (x volar, y proximal, z radial) to plot axes (radial right, volar towards the viewer, proximal up)."""
+    p = np.asarray(p)
+    return np.stack([p[..., 2], -p[..., 0], p[..., 1]], axis=-1)
+
+
+def _add_mesh(ax, vertices, faces, colour, alpha=1.0, facecolors=None):
+    tris = _to_plot(vertices[faces])
+    coll = Poly3DCollection(tris, facecolors=facecolors if facecolors is not None else colour,
+                            linewidths=0, alpha=alpha, shade=True, lightsource=matplotlib.colors.LightSource(45, 45))
+    ax.add_collection3d(coll)
+
+
+def _frame(ax, points, title):
+    p = _to_plot(points)
+    centre = (p.max(axis=0) + p.min(axis=0)) / 2
+    half = (p.max(axis=0) - p.min(axis=0)).max() / 2
+    for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
+        setter(c - half, c + half)
+    ax.set_box_aspect((1, 1, 1))
+    ax.set_xlabel("radial (mm)")
+    ax.set_ylabel("dorsal (mm)")
+    ax.set_zlabel("proximal (mm)")
+    ax.set_title(title)
+
+
+def _crop(vertices, faces, y_max):
+    return faces[(vertices[faces][:, :, 1] < y_max).all(axis=1)]
+
+
+def model_figure(name: str, out: Path | None = None) -> Path:
+    """Bones, cartilage coloured by thickness, ligament fibres and the RSC membrane of a model."""
+    from wrist_env.model import BONES
+    from wrist_env.participants.registry import load_model
+
+    model = load_model(name)
+    out = out or FIGURES / f"model_{name}.png"
+    fig = plt.figure(figsize=(16, 6.2))
+    norm = matplotlib.colors.Normalize(0.0, 1.1)
+    cmap = plt.get_cmap("viridis")
+    for k, (title, elev, azim) in enumerate(VIEWS):
+        ax = fig.add_subplot(1, 3, k + 1, projection="3d")
+        for bone in BONES:
+            v, f = model.bone_mesh(bone)
+            f = _crop(v, f, 14.0)
+            t = model.bone_thickness(bone)
+            ft = t[f].mean(axis=1)
+            colours = np.array([matplotlib.colors.to_rgba(BONE_COLOUR[bone])] * len(f))
+            covered = ft > 0.05
+            colours[covered] = cmap(norm(ft[covered]))
+            _add_mesh(ax, v, f, None, facecolors=colours)
+        segs = np.stack([model.fibre_origin, model.fibre_insertion], axis=1)
+        lc = Line3DCollection(_to_plot(segs), colors=[LIGAMENT_COLOURS[LIGAMENT_NAMES[i]] for i in model.fibre_ligament], linewidths=1.6)
+        ax.add_collection3d(lc)
+        nodes = model.membrane_nodes
+        ms = np.stack([nodes[model.membrane_connectors[:, 0]], nodes[model.membrane_connectors[:, 1]]], axis=1)
+        ax.add_collection3d(Line3DCollection(_to_plot(ms), colors=LIGAMENT_COLOURS["RSC"], linewidths=1.0))
+        ax.view_init(elev=elev, azim=azim - 90)
+        _frame(ax, model.vertices[model.vertices[:, 1] < 14.0], title)
+    handles = [plt.Line2D([], [], color=LIGAMENT_COLOURS[n], lw=2, label=n) for n in LIGAMENT_NAMES]
+    fig.legend(handles=handles, loc="lower center", ncol=11, frameon=False)
+    sm = plt.cm.ScalarMappable(norm=norm, cmap=cmap)
+    fig.colorbar(sm, ax=fig.axes, shrink=0.5, label="cartilage thickness (mm)", location="right")
+    fig.suptitle(f"{name}: bones, cartilage thickness, ligament fibres and the RSC membrane (RCS, neutral pose)")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+    return out
+
+
+ANNOTATION_PANELS = (
+    # title, bones shown, elevation, azimuth (plot frame: x radial, y dorsal-negative, z proximal)
+    ("carpus, volar view", ("scaphoid", "lunate", "capitate"), 0, 0),
+    ("carpus, dorsal view", ("scaphoid", "lunate", "capitate"), 0, 180),
+    ("carpus, proximal view", ("scaphoid", "lunate", "capitate"), 90, 0),
+    ("radius and ulna, distal view", ("radius", "ulna"), -90, 0),
+)
+
+
+def annotations_figure(out: Path | None = None) -> Path:
+    """The template with its cartilage coverage and ligament attachment sites, for review."""
+    from wrist_env.anatomy.annotations import ARTICULATIONS, template_annotations
+    from wrist_env.anatomy.template import load_template
+
+    bones = load_template().bones
+    ann = template_annotations()
+    out = out or FIGURES / "template_annotations.png"
+    art_colours = dict(zip(ARTICULATIONS, ("#f4a6a0", "#9fc3e0", "#b9e3ae", "#d3bde0", "#fdd49e")))
+    fig = plt.figure(figsize=(18, 5.6))
+    for k, (title, shown, elev, azim) in enumerate(ANNOTATION_PANELS):
+        ax = fig.add_subplot(1, 4, k + 1, projection="3d")
+        for name in shown:
+            bone = bones[name]
+            f = _crop(bone.vertices, bone.faces, 14.0)
+            if name == "radius":  # the articular solid's walls and base hide the fossae
+                f = f[(bone.vertices[f][:, :, 1] < bone.vertices[bone.solid, 1].max() - 0.1).all(axis=1)]
+            colours = np.array([matplotlib.colors.to_rgba(BONE_COLOUR[name])] * len(f))
+            for art, (a, b, ma, mb) in ann.coverage.items():
+                for bn, m in ((a, ma), (b, mb)):
+                    if bn == name:
+                        colours[m[f].all(axis=1)] = matplotlib.colors.to_rgba(art_colours[art], 0.9)
+            _add_mesh(ax, bone.vertices, f, None, facecolors=colours)
+            for lig, sites in ann.sites.items():
+                for s in sites:
+                    if s.bone == name:
+                        p = _to_plot(bone.vertices[s.mask])
+                        ax.scatter(p[:, 0], p[:, 1], p[:, 2], s=9, color=LIGAMENT_COLOURS[lig], depthshade=False)
+        ax.view_init(elev=elev, azim=azim - 90)
+        _frame(ax, np.vstack([bones[b].vertices[bones[b].vertices[:, 1] < 14.0] for b in shown]), title)
+    handles = [plt.Line2D([], [], color=c, lw=6, label=a) for a, c in art_colours.items()]
+    handles += [plt.Line2D([], [], color=LIGAMENT_COLOURS[n], marker="o", lw=0, label=n) for n in LIGAMENT_NAMES]
+    fig.legend(handles=handles, loc="lower center", ncol=8, frameon=False)
+    fig.suptitle("Template annotations: cartilage coverage per articulation (patches) and ligament sites (dots), RCS")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+    return out

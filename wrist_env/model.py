@@ -1,0 +1,115 @@
+"""The simulation-ready participant model: immutable arrays, saved as `.npz` + JSON.
+
+All positions are in the RCS at the neutral pose (mm), which is also each
+bone's own frame: a bone's pose is the 4x4 transform of its neutral-pose
+points. Ragged per-bone or per-pair data are concatenated with offsets, so
+`x[offsets[i]:offsets[i + 1]]` is item i; this is the layout the kernels read.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from wrist_env.io import load_dataclass, save_dataclass
+
+BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate")
+RADIUS, ULNA, SCAPHOID, LUNATE, CAPITATE = range(5)
+PAIRS = ("radioscaphoid", "radiolunate", "scapholunate", "scaphocapitate", "lunocapitate")
+PAIR_BONES = np.array([[SCAPHOID, RADIUS], [LUNATE, RADIUS], [SCAPHOID, LUNATE], [CAPITATE, SCAPHOID], [CAPITATE, LUNATE]])
+"""(sample bone, grid bone) of each contact pair: samples of the first are looked up in the second's grid."""
+
+
+@dataclass(frozen=True)
+class Model:
+    """A participant model.
+
+    Bones (5, `BONES` order):
+        vertices (V, 3) mm, vertex_offsets (6,); faces (F, 3) local indices, face_offsets (6,);
+        thickness (V,) mm, cartilage thickness per vertex (0 off cartilage);
+        mass (5,) t; com (5, 3) mm; inertia (5, 3, 3) t·mm² about the com, RCS axes.
+    Contact grids (one per bone; empty for the ulna):
+        grid_origin (5, 3) mm; grid_spacing (5,) mm; grid_shape (5, 3);
+        grid_values (G,) float32 mm, C-order per bone, grid_offsets (6,).
+    Contact samples (pair-sorted, 5 pairs in `PAIRS` order, bones in `PAIR_BONES`):
+        sample_points (S, 3) mm on the sample bone's cartilage surface; sample_normals (S, 3);
+        sample_area (S,) mm²; sample_thickness (S,) mm, total cartilage thickness of both layers;
+        sample_offsets (6,).
+    contact_law (5,): tri-linear pressure–strain law [e1, e2, k1, k2, k3] (strain, MPa).
+    Ligament fibres (1D bundles, Table 2 order):
+        fibre_ligament (N,) ligament index; fibre_bones (N, 2) origin, insertion bone;
+        fibre_origin (N, 3), fibre_insertion (N, 3) mm; reference_length (11,) mm, the mean
+        neutral fibre length of each bundle (for the RSC, of its longitudinal connectors).
+    RSC membrane:
+        membrane_nodes (M, 3) mm; membrane_bone (M,) attached bone or -1 if free;
+        membrane_connectors (C, 2); membrane_kind (C,) 0 along, 1 across; membrane_length (C,) mm.
+    """
+
+    name: str
+    source_hash: str
+    vertices: np.ndarray
+    vertex_offsets: np.ndarray
+    faces: np.ndarray
+    face_offsets: np.ndarray
+    thickness: np.ndarray
+    mass: np.ndarray
+    com: np.ndarray
+    inertia: np.ndarray
+    grid_origin: np.ndarray
+    grid_spacing: np.ndarray
+    grid_shape: np.ndarray
+    grid_values: np.ndarray
+    grid_offsets: np.ndarray
+    sample_points: np.ndarray
+    sample_normals: np.ndarray
+    sample_area: np.ndarray
+    sample_thickness: np.ndarray
+    sample_offsets: np.ndarray
+    contact_law: np.ndarray
+    fibre_ligament: np.ndarray
+    fibre_bones: np.ndarray
+    fibre_origin: np.ndarray
+    fibre_insertion: np.ndarray
+    reference_length: np.ndarray
+    membrane_nodes: np.ndarray
+    membrane_bone: np.ndarray
+    membrane_connectors: np.ndarray
+    membrane_kind: np.ndarray
+    membrane_length: np.ndarray
+    report: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        for name, value in vars(self).items():
+            if isinstance(value, np.ndarray):
+                value.setflags(write=False)
+
+    def bone_mesh(self, bone: str) -> tuple[np.ndarray, np.ndarray]:
+        """(vertices (n, 3) mm, faces (m, 3)) of one bone, neutral pose."""
+        i = BONES.index(bone)
+        return (self.vertices[self.vertex_offsets[i]:self.vertex_offsets[i + 1]],
+                self.faces[self.face_offsets[i]:self.face_offsets[i + 1]])
+
+    def bone_thickness(self, bone: str) -> np.ndarray:
+        """Cartilage thickness (n,) mm on one bone's vertices."""
+        i = BONES.index(bone)
+        return self.thickness[self.vertex_offsets[i]:self.vertex_offsets[i + 1]]
+
+    def grid(self, bone: str) -> np.ndarray:
+        """The signed-distance values (nx, ny, nz) of one bone's contact grid."""
+        i = BONES.index(bone)
+        return self.grid_values[self.grid_offsets[i]:self.grid_offsets[i + 1]].reshape(self.grid_shape[i])
+
+    def save(self, path) -> None:
+        """Write `path.npz` + `path.json`."""
+        save_dataclass(self, path)
+
+    @classmethod
+    def load(cls, path) -> "Model":
+        """Read a model written by `save`."""
+        return load_dataclass(cls, path)
+
+
+def offsets(sizes) -> np.ndarray:
+    """Offsets (n + 1,) of concatenated items of the given sizes."""
+    return np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)

@@ -1,0 +1,66 @@
+"""Built-in participants P1–P3 (preprint Table 1), synthetic and said to be.
+
+No 4DCT ships, so each built-in participant is the anatomy template under a
+smooth participant-specific warp and isotropic scale, with hidden
+ground-truth ligament properties drawn from Table 2's distributions (fixed
+seed). `experiments/make_participants.py` writes the data files under
+`participants/data/<name>/` (`participant.json`, `truth.json`).
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.resources
+import json
+from dataclasses import dataclass
+
+import numpy as np
+
+from wrist_env.anatomy.template import BoneSurface, load_template
+from wrist_env.build.warp import Warp
+from wrist_env.design import Design
+from wrist_env.errors import ParticipantError
+
+BUILTIN = ("P1", "P2", "P3")
+
+
+@dataclass(frozen=True)
+class BuiltinInfo:
+    """Table 1 facts and the synthetic warp of one built-in participant."""
+
+    name: str
+    sex: str
+    age: int
+    facet_type: str
+    task: str
+    warp: dict
+    truth_seed: int
+
+
+def _data(name: str, file: str) -> dict:
+    if name not in BUILTIN:
+        raise ParticipantError(f"unknown built-in participant {name!r}; the built-in ones are {list(BUILTIN)}")
+    path = importlib.resources.files("wrist_env.participants") / "data" / name / file
+    return json.loads(path.read_text())
+
+
+def info(name: str) -> BuiltinInfo:
+    """Table 1 facts and warp parameters of a built-in participant."""
+    return BuiltinInfo(**_data(name, "participant.json"))
+
+
+def truth(name: str) -> Design:
+    """The hidden ground-truth ligament design of a built-in participant."""
+    return Design.from_dict(_data(name, "truth.json"))
+
+
+@functools.lru_cache(maxsize=len(BUILTIN))
+def bones(name: str) -> dict:
+    """The participant's bones: the template under its warp (name -> BoneSurface, RCS mm)."""
+    warp = Warp.from_dict(info(name).warp)
+    out = {}
+    for bone, surface in load_template().bones.items():
+        v = warp.apply(surface.vertices)
+        v.setflags(write=False)
+        out[bone] = BoneSurface(bone, v, surface.faces, surface.solid)
+    return out

@@ -1,0 +1,70 @@
+"""Participants by name: the built-in P1–P3 and user folders, and their cached models.
+
+Models are cached as `.npz` + `.json` under `$WRIST_ENV_CACHE` (default
+`~/.cache/wrist_env`), keyed by a hash of the bones, the build parameters,
+the annotations and the builder version.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from wrist_env.anatomy.template import BoneSurface
+from wrist_env.build.pipeline import BuildParams, build_model, source_hash
+from wrist_env.errors import ParticipantError
+from wrist_env.model import BONES, Model
+from wrist_env.participants import builtin
+
+_FOLDERS: dict[str, Path] = {}
+
+
+def cache_dir() -> Path:
+    """Where built models are cached."""
+    return Path(os.environ.get("WRIST_ENV_CACHE", Path.home() / ".cache" / "wrist_env"))
+
+
+def participants() -> tuple[str, ...]:
+    """Names of all known participants: built-in first, then registered folders."""
+    return builtin.BUILTIN + tuple(n for n in _FOLDERS if n not in builtin.BUILTIN)
+
+
+def add_folder(folder) -> str:
+    """Validate a participant folder and make it known by its name; returns the name."""
+    from wrist_env.participants.folder import load_participant_folder
+
+    source = load_participant_folder(folder)
+    if source.name in builtin.BUILTIN:
+        raise ParticipantError(f"{Path(folder) / 'participant.toml'}: name {source.name!r} is taken by a built-in participant")
+    _FOLDERS[source.name] = Path(folder)
+    return source.name
+
+
+def bones(name: str) -> dict:
+    """The participant's bones (name -> BoneSurface, RCS mm, neutral pose)."""
+    if name in builtin.BUILTIN:
+        return builtin.bones(name)
+    if name not in _FOLDERS:
+        raise ParticipantError(f"unknown participant {name!r}; known: {list(participants())}")
+    from wrist_env.participants.folder import load_participant_folder
+
+    source = load_participant_folder(_FOLDERS[name])
+    return {b: BoneSurface(b, v, f, np.ones(len(v), bool)) for b, (v, f) in source.bones.items()}
+
+
+def load_model(name: str, params: BuildParams | None = None, *, cache: bool = True) -> Model:
+    """The participant's model, built on first use and cached by the hash of its inputs."""
+    params = params or BuildParams()
+    b = bones(name)
+    path = cache_dir() / f"{name}-{source_hash(name, b, params)}"
+    if cache and path.with_suffix(".json").exists() and path.with_suffix(".npz").exists():
+        return Model.load(path)
+    model = build_model(name, b, params)
+    if cache:
+        model.save(path)
+    return model
+
+
+__all__ = ["BONES", "add_folder", "bones", "cache_dir", "load_model", "participants"]
