@@ -132,7 +132,7 @@ def check_action(action) -> np.ndarray:
         raise DesignError(f"an action must have shape ({N_DESIGN},), but got {a.shape}.")
     bad = ~np.isfinite(a) | (np.abs(a) > 1.0 + 1e-9)
     if bad.any():
-        detail = ", ".join(f"{NAMES[i]}={a[i]!r}" for i in np.flatnonzero(bad))
+        detail = ", ".join(f"{NAMES[i]}={float(a[i])!r}" for i in np.flatnonzero(bad))
         raise DesignError(f"actions must be finite and in [-1, 1], but got {detail}.")
     return np.clip(a, -1.0, 1.0)
 

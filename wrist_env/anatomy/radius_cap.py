@@ -112,7 +112,7 @@ def extrude_heightfield(xs, zs, height, *, depth_mm=4.0) -> trimesh.Trimesh:
     return mesh
 
 
-def build_radius_cap(row_meshes, radius_mesh, *, joint_space_mm=1.5, spacing_mm=0.5, depth_mm=4.0):
+def build_radius_cap(row_meshes, radius_mesh, *, joint_space_mm=1.5, spacing_mm=0.4, depth_mm=4.0):
     """The rebuilt distal radius articular solid and its articular (top) vertex mask.
 
     Returns (mesh, articular) where articular is a bool array over mesh vertices.

@@ -12,7 +12,7 @@ defined from landmarks, not assumed from the mesh frame:
 - origin: centre of the rebuilt articular surface (scaphoid + lunate fossae).
 
 Bones: the carpal meshes as shipped (watertight, ~0.7 mm edges); the radius
-is the rebuilt articular solid (≤ 0.5 mm grid) plus the distal 45 mm of the
+is the rebuilt articular solid (0.4 mm grid) plus the distal 45 mm of the
 shaft subdivided to ≤ 1.5 mm (for ligament sites and display); the ulna is its
 distal 45 mm subdivided likewise.
 """

@@ -1,0 +1,73 @@
+"""The template is real anatomy in the RCS: checked against anatomical facts."""
+
+import igl
+import numpy as np
+import pytest
+
+from wrist_env.anatomy.annotations import template_annotations
+
+from wrist_env.anatomy.myosim import load_myosim_anatomy
+from wrist_env.anatomy.template import JOINT_SPACE_MM, load_template
+
+
+@pytest.fixture(scope="module")
+def template():
+    return load_template()
+
+
+def test_rcs_is_a_proper_rotation(template):
+    R = template.rcs_from_myosim[:3, :3]
+    np.testing.assert_allclose(R @ R.T, np.eye(3), atol=1e-12)
+    assert np.linalg.det(R) == pytest.approx(1.0)
+
+
+def test_scaphoid_lies_radial_to_the_lunate(template):
+    assert template.bones["scaphoid"].vertices.mean(axis=0)[2] > template.bones["lunate"].vertices.mean(axis=0)[2] + 5
+
+
+def test_radial_styloid_is_radial_and_distal(template):
+    radius = load_myosim_anatomy().meshes["radius"].copy()
+    radius.apply_transform(template.rcs_from_myosim)
+    tip = radius.vertices[np.argmin(radius.vertices[:, 1])]
+    assert tip[2] > 10.0  # radial of the articular centre by more than a fossa half-width
+    assert tip[1] < -5.0  # distal of the articular centre
+
+
+def test_ulna_is_ulnar_and_carpus_distal(template):
+    assert template.bones["ulna"].vertices.mean(axis=0)[2] < -10
+    for bone in ("scaphoid", "lunate", "capitate"):
+        assert template.bones[bone].vertices.mean(axis=0)[1] < 0
+
+
+def test_scaphoid_is_flexed_with_its_distal_pole_volar(template):
+    """In the neutral wrist the scaphoid lies flexed: its distal pole (tubercle) is volar of its proximal pole."""
+    s = template.bones["scaphoid"].vertices
+    distal, proximal = s[np.argmin(s[:, 1])], s[np.argmax(s[:, 1])]
+    assert distal[0] - proximal[0] > 4.0
+
+
+def test_rebuilt_fossae_are_fine_watertight_and_congruent(template):
+    cap = template.bones["radius"].trimesh(solid_only=True)
+    assert cap.is_watertight and cap.volume > 0
+    radius = template.bones["radius"]
+    ann = template_annotations()
+    fossae = ann.coverage["radioscaphoid"][2] | ann.coverage["radiolunate"][2]
+    edges = radius.trimesh().edges_unique
+    edges = edges[fossae[edges].all(axis=1)]
+    lengths = np.linalg.norm(radius.vertices[edges[:, 0]] - radius.vertices[edges[:, 1]], axis=1)
+    assert np.percentile(lengths, 95) <= 1.0 and np.median(lengths) < 0.6  # ≤ 1 mm resolution
+    # joint space: proximal-row vertices facing the fossae sit one joint space away
+
+    for art in ("radioscaphoid", "radiolunate"):
+        _, bone, _, mask = ann.coverage[art]
+        d2 = igl.point_mesh_squared_distance(template.bones[bone].vertices[mask], cap.vertices, cap.faces.astype(np.int64))[0]
+        gap = np.sqrt(d2)
+        assert np.median(gap) == pytest.approx(JOINT_SPACE_MM, abs=0.15)
+        assert gap.min() > 1.0
+
+
+def test_carpal_meshes_are_watertight_and_fine(template):
+    for bone in ("scaphoid", "lunate", "capitate"):
+        mesh = template.bones[bone].trimesh()
+        assert mesh.is_watertight
+        assert 0.4 < mesh.edges_unique_length.mean() < 1.0

@@ -1,0 +1,57 @@
+import numpy as np
+import pytest
+
+from wrist_env import design
+from wrist_env.errors import DesignError
+
+
+def test_twenty_seven_variables_in_table_2_order():
+    assert design.N_DESIGN == 27 and len(design.NAMES) == 27
+    assert design.NAMES[0] == "SLIL_v.stiffness" and design.NAMES[11] == "SLIL_v.reference_strain"
+    assert design.NAMES[22:] == tuple(f"{n}.injury" for n in ("SLIL_v", "SLIL_p", "SLIL_d", "RSC", "LRL"))
+    assert [l.fibres for l in design.LIGAMENTS] == [7, 7, 7, 0, 4, 4, 3, 3, 7, 3, 3]
+
+
+def test_action_maps_to_mean_plus_three_sd():
+    a = np.zeros(27)
+    a[2], a[13] = 1.0, -1.0  # SLIL_d stiffness +3 SD, SLIL_v... reference strain of SLIL_p -3 SD
+    d = design.from_action(a)
+    assert d.stiffness[2] == pytest.approx(79 + 3 * 24)
+    assert d.reference_strain[2] == pytest.approx(0.7)
+    assert d.stiffness[0] == pytest.approx(33.0)
+    np.testing.assert_allclose(design.to_action(d), a)
+
+
+def test_negative_injury_scalar_is_a_tear():
+    a = np.zeros(27)
+    a[22:] = [-0.5, 0.5, -1, 1, 0.1]
+    torn = design.from_action(a).torn
+    assert torn.tolist() == [True, False, True, False, False, False, False, False, False, False, False]
+
+
+def test_population_is_the_table_2_mean_and_intact():
+    p = design.population()
+    assert p.stiffness.tolist() == [33, 25, 79, 10, 75, 75, 75, 10, 40, 75, 40]
+    assert np.all(p.reference_strain == 1.0) and not p.torn.any()
+
+
+@pytest.mark.parametrize("bad,match", [
+    (np.zeros(26), r"shape \(27,\)"),
+    (np.r_[np.zeros(26), 1.5], r"LRL.injury=1.5"),
+    (np.r_[np.nan, np.zeros(26)], r"SLIL_v.stiffness=nan"),
+])
+def test_bad_actions_name_the_value(bad, match):
+    with pytest.raises(DesignError, match=match):
+        design.from_action(bad)
+
+
+def test_dict_round_trip_and_z_scores():
+    d = design.from_action(np.linspace(-1, 1, 27))
+    assert design.Design.from_dict(d.as_dict()).as_dict() == d.as_dict()
+    np.testing.assert_allclose(design.z_scores(d), 3 * np.linspace(-1, 1, 27)[:22])
+
+
+def test_truncated_material_samples_stay_in_bounds_and_are_normal():
+    a = design.sample_materials(20000, seed=1)
+    assert a.shape == (20000, 22) and np.abs(a).max() <= 1.0
+    assert np.std(a * 3) == pytest.approx(0.986, abs=0.02)  # SD of N(0,1) truncated at ±3
