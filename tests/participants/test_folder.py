@@ -1,0 +1,333 @@
+"""Participant folders: round trip, left-wrist mirroring, and one test per validation rule."""
+
+import re
+
+import numpy as np
+import pytest
+import trimesh
+from scipy.spatial.transform import Rotation
+
+from wrist_env.errors import MeshError, ParticipantError, TrialError
+from wrist_env.participants.folder import ParticipantSource, load_participant_folder, write_participant_folder
+from wrist_env.trial import MIRROR, Trial
+
+BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate")
+# carpal ellipsoid semi-axes and centres (mm, RCS: x volar, y proximal, z radial)
+CARPALS = {"scaphoid": ((12, 7, 6), (2, -10, 10)), "lunate": ((9, 7, 8), (0, -10, -2)), "capitate": ((8, 13, 7), (0, -28, 3))}
+
+
+def bone_meshes() -> dict:
+    """{bone: (vertices, faces)}: icosphere ellipsoids for carpals, capsules along y for radius and ulna."""
+    out = {}
+    for bone, z in (("radius", 8.0), ("ulna", -20.0)):
+        mesh = trimesh.creation.capsule(height=40.0, radius=10.0 if bone == "radius" else 6.0, count=[16, 16])
+        mesh.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, [1, 0, 0]))
+        mesh.apply_translation([0.0, 30.0, z])
+        out[bone] = (mesh.vertices, mesh.faces)
+    for bone, (axes, centre) in CARPALS.items():
+        mesh = trimesh.creation.icosphere(subdivisions=2)
+        mesh.apply_scale(axes)
+        mesh.apply_translation(centre)
+        out[bone] = (mesh.vertices, mesh.faces)
+    return out
+
+
+def trial_transforms(peak_deg: float) -> np.ndarray:
+    """Array of shape (5, 15, 4, 4): carpals rotate about their centres by shares of a flexion/deviation cycle."""
+    angles = peak_deg * np.sin(np.linspace(0, 2 * np.pi, 15))
+    out = np.tile(np.eye(4), (5, 15, 1, 1))
+    for b, bone in enumerate(BONES[2:], start=2):
+        share = {"scaphoid": 0.8, "lunate": 0.5, "capitate": 1.0}[bone]
+        rot = Rotation.from_euler("ZX", np.c_[angles, 0.3 * angles] * share, degrees=True).as_matrix()
+        c = np.array(CARPALS[bone][1], float)
+        out[b, :, :3, :3], out[b, :, :3, 3] = rot, c - rot @ c
+    return out
+
+
+def make_source(tmp_path, side: str = "right") -> ParticipantSource:
+    trials = {
+        "unresisted": Trial("unresisted", "calibrate", BONES, trial_transforms(30.0)),
+        "resisted": Trial("resisted", "validate", BONES, trial_transforms(20.0)),
+    }
+    meta = {"side": side, "sex": "female", "age": 41, "facet_type": "I", "task": "flexion-extension", "frames": 15}
+    return ParticipantSource("P7", meta, bone_meshes(), trials, tmp_path)
+
+
+@pytest.fixture
+def folder(tmp_path):
+    return write_participant_folder(make_source(tmp_path), tmp_path / "my_wrist")
+
+
+def edit_toml(folder, old: str, new: str) -> None:
+    path = folder / "participant.toml"
+    text = path.read_text()
+    assert old in text
+    path.write_text(text.replace(old, new))
+
+
+def replace_mesh(folder, bone: str, vertices, faces, name: str | None = None) -> None:
+    path = folder / "bones" / (name or f"{bone}.stl")
+    trimesh.Trimesh(vertices, faces, process=False).export(path)
+    if name:
+        edit_toml(folder, f'"bones/{bone}.stl"', f'"bones/{name}"')
+
+
+def raises(error, path, value: str):
+    """pytest.raises(error) whose message names the file and then the value."""
+    return pytest.raises(error, match=f"(?s){re.escape(str(path))}.*{value}")
+
+
+def assert_same_triangles(a, b, atol):
+    """Two (vertices, faces) meshes have the same triangles in the same order."""
+    np.testing.assert_allclose(a[0][a[1]], b[0][b[1]], atol=atol, rtol=0)
+
+
+def test_round_trip(tmp_path, folder):
+    source = make_source(tmp_path)
+    loaded = load_participant_folder(folder)
+    assert loaded.name == "P7" and loaded.folder == folder
+    assert loaded.meta == source.meta
+    assert list(loaded.bones) == list(BONES)
+    for bone in BONES:
+        vertices, faces = loaded.bones[bone]
+        assert vertices.dtype == np.float64 and faces.dtype == np.int64
+        assert not vertices.flags.writeable and not faces.flags.writeable
+        assert len(vertices) == len(source.bones[bone][0])  # STL corners merged back to shared vertices
+        assert_same_triangles(loaded.bones[bone], source.bones[bone], atol=1e-5)  # STL stores float32
+    assert list(loaded.trials) == ["unresisted", "resisted"]
+    for name, trial in source.trials.items():
+        assert (loaded.trials[name].role, loaded.trials[name].bones) == (trial.role, trial.bones)
+        np.testing.assert_array_equal(loaded.trials[name].transforms, trial.transforms)
+
+    again = load_participant_folder(write_participant_folder(loaded, tmp_path / "copy"))
+    assert again.meta == loaded.meta
+    for bone in BONES:
+        np.testing.assert_array_equal(again.bones[bone][0], loaded.bones[bone][0])
+        np.testing.assert_array_equal(again.bones[bone][1], loaded.bones[bone][1])
+
+
+def test_left_folder_loads_as_mirror_image(tmp_path, folder):
+    right = load_participant_folder(folder)
+    edit_toml(folder, 'side = "right"', 'side = "left"')
+    left = load_participant_folder(folder)
+    assert left.meta["side"] == "left"
+    for bone in BONES:
+        vertices, faces = left.bones[bone]
+        mesh = trimesh.Trimesh(vertices, faces, process=False)
+        assert mesh.is_watertight and mesh.volume == pytest.approx(trimesh.Trimesh(*right.bones[bone]).volume)
+        assert mesh.volume > 0
+        expected = right.bones[bone][0][right.bones[bone][1]][:, [0, 2, 1]] * [1, 1, -1]
+        np.testing.assert_array_equal(vertices[faces], expected)
+    for name, trial in left.trials.items():
+        np.testing.assert_allclose(np.linalg.det(trial.transforms[..., :3, :3]), 1.0, atol=1e-9)
+        # a point of the mirrored bone follows the mirror image of the right bone's path
+        point = np.array([1.0, -10.0, 9.0, 1.0])
+        moved = right.trials[name].pose("scaphoid") @ point
+        np.testing.assert_allclose(trial.pose("scaphoid") @ (MIRROR @ point), moved @ MIRROR, atol=1e-12)
+
+
+def test_left_source_round_trips(tmp_path):
+    source = make_source(tmp_path, side="left")
+    folder = write_participant_folder(source, tmp_path / "left")
+    on_disk = trimesh.load_mesh(folder / "bones" / "scaphoid.stl")
+    assert on_disk.bounds[0, 2] == pytest.approx(-16.0, abs=1e-4)  # scaphoid z in [4, 16] mirrored to [-16, -4]
+    loaded = load_participant_folder(folder)
+    assert_same_triangles(loaded.bones["scaphoid"], source.bones["scaphoid"], atol=1e-5)
+    np.testing.assert_allclose(loaded.trials["unresisted"].transforms, source.trials["unresisted"].transforms, atol=1e-15)
+
+
+# --- one test per error ---------------------------------------------------------------
+
+
+def test_missing_folder(tmp_path):
+    with raises(ParticipantError, tmp_path / "nowhere", "does not exist"):
+        load_participant_folder(tmp_path / "nowhere")
+
+
+def test_missing_toml(folder):
+    (folder / "participant.toml").unlink()
+    with raises(ParticipantError, folder / "participant.toml", "does not exist"):
+        load_participant_folder(folder)
+
+
+def test_toml_syntax_error(folder):
+    edit_toml(folder, 'name = "P7"', 'name = "P7')
+    with raises(ParticipantError, folder / "participant.toml", r"TOML syntax error: .*line 1"):
+        load_participant_folder(folder)
+
+
+def test_missing_required_key(folder):
+    edit_toml(folder, 'units = "mm"\n', "")
+    with raises(ParticipantError, folder / "participant.toml", r"required keys \['units'\] are missing"):
+        load_participant_folder(folder)
+
+
+def test_unknown_key(folder):
+    edit_toml(folder, "frames = 15", "frame = 15")
+    with raises(ParticipantError, folder / "participant.toml", r"but got \['frame'\]"):
+        load_participant_folder(folder)
+
+
+def test_bad_units(folder):
+    edit_toml(folder, 'units = "mm"', 'units = "m"')
+    with raises(ParticipantError, folder / "participant.toml", "units must be \"mm\", but got 'm'"):
+        load_participant_folder(folder)
+
+
+def test_bad_side(folder):
+    edit_toml(folder, 'side = "right"', 'side = "R"')
+    with raises(ParticipantError, folder / "participant.toml", "side must be one of.*got 'R'"):
+        load_participant_folder(folder)
+
+
+def test_bad_name(folder):
+    edit_toml(folder, 'name = "P7"', 'name = "P-7"')
+    with raises(ParticipantError, folder / "participant.toml", "name must match.*got 'P-7'"):
+        load_participant_folder(folder)
+
+
+def test_bad_age(folder):
+    edit_toml(folder, "age = 41", 'age = "41"')
+    with raises(ParticipantError, folder / "participant.toml", "age must be a number.*got '41'"):
+        load_participant_folder(folder)
+
+
+def test_missing_bone_entry(folder):
+    edit_toml(folder, 'lunate = "bones/lunate.stl"\n', "")
+    with raises(ParticipantError, folder / "participant.toml", r"absent=\['lunate'\]"):
+        load_participant_folder(folder)
+
+
+def test_missing_bone_file(folder):
+    (folder / "bones" / "lunate.stl").unlink()
+    with raises(ParticipantError, folder / "participant.toml", "bones.lunate = 'bones/lunate.stl', but .*does not exist"):
+        load_participant_folder(folder)
+
+
+def test_unreadable_mesh_file(folder):
+    (folder / "bones" / "lunate.ply").write_bytes(b"\x00\x01 not a mesh\n")
+    edit_toml(folder, '"bones/lunate.stl"', '"bones/lunate.ply"')
+    with raises(MeshError, folder / "bones" / "lunate.ply", "trimesh cannot read the lunate mesh: ValueError"):
+        load_participant_folder(folder)
+
+
+def test_mesh_file_without_triangles(folder):
+    (folder / "bones" / "lunate.stl").write_text("not a mesh\n")
+    with raises(MeshError, folder / "bones" / "lunate.stl", "must hold a triangle mesh.*faces.shape=\\(0, 3\\)"):
+        load_participant_folder(folder)
+
+
+def test_nan_vertices(folder):
+    vertices, faces = bone_meshes()["lunate"]
+    vertices = vertices.copy()
+    vertices[5, 1] = np.nan
+    replace_mesh(folder, "lunate", vertices, faces)
+    with raises(MeshError, folder / "bones" / "lunate.stl", "vertices must be finite.*nan"):
+        load_participant_folder(folder)
+
+
+def test_mesh_in_metres(folder):
+    vertices, faces = bone_meshes()["lunate"]
+    replace_mesh(folder, "lunate", vertices / 1000, faces)
+    diagonal = np.linalg.norm(np.ptp(vertices / 1000, axis=0))
+    assert 0.02 < diagonal < 0.04
+    with raises(MeshError, folder / "bones" / "lunate.stl", rf"looks like metres: bounding-box diagonal {diagonal:.3g}; convert to mm \(×1000\)"):
+        load_participant_folder(folder)
+
+
+def test_carpal_mesh_too_large(folder):
+    vertices, faces = bone_meshes()["capitate"]
+    replace_mesh(folder, "capitate", vertices * 10, faces)
+    with raises(MeshError, folder / "bones" / "capitate.stl", "looks like the wrong unit: bounding-box diagonal 3[0-9]{2}"):
+        load_participant_folder(folder)
+
+
+def test_radius_mesh_too_large(folder):
+    vertices, faces = bone_meshes()["radius"]
+    replace_mesh(folder, "radius", vertices * 10, faces)
+    with raises(MeshError, folder / "bones" / "radius.stl", "wrong unit: bounding-box diagonal 6[0-9]{2}.*10–600 mm"):
+        load_participant_folder(folder)
+
+
+def test_carpal_mesh_in_centimetres(folder):
+    vertices, faces = bone_meshes()["scaphoid"]
+    replace_mesh(folder, "scaphoid", vertices / 10, faces)
+    with raises(MeshError, folder / "bones" / "scaphoid.stl", r"wrong unit: bounding-box diagonal 3\.[0-9]+, expected 5–100 mm"):
+        load_participant_folder(folder)
+
+
+def test_non_watertight_mesh(folder):
+    vertices, faces = bone_meshes()["lunate"]
+    replace_mesh(folder, "lunate", vertices, faces[1:])
+    with raises(MeshError, folder / "bones" / "lunate.stl", "watertight, but it has 3 boundary edges"):
+        load_participant_folder(folder)
+
+
+def test_zero_area_faces(folder):
+    vertices, faces = bone_meshes()["lunate"]
+    replace_mesh(folder, "lunate", vertices, np.vstack([faces, [[0, 0, 1], [2, 2, 3]]]))
+    with raises(MeshError, folder / "bones" / "lunate.stl", "has 2 zero-area faces"):
+        load_participant_folder(folder)
+
+
+def test_duplicate_faces(folder):
+    vertices, faces = bone_meshes()["lunate"]
+    replace_mesh(folder, "lunate", vertices, np.vstack([faces, faces[[4]]]))
+    with raises(MeshError, folder / "bones" / "lunate.stl", "has 1 duplicate faces.*face 320"):
+        load_participant_folder(folder)
+
+
+def test_inverted_winding(folder):
+    vertices, faces = bone_meshes()["lunate"]
+    volume = trimesh.Trimesh(vertices, faces).volume
+    replace_mesh(folder, "lunate", vertices, faces[:, ::-1])
+    with raises(MeshError, folder / "bones" / "lunate.stl", f"positive volume, but has -{volume:.4g} mm³"):
+        load_participant_folder(folder)
+
+
+def test_inconsistent_winding(folder):
+    vertices, faces = bone_meshes()["lunate"]
+    faces = faces.copy()
+    faces[0] = faces[0, ::-1]
+    replace_mesh(folder, "lunate", vertices, faces)
+    with raises(MeshError, folder / "bones" / "lunate.stl", "consistently wound"):
+        load_participant_folder(folder)
+
+
+def test_too_few_faces(folder):
+    mesh = trimesh.creation.icosphere(subdivisions=1)
+    mesh.apply_scale(10.0)
+    replace_mesh(folder, "lunate", mesh.vertices, mesh.faces)
+    with raises(MeshError, folder / "bones" / "lunate.stl", "at least 100 faces, but has 80"):
+        load_participant_folder(folder)
+
+
+def test_no_calibrate_trial(folder):
+    edit_toml(folder, 'role = "calibrate"', 'role = "other"')
+    with raises(ParticipantError, folder / "participant.toml", "role \"calibrate\", but got .*'unresisted': 'other'"):
+        load_participant_folder(folder)
+
+
+def test_bad_trial_role(folder):
+    edit_toml(folder, 'role = "calibrate"', 'role = "train"')
+    with raises(ParticipantError, folder / "participant.toml", r"\[trials.unresisted\] role must be one of.*'train'"):
+        load_participant_folder(folder)
+
+
+def test_missing_trial_file(folder):
+    (folder / "trials" / "resisted.csv").unlink()
+    with raises(ParticipantError, folder / "participant.toml", "trials/resisted.csv', but .*does not exist"):
+        load_participant_folder(folder)
+
+
+def test_trial_frames_differ_from_toml(folder):
+    edit_toml(folder, "frames = 15", "frames = 12")
+    with raises(TrialError, folder / "trials" / "unresisted.csv", "n_frames=12 frames, but has 15"):
+        load_participant_folder(folder)
+
+
+def test_bad_trial_csv_names_its_file(folder):
+    path = folder / "trials" / "resisted.csv"
+    path.write_text(path.read_text().replace(",lunate,", ",hamate,", 1))
+    with raises(TrialError, path, "line 5 has 'hamate'"):
+        load_participant_folder(folder)

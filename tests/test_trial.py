@@ -1,0 +1,253 @@
+"""Trials: CSV round trip, mirroring, and one test per validation rule."""
+
+import re
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.spatial.transform import Rotation
+
+from wrist_env.errors import TrialError
+from wrist_env.trial import (
+    COLUMNS,
+    MIRROR,
+    Trial,
+    mirror_trial,
+    read_trial_csv,
+    validate_transforms,
+    write_trial_csv,
+)
+
+BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate")
+# rotation centres (mm, RCS) and share of the hand's motion of each bone
+CENTRES = {"radius": (0, 0, 0), "ulna": (0, 0, -20), "scaphoid": (2, -10, 10), "lunate": (0, -10, -2), "capitate": (0, -28, 3)}
+SHARE = {"radius": 0.0, "ulna": 0.0, "scaphoid": 0.8, "lunate": 0.5, "capitate": 1.0}
+
+
+def flexion_transforms(n_frames: int = 15, peak_deg: float = 30.0) -> np.ndarray:
+    """Array of shape (5, n_frames, 4, 4): each bone rotates about its centre (flexion about z, some deviation about x)."""
+    angles = peak_deg * np.sin(np.linspace(0, 2 * np.pi, n_frames))
+    out = np.tile(np.eye(4), (len(BONES), n_frames, 1, 1))
+    for b, bone in enumerate(BONES):
+        rot = Rotation.from_euler("ZX", np.c_[angles, 0.2 * angles] * SHARE[bone], degrees=True).as_matrix()
+        c = np.array(CENTRES[bone], float)
+        out[b, :, :3, :3] = rot
+        out[b, :, :3, 3] = c - rot @ c
+    return out
+
+
+def make_trial(n_frames: int = 15, role: str = "calibrate") -> Trial:
+    return Trial("unresisted", role, BONES, flexion_transforms(n_frames))
+
+
+@pytest.fixture
+def csv_path(tmp_path):
+    path = tmp_path / "unresisted.csv"
+    write_trial_csv(make_trial(), path)
+    return path
+
+
+def edit_csv(path, edit) -> None:
+    """Rewrite the CSV at `path` with `edit(table) -> table` applied."""
+    table = pd.read_csv(path)
+    edit(table).to_csv(path, index=False, float_format="%.17g")
+
+
+def raises(path, value: str):
+    """pytest.raises(TrialError) whose message names the file and the value."""
+    return pytest.raises(TrialError, match=f"(?s){re.escape(str(path))}.*{value}")
+
+
+def test_round_trip_is_exact(csv_path):
+    trial = make_trial()
+    back = read_trial_csv(csv_path, "unresisted", "calibrate")
+    assert (back.name, back.role, back.bones, back.n_frames) == ("unresisted", "calibrate", BONES, 15)
+    assert back.transforms.dtype == np.float64
+    np.testing.assert_array_equal(back.transforms, trial.transforms)
+
+
+def test_csv_layout(csv_path):
+    lines = csv_path.read_text().splitlines()
+    assert lines[0] == ",".join(COLUMNS)
+    assert len(lines) == 1 + 5 * 15
+    assert lines[1].startswith("0,radius,1,0,0,0,") and lines[5].startswith("0,capitate,")
+    assert lines[6].startswith("1,radius,")
+
+
+def test_rows_in_any_order_read_the_same(csv_path):
+    edit_csv(csv_path, lambda t: t.sample(frac=1.0, random_state=np.random.default_rng(0)))
+    np.testing.assert_array_equal(read_trial_csv(csv_path, "u", "other").transforms, make_trial().transforms)
+
+
+def test_optional_bones_may_be_absent(csv_path):
+    edit_csv(csv_path, lambda t: t[t.bone != "ulna"])
+    trial = read_trial_csv(csv_path, "u", "validate")
+    assert trial.bones == ("radius", "scaphoid", "lunate", "capitate")
+    np.testing.assert_array_equal(trial.pose("capitate"), make_trial().pose("capitate"))
+
+
+def test_pose_and_read_only():
+    trial = make_trial(n_frames=7)
+    assert trial.n_frames == 7
+    assert trial.pose("lunate").shape == (7, 4, 4)
+    np.testing.assert_allclose(trial.pose("radius"), np.tile(np.eye(4), (7, 1, 1)))
+    with pytest.raises(ValueError):
+        trial.transforms[0, 0, 0, 0] = 2.0
+    with pytest.raises(TrialError, match="no bone 'hamate'"):
+        trial.pose("hamate")
+
+
+def test_mirror_trial_moves_mirrored_points_to_mirrored_poses():
+    trial = make_trial()
+    mirrored = mirror_trial(trial)
+    np.testing.assert_allclose(np.linalg.det(mirrored.transforms[..., :3, :3]), 1.0, atol=1e-12)
+    point = np.array([3.0, -12.0, 7.0, 1.0])
+    moved = trial.pose("scaphoid") @ point
+    np.testing.assert_allclose(mirrored.pose("scaphoid") @ (MIRROR @ point), moved @ MIRROR, atol=1e-12)
+    np.testing.assert_allclose(mirror_trial(mirrored).transforms, trial.transforms, atol=1e-15)
+
+
+def test_validate_transforms_accepts_single_pose_and_returns_float64():
+    out = validate_transforms(np.eye(4, dtype=np.float32), "pose")
+    assert out.dtype == np.float64 and out.shape == (4, 4)
+
+
+# --- one test per error ---------------------------------------------------------------
+
+
+def test_nan(csv_path):
+    edit_csv(csv_path, lambda t: t.assign(m01=np.where((t.frame == 3) & (t.bone == "lunate"), np.nan, t.m01)))
+    with raises(csv_path, "finite.*bone 'lunate' frame 3 has m01=nan"):
+        read_trial_csv(csv_path, "u", "calibrate")
+
+
+def test_inf(csv_path):
+    edit_csv(csv_path, lambda t: t.assign(m13=np.where((t.frame == 9) & (t.bone == "capitate"), np.inf, t.m13)))
+    with raises(csv_path, "finite.*bone 'capitate' frame 9 has m13=inf"):
+        read_trial_csv(csv_path, "u", "calibrate")
+
+
+def test_non_orthonormal_rotation(csv_path):
+    row = lambda t: (t.frame == 4) & (t.bone == "scaphoid")  # noqa: E731
+    edit_csv(csv_path, lambda t: t.assign(m00=np.where(row(t), t.m00 * 1.01, t.m00)))
+    m00 = make_trial().pose("scaphoid")[4, 0, 0]
+    deviation = (1.01**2 - 1) * m00**2  # (RᵀR − I)[0, 0] with column 0 scaled in its first entry
+    with raises(csv_path, rf"orthonormal.*bone 'scaphoid' frame 4 has max \|RᵀR − I\| = {deviation:.3g}"):
+        read_trial_csv(csv_path, "u", "calibrate")
+
+
+def test_reflection(csv_path):
+    row = lambda t: (t.frame == 2) & (t.bone == "lunate")  # noqa: E731
+    edit_csv(csv_path, lambda t: t.assign(**{c: np.where(row(t), -t[c], t[c]) for c in ("m02", "m12", "m22")}))
+    with raises(csv_path, "det = \\+1.*bone 'lunate' frame 2 has det = -1"):
+        read_trial_csv(csv_path, "u", "calibrate")
+
+
+def test_bones_with_different_frames(csv_path):
+    edit_csv(csv_path, lambda t: t[~((t.bone == "lunate") & (t.frame == 14))])
+    with raises(csv_path, r"bone 'lunate' lacks frames \[14\]"):
+        read_trial_csv(csv_path, "u", "calibrate")
+
+
+def test_frames_with_a_gap(csv_path):
+    edit_csv(csv_path, lambda t: t[t.frame != 7])
+    with raises(csv_path, r"without gaps.*0\.\.14 with \[7\] missing"):
+        read_trial_csv(csv_path, "u", "calibrate")
+
+
+def test_frames_not_from_zero(csv_path):
+    edit_csv(csv_path, lambda t: t.assign(frame=t.frame + 1))
+    with raises(csv_path, r"without gaps.*run 1\.\.15"):
+        read_trial_csv(csv_path, "u", "calibrate")
+
+
+def test_fewer_than_two_frames(csv_path):
+    edit_csv(csv_path, lambda t: t[t.frame == 0])
+    with raises(csv_path, "at least 2 frames, but got 1"):
+        read_trial_csv(csv_path, "u", "calibrate")
+
+
+def test_frame_count_differs_from_required(csv_path):
+    with raises(csv_path, "must have n_frames=12 frames, but has 15"):
+        read_trial_csv(csv_path, "u", "calibrate", n_frames=12)
+
+
+def test_missing_required_bone(csv_path):
+    edit_csv(csv_path, lambda t: t[t.bone != "capitate"])
+    with raises(csv_path, r"\['capitate'\] are missing"):
+        read_trial_csv(csv_path, "u", "calibrate")
+
+
+def test_unknown_bone(csv_path):
+    edit_csv(csv_path, lambda t: t.assign(bone=t.bone.replace("lunate", "Lunate")))
+    with raises(csv_path, "lower case.*line 5 has 'Lunate'"):
+        read_trial_csv(csv_path, "u", "calibrate")
+
+
+def test_missing_column(csv_path):
+    edit_csv(csv_path, lambda t: t.drop(columns="m23"))
+    with raises(csv_path, r"missing=\['m23'\]"):
+        read_trial_csv(csv_path, "u", "calibrate")
+
+
+def test_extra_column(csv_path):
+    edit_csv(csv_path, lambda t: t.assign(m30=0.0))
+    with raises(csv_path, r"extra=\['m30'\]"):
+        read_trial_csv(csv_path, "u", "calibrate")
+
+
+def test_non_numeric_value(csv_path):
+    edit_csv(csv_path, lambda t: t.astype({"m12": object}).assign(m12=lambda s: s.m12.where(s.index != 20, "0.5x")))
+    with raises(csv_path, "column m12 must hold numbers, but line 22 has '0.5x'"):
+        read_trial_csv(csv_path, "u", "calibrate")
+
+
+def test_duplicate_row(csv_path):
+    edit_csv(csv_path, lambda t: pd.concat([t, t.iloc[[7]]]))
+    with raises(csv_path, "line 77 repeats frame 1 bone 'scaphoid'"):
+        read_trial_csv(csv_path, "u", "calibrate")
+
+
+def test_translations_in_metres(csv_path):
+    edit_csv(csv_path, lambda t: t.assign(**{c: t[c] / 1000 for c in ("m03", "m13", "m23")}))
+    largest = np.abs(make_trial().transforms[..., :3, 3]).max() / 1000
+    with raises(csv_path, rf"translations look like metres; use mm \(largest \|t\| = {largest:.3g}"):
+        read_trial_csv(csv_path, "u", "calibrate")
+
+
+def test_metres_rule_needs_rotation_over_five_degrees():
+    # rotations about the origin have zero translation: flagged only once they span > 5°
+    transforms = np.tile(np.eye(4), (len(BONES), 2, 1, 1))
+    transforms[2, 1, :3, :3] = Rotation.from_rotvec([0, 0, 4.9], degrees=True).as_matrix()
+    Trial("small", "other", BONES, transforms)
+    transforms[2, 1, :3, :3] = Rotation.from_rotvec([0, 0, 5.1], degrees=True).as_matrix()
+    with pytest.raises(TrialError, match="trial 'small': translations look like metres.*vary by 5.1°"):
+        Trial("small", "other", BONES, transforms)
+
+
+def test_missing_file(tmp_path):
+    with raises(tmp_path / "absent.csv", "does not exist"):
+        read_trial_csv(tmp_path / "absent.csv", "u", "calibrate")
+
+
+def test_bad_role():
+    with pytest.raises(TrialError, match="role must be one of.*'calibration'"):
+        make_trial(role="calibration")
+
+
+def test_bottom_row():
+    transforms = flexion_transforms()
+    transforms[2, 5, 3, 0] = 0.1
+    with pytest.raises(TrialError, match=r"my array: the bottom row.*bone 'scaphoid' frame 5 has \[0.1, 0.0, 0.0, 1.0\]"):
+        validate_transforms(transforms, "my array", BONES)
+
+
+def test_wrong_shape():
+    with pytest.raises(TrialError, match=r"my array: .*shape \(\.\.\., 4, 4\), but got \(5, 3, 3\)"):
+        validate_transforms(np.zeros((5, 3, 3)), "my array")
+
+
+def test_non_integer_frame(csv_path):
+    edit_csv(csv_path, lambda t: t.assign(frame=t.frame.astype(float).where(t.index != 11, 2.5)))
+    with raises(csv_path, "column frame must hold integers, but line 13 has '2.5'"):
+        read_trial_csv(csv_path, "u", "calibrate")

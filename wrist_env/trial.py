@@ -1,0 +1,235 @@
+"""Kinematic trials: rigid bone poses per frame as 4×4 transforms in the RCS (mm).
+
+`transforms[b, f]` maps the vertices of bone b in the neutral (static CT)
+pose, expressed in the RCS, to their pose at frame f; the radius is close to
+the identity. CSV format, one row per bone per frame, frames 0..n-1:
+
+    frame,bone,m00,m01,m02,m03,m10,m11,m12,m13,m20,m21,m22,m23
+
+(the top three rows of the 4×4; the bottom row is 0 0 0 1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from wrist_env.anatomy.myosim import BONES
+from wrist_env.errors import TrialError
+
+ROLES = ("calibrate", "validate", "other")
+REQUIRED_BONES = ("scaphoid", "lunate", "capitate")
+MATRIX_COLUMNS = tuple(f"m{r}{c}" for r in range(3) for c in range(4))
+COLUMNS = ("frame", "bone") + MATRIX_COLUMNS
+ORTHONORMAL_TOL = 1e-4  # max |RᵀR − I|
+BOTTOM_ROW_TOL = 1e-9
+METRES_TRANSLATION_MM = 0.5  # all |t| below this while rotations vary ...
+METRES_ROTATION_DEG = 5.0  # ... by more than this: translations are in metres
+MIRROR = np.diag([1.0, 1.0, -1.0, 1.0])
+"""Left → right wrist reflection of the RCS (z → −z)."""
+
+
+@dataclass(frozen=True, eq=False)
+class Trial:
+    """One motion trial of a participant.
+
+    name: trial name, e.g. "unresisted". role: "calibrate", "validate" or "other".
+    bones: bone names, a subset of BONES in BONES order.
+    transforms: array of shape (n_bones, n_frames, 4, 4), float64, mm; neutral pose → frame f, RCS.
+    """
+
+    name: str
+    role: str
+    bones: tuple[str, ...]
+    transforms: np.ndarray
+
+    def __post_init__(self):
+        if self.role not in ROLES:
+            raise TrialError(f"trial {self.name!r}: role must be one of {ROLES}, but got {self.role!r}.")
+        bones = tuple(self.bones)
+        unknown = [b for b in bones if b not in BONES]
+        if unknown or len(set(bones)) != len(bones):
+            raise TrialError(f"trial {self.name!r}: bones must be distinct names from {BONES}, but got {bones}.")
+        transforms = validate_transforms(self.transforms, f"trial {self.name!r}", bones)
+        if transforms.ndim != 4 or transforms.shape[0] != len(bones) or transforms.shape[1] < 2:
+            raise TrialError(
+                f"trial {self.name!r}: transforms must have shape ({len(bones)}, n_frames >= 2, 4, 4), "
+                f"but got {transforms.shape}."
+            )
+        transforms = transforms.copy()
+        transforms.setflags(write=False)
+        object.__setattr__(self, "bones", bones)
+        object.__setattr__(self, "transforms", transforms)
+
+    @property
+    def n_frames(self) -> int:
+        return self.transforms.shape[1]
+
+    def pose(self, bone: str) -> np.ndarray:
+        """Transforms of one bone, array of shape (n_frames, 4, 4), mm."""
+        if bone not in self.bones:
+            raise TrialError(f"trial {self.name!r} has no bone {bone!r}; it has {self.bones}.")
+        return self.transforms[self.bones.index(bone)]
+
+
+def mirror_trial(trial: Trial) -> Trial:
+    """The trial of the mirror-image wrist (left ↔ right): each transform conjugated by diag(1, 1, −1, 1)."""
+    return Trial(trial.name, trial.role, trial.bones, MIRROR @ trial.transforms @ MIRROR)
+
+
+def validate_transforms(array, source: str, bones: tuple[str, ...] | None = None) -> np.ndarray:
+    """The transforms as float64 array of shape (..., 4, 4), or a TrialError naming `source` and the entry.
+
+    Rules: finite; bottom row 0 0 0 1; rotation orthonormal (max |RᵀR − I| <= 1e-4) and proper
+    (det > 0); translations in mm, not metres. `bones` names axis 0 of a (n_bones, n_frames, 4, 4) array.
+    """
+    t = np.asarray(array, dtype=np.float64)
+    if t.ndim < 2 or t.shape[-2:] != (4, 4):
+        raise TrialError(f"{source}: transforms must have shape (..., 4, 4), but got {t.shape}.")
+
+    def where(index) -> str:
+        index = tuple(int(i) for i in index)
+        if t.ndim == 4 and bones is not None:
+            return f"bone {bones[index[0]]!r} frame {index[1]}"
+        if t.ndim == 3:
+            return f"frame {index[0]}"
+        return f"index {index}"
+
+    bad = ~np.isfinite(t)
+    if bad.any():
+        *index, r, c = np.argwhere(bad)[0]
+        raise TrialError(f"{source}: transforms must be finite, but {where(index)} has m{r}{c}={t[(*index, r, c)]}.")
+    bottom = np.abs(t[..., 3, :] - [0.0, 0.0, 0.0, 1.0]).max(axis=-1)
+    if (bottom > BOTTOM_ROW_TOL).any():
+        index = np.unravel_index(np.argmax(bottom), bottom.shape)
+        raise TrialError(f"{source}: the bottom row must be 0 0 0 1, but {where(index)} has {t[index][3].tolist()}.")
+    rot = t[..., :3, :3]
+    deviation = np.abs(np.swapaxes(rot, -1, -2) @ rot - np.eye(3)).max(axis=(-2, -1))
+    if (deviation > ORTHONORMAL_TOL).any():
+        index = np.unravel_index(np.argmax(deviation), deviation.shape)
+        raise TrialError(
+            f"{source}: rotations must be orthonormal (max |RᵀR − I| <= {ORTHONORMAL_TOL}), "
+            f"but {where(index)} has max |RᵀR − I| = {deviation[index]:.3g}."
+        )
+    det = np.linalg.det(rot)
+    if (det < 0).any():
+        index = np.unravel_index(np.argmin(det), det.shape)
+        raise TrialError(
+            f"{source}: rotations must be proper (det = +1), but {where(index)} has det = {det[index]:.6g} "
+            f"(a reflection; mirror left wrists with side = \"left\" instead)."
+        )
+    if t.ndim >= 3:
+        # rotation of every frame relative to the first frame of the same bone
+        relative = np.swapaxes(rot[..., :1, :, :], -1, -2) @ rot
+        cos = np.clip((np.trace(relative, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
+        span_deg = float(np.degrees(np.arccos(cos)).max())
+        max_t = float(np.abs(t[..., :3, 3]).max())
+        if max_t < METRES_TRANSLATION_MM and span_deg > METRES_ROTATION_DEG:
+            raise TrialError(
+                f"{source}: translations look like metres; use mm (largest |t| = {max_t:.3g} "
+                f"while rotations vary by {span_deg:.1f}°)."
+            )
+    return t
+
+
+def read_trial_csv(
+    path,
+    name: str,
+    role: str,
+    required_bones: tuple[str, ...] = REQUIRED_BONES,
+    n_frames: int | None = None,
+) -> Trial:
+    """A Trial from a CSV of 4×4 transforms (mm, RCS) per bone per frame, or a TrialError naming the file."""
+    path = Path(path)
+    if not path.is_file():
+        raise TrialError(f"trial file {path} does not exist.")
+    try:
+        table = pd.read_csv(path, skipinitialspace=True)
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+        raise TrialError(f"{path}: cannot parse as CSV: {exc}") from exc
+    table.columns = [str(c).strip() for c in table.columns]
+    missing = [c for c in COLUMNS if c not in table.columns]
+    extra = [c for c in table.columns if c not in COLUMNS]
+    if missing or extra:
+        raise TrialError(
+            f"{path}: columns must be {','.join(COLUMNS)}, but {missing=} and {extra=}."
+        )
+    if table.empty:
+        raise TrialError(f"{path}: the file has a header but no rows.")
+    for column in ("frame",) + MATRIX_COLUMNS:
+        values = pd.to_numeric(table[column], errors="coerce")
+        bad = values.isna() & table[column].notna()
+        if column == "frame":
+            bad |= values.isna() | (values != np.round(values))
+        if bad.any():
+            row = int(np.flatnonzero(bad)[0])
+            kind = "integers" if column == "frame" else "numbers"
+            raise TrialError(
+                f"{path}: column {column} must hold {kind}, but line {row + 2} has {str(table[column].iloc[row])!r}."
+            )
+        table[column] = values
+    table["frame"] = table["frame"].astype(np.int64)
+    table["bone"] = table["bone"].astype(str).str.strip()
+
+    unknown = sorted(set(table["bone"]) - set(BONES))
+    if unknown:
+        row = int(np.flatnonzero(table["bone"] == unknown[0])[0])
+        raise TrialError(
+            f"{path}: bone names must be lower case from {BONES}, but line {row + 2} has {unknown[0]!r}."
+        )
+    duplicated = table.duplicated(["frame", "bone"])
+    if duplicated.any():
+        row = int(np.flatnonzero(duplicated)[0])
+        raise TrialError(
+            f"{path}: each (frame, bone) must appear once, but line {row + 2} repeats "
+            f"frame {table['frame'].iloc[row]} bone {table['bone'].iloc[row]!r}."
+        )
+    bones = tuple(b for b in BONES if b in set(table["bone"]))
+    absent = [b for b in required_bones if b not in bones]
+    if absent:
+        raise TrialError(f"{path}: bones {list(required_bones)} are required, but {absent} are missing.")
+
+    frames = {b: set(table.loc[table["bone"] == b, "frame"]) for b in bones}
+    every = set().union(*frames.values())
+    for b in bones:
+        if frames[b] != every:
+            raise TrialError(
+                f"{path}: every bone must have a row for every frame, but bone {b!r} lacks frames "
+                f"{_brief(sorted(every - frames[b]))}."
+            )
+    first, last = min(every), max(every)
+    gaps = sorted(set(range(first, last + 1)) - every)
+    if first != 0 or gaps:
+        raise TrialError(
+            f"{path}: frames must run 0..n-1 without gaps, but they run {first}..{last} with {_brief(gaps)} missing."
+        )
+    if len(every) < 2:
+        raise TrialError(f"{path}: a trial needs at least 2 frames, but got {len(every)}.")
+    if n_frames is not None and len(every) != n_frames:
+        raise TrialError(f"{path}: the trial must have {n_frames=} frames, but has {len(every)}.")
+
+    order = np.lexsort((table["bone"].map(bones.index).to_numpy(), table["frame"].to_numpy()))
+    matrix = table.loc[:, list(MATRIX_COLUMNS)].to_numpy(np.float64)[order].reshape(len(every), len(bones), 3, 4)
+    transforms = np.zeros((len(bones), len(every), 4, 4))
+    transforms[:, :, :3, :] = matrix.transpose(1, 0, 2, 3)
+    transforms[:, :, 3, 3] = 1.0
+    transforms = validate_transforms(transforms, str(path), bones)
+    return Trial(name, role, bones, transforms)
+
+
+def write_trial_csv(trial: Trial, path) -> None:
+    """Write the trial as CSV (rows frame-major, bones in BONES order; exact float round trip)."""
+    n_bones, n_frames = trial.transforms.shape[:2]
+    matrix = trial.transforms[:, :, :3, :].transpose(1, 0, 2, 3).reshape(n_frames * n_bones, 12)
+    table = pd.DataFrame(matrix, columns=list(MATRIX_COLUMNS))
+    table.insert(0, "bone", np.tile(trial.bones, n_frames))
+    table.insert(0, "frame", np.repeat(np.arange(n_frames), n_bones))
+    table.to_csv(Path(path), index=False, float_format="%.17g")
+
+
+def _brief(values: list, limit: int = 10) -> str:
+    """A list for a message, cut to `limit` entries."""
+    return str(values) if len(values) <= limit else f"{values[:limit]}... ({len(values)} in all)"
