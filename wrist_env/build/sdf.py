@@ -36,7 +36,7 @@ def signed_distance_grid(vertices, faces, *, spacing_mm=0.5, margin_mm=3.0, band
     shape = np.ceil((v.max(axis=0) + margin_mm - lo) / spacing_mm).astype(int) + 1
     axes = [lo[i] + spacing_mm * np.arange(shape[i]) for i in range(3)]
     points = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    s = igl.signed_distance(points, v, f, lower_bound=-band_mm, upper_bound=band_mm)[0]
+    s = igl.signed_distance(points, v, f)[0]
     values = np.clip(s, -band_mm, band_mm).reshape(shape).astype(np.float32)
     return DistanceGrid(origin=lo, spacing_mm=float(spacing_mm), values=values)
 
