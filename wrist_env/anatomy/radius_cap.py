@@ -58,7 +58,23 @@ def offset_heightfield(footprint, row_vertices, *, joint_space_mm=1.5, spacing_m
             p = row_vertices[neighbours]
             d2 = ((p[:, [0, 2]] - grid[i]) ** 2).sum(axis=1)
             height[i] = np.max(p[:, 1] + np.sqrt(g * g - d2))
-    return xs, zs, height.reshape(X.shape)
+    return xs, zs, fill_creases(height.reshape(X.shape), sigma_cells=1.5)
+
+
+def fill_creases(height, sigma_cells=1.5):
+    """Smooth the envelope's creases upwards: max(Gaussian-smoothed height, height), NaN kept.
+
+    The envelope of balls is the lowest surface that keeps the joint space; its
+    creases are valleys, so lifting them to the smoothed surface never brings
+    the radius closer to the row.
+    """
+    from scipy import ndimage
+
+    defined = ~np.isnan(height)
+    filled = np.where(defined, height, 0.0)
+    weight = ndimage.gaussian_filter(defined.astype(float), sigma_cells)
+    smooth = ndimage.gaussian_filter(filled, sigma_cells) / np.maximum(weight, 1e-12)
+    return np.where(defined, np.maximum(smooth, height), np.nan)
 
 
 def _largest_component(mask: np.ndarray) -> np.ndarray:
@@ -112,13 +128,16 @@ def extrude_heightfield(xs, zs, height, *, depth_mm=4.0) -> trimesh.Trimesh:
     return mesh
 
 
-def build_radius_cap(row_meshes, radius_mesh, *, joint_space_mm=1.5, spacing_mm=0.4, depth_mm=4.0):
+def build_radius_cap(row_meshes, radius_mesh, *, joint_space_mm=1.5, spacing_mm=0.4, depth_mm=4.0, sample_mm=0.15):
     """The rebuilt distal radius articular solid and its articular (top) vertex mask.
 
     Returns (mesh, articular) where articular is a bool array over mesh vertices.
     """
     footprint = fossa_points(row_meshes, radius_mesh)
-    row_vertices = np.concatenate([m.vertices for m in row_meshes])
+    # dense surface samples (not just vertices) so the envelope of balls is smooth
+    row_vertices = np.concatenate(
+        [trimesh.sample.sample_surface_even(m, int(m.area / (sample_mm * sample_mm)), seed=0)[0] for m in row_meshes]
+        + [m.vertices for m in row_meshes])
     xs, zs, height = offset_heightfield(footprint, row_vertices, joint_space_mm=joint_space_mm, spacing_mm=spacing_mm)
     mesh = extrude_heightfield(xs, zs, height, depth_mm=depth_mm)
     articular = mesh.vertices[:, 1] < mesh.vertices[:, 1].max() - 1e-6
