@@ -1,0 +1,1 @@
+"""The Numba explicit solver: kernels over arrays and the `simulate` recipe."""

@@ -1,0 +1,145 @@
+"""Kernel inputs: the one place where a `Model`, a `Design` and settings become arrays.
+
+The kernels take named tuples of contiguous arrays (Numba handles them as
+plain records). Nothing here runs in a hot loop.
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+from dataclasses import dataclass
+
+import numpy as np
+
+from wrist_env.design import LIGAMENT_NAMES, Design
+from wrist_env.model import BONES, PAIR_BONES, Model
+
+Bodies = namedtuple("Bodies", "com0 inv_mass inv_inertia mass inertia")
+Grids = namedtuple("Grids", "pair_bones sample_offsets points thickness area values offsets shape origin spacing")
+Fibres = namedtuple("Fibres", "bones origin insertion ligament rest_length")
+Membrane = namedtuple("Membrane", "connectors kind first_row bone rest scaphoid grid_values grid_offset grid_shape grid_origin grid_spacing rest_length")
+Settings = namedtuple(
+    "Settings",
+    "dt settle_steps move_steps frame_steps hold_fraction damping rot_damping fibre_damping_s "
+    "active_band_mm rebuild_every node_mass membrane_contact_stiffness driver load max_disp_mm max_rot_rad",
+)
+
+RSC = LIGAMENT_NAMES.index("RSC")
+EXPERIMENTAL, IDEALIZED = 0, 1
+
+
+@dataclass(frozen=True)
+class SolverSettings:
+    """Explicit-integration settings (s, mm, N, t).
+
+    dt_s: time step. settle_steps, move_steps, frame_steps: steps to settle,
+    to move the capitate to the first pose, and per motion frame; the capitate
+    moves during the first (1 − hold_fraction) of a frame's steps and holds
+    for the rest. damping_per_s: mass-proportional damping of translations
+    and rotations. mass_scale, inertia_scale: mass scaling of the free bones
+    (inertia_scale multiplies rotational inertia on top of mass_scale).
+    """
+
+    dt_s: float = 6e-5
+    settle_steps: int = 600
+    move_steps: int = 300
+    frame_steps: int = 80
+    hold_fraction: float = 0.4
+    damping_per_s: float = 1000.0
+    rot_damping_per_s: float = 1000.0
+    fibre_damping_s: float = 2e-4
+    mass_scale: float = 1.0
+    inertia_scale: float = 2.0
+    active_band_mm: float = 0.6
+    rebuild_every: int = 8
+    node_mass_t: float = 2e-8
+    membrane_contact_stiffness: float = 50.0
+    compressive_load_n: float = 10.0
+    max_disp_mm: float = 15.0
+    max_rot_deg: float = 75.0
+
+    def halved(self) -> "SolverSettings":
+        """The same run with half the time step (twice the steps)."""
+        from dataclasses import replace
+
+        return replace(self, dt_s=self.dt_s / 2, settle_steps=2 * self.settle_steps,
+                       move_steps=2 * self.move_steps, frame_steps=2 * self.frame_steps)
+
+
+def bodies(model: Model, s: SolverSettings) -> Bodies:
+    mass = model.mass * s.mass_scale
+    inertia = model.inertia * (s.mass_scale * s.inertia_scale)
+    inv_mass = np.where(mass > 0, 1.0 / np.where(mass > 0, mass, 1.0), 0.0)
+    inv_inertia = np.array([np.linalg.inv(I) if m > 0 else np.zeros((3, 3)) for I, m in zip(inertia, mass)])
+    return Bodies(np.ascontiguousarray(model.com), inv_mass, inv_inertia, mass, inertia)
+
+
+def grids(model: Model) -> Grids:
+    return Grids(
+        np.ascontiguousarray(PAIR_BONES, dtype=np.int64),
+        np.ascontiguousarray(model.sample_offsets, dtype=np.int64),
+        np.ascontiguousarray(model.sample_points, dtype=np.float64),
+        np.ascontiguousarray(model.sample_thickness, dtype=np.float64),
+        np.ascontiguousarray(model.sample_area, dtype=np.float64),
+        np.ascontiguousarray(model.grid_values, dtype=np.float32),
+        np.ascontiguousarray(model.grid_offsets, dtype=np.int64),
+        np.ascontiguousarray(model.grid_shape, dtype=np.int64),
+        np.ascontiguousarray(model.grid_origin, dtype=np.float64),
+        np.ascontiguousarray(model.grid_spacing, dtype=np.float64),
+    )
+
+
+def fibres(model: Model) -> Fibres:
+    rest = np.linalg.norm(model.fibre_insertion - model.fibre_origin, axis=1)
+    return Fibres(np.ascontiguousarray(model.fibre_bones), np.ascontiguousarray(model.fibre_origin),
+                  np.ascontiguousarray(model.fibre_insertion), np.ascontiguousarray(model.fibre_ligament), rest)
+
+
+def membrane(model: Model) -> Membrane:
+    s = BONES.index("scaphoid")
+    conn = np.ascontiguousarray(model.membrane_connectors)
+    radius = BONES.index("radius")
+    first_row = (model.membrane_bone[conn[:, 0]] == radius) | (model.membrane_bone[conn[:, 1]] == radius)
+    return Membrane(
+        conn, np.ascontiguousarray(model.membrane_kind), first_row & (model.membrane_kind == 0),
+        np.ascontiguousarray(model.membrane_bone), np.ascontiguousarray(model.membrane_nodes), s,
+        np.ascontiguousarray(model.grid_values, dtype=np.float32), int(model.grid_offsets[s]),
+        np.ascontiguousarray(model.grid_shape[s]), np.ascontiguousarray(model.grid_origin[s]),
+        float(model.grid_spacing[s]), np.ascontiguousarray(model.membrane_length),
+    )
+
+
+def design_arrays(model: Model, fib: Fibres, mem: Membrane, design: Design):
+    """Per-fibre (l0, K) and per-connector (l0, K) of a design; K = 0 for torn ligaments.
+
+    l0 = l_ref / reference_strain per fibre (l_ref its neutral length, whose bundle
+    mean is the bundle's reference length); K = (k / n_fibres)·l0, so the bundle's
+    fibres share its stiffness k. The RSC's k is the membrane's stiffness along
+    its length: its n_across longitudinal chains of (n_along − 1) connectors in
+    parallel; across connectors take a quarter of the along connectors' stiffness.
+    """
+    k = design.stiffness
+    r = design.reference_strain
+    torn = design.torn
+    lig = fib.ligament
+    counts = np.bincount(lig, minlength=len(k)).astype(float)
+    f_l0 = fib.rest_length / r[lig]
+    f_K = np.where(torn[lig], 0.0, k[lig] / np.maximum(counts[lig], 1) * f_l0)
+    kind = mem.kind
+    n_across = int(np.sum(mem.first_row))
+    n_along_segments = int(np.sum(kind == 0)) / max(n_across, 1)
+    k_along = k[RSC] * n_along_segments / max(n_across, 1)
+    m_l0 = mem.rest_length / r[RSC]
+    m_k = np.where(kind == 0, k_along, 0.25 * k_along)
+    m_K = 0.0 if torn[RSC] else 1.0
+    return f_l0, f_K, m_l0, m_K * m_k * m_l0
+
+
+def settings_tuple(s: SolverSettings, driver: int) -> Settings:
+    load = np.array([0.0, s.compressive_load_n if driver == IDEALIZED else 0.0, 0.0])
+    return Settings(
+        float(s.dt_s), int(s.settle_steps), int(s.move_steps), int(s.frame_steps), float(s.hold_fraction),
+        float(s.damping_per_s), float(s.rot_damping_per_s), float(s.fibre_damping_s), float(s.active_band_mm),
+        int(s.rebuild_every), float(s.node_mass_t), float(s.membrane_contact_stiffness), int(driver), load,
+        float(s.max_disp_mm), float(np.radians(s.max_rot_deg)),
+    )

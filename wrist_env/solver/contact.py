@@ -1,0 +1,93 @@
+"""Cartilage contact kernels: signed-distance look-up and the tri-linear law (Numba).
+
+A contact sample of one bone (its cartilage surface, bone frame) is looked up
+in the signed-distance grid of the other bone (cartilage folded in). A
+negative distance is an overclosure δ (mm); with the local total cartilage
+thickness h (mm), strain e = δ / h gives the pressure p(e) (MPa) of the
+tri-linear law; the force p·area (N) acts along the grid's gradient.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+OUTSIDE_MM = 1e3  # distance reported outside a grid: no contact
+
+
+@njit(cache=True)
+def sdf_lookup(values, offset, shape, origin, spacing, q):
+    """Trilinear signed distance (mm) and its gradient (3,) at local point q (3,)."""
+    d, gx, gy, gz = sdf_lookup_scalar(values, offset, shape, origin, spacing, q[0], q[1], q[2])
+    return d, np.array([gx, gy, gz])
+
+
+@njit(cache=True, inline="always")
+def sdf_lookup_scalar(values, offset, shape, origin, spacing, qx, qy, qz):
+    """Trilinear signed distance (mm) and gradient components at local point (qx, qy, qz)."""
+    nx, ny, nz = shape[0], shape[1], shape[2]
+    fx = (qx - origin[0]) / spacing
+    fy = (qy - origin[1]) / spacing
+    fz = (qz - origin[2]) / spacing
+    if fx < 0.0 or fy < 0.0 or fz < 0.0 or fx >= nx - 1 or fy >= ny - 1 or fz >= nz - 1:
+        return OUTSIDE_MM, 0.0, 0.0, 0.0
+    i = int(fx)
+    j = int(fy)
+    k = int(fz)
+    tx = fx - i
+    ty = fy - j
+    tz = fz - k
+    base = offset + (i * ny + j) * nz + k
+    sy = nz
+    sx = ny * nz
+    c000 = values[base]
+    c001 = values[base + 1]
+    c010 = values[base + sy]
+    c011 = values[base + sy + 1]
+    c100 = values[base + sx]
+    c101 = values[base + sx + 1]
+    c110 = values[base + sx + sy]
+    c111 = values[base + sx + sy + 1]
+    c00 = c000 + (c001 - c000) * tz
+    c01 = c010 + (c011 - c010) * tz
+    c10 = c100 + (c101 - c100) * tz
+    c11 = c110 + (c111 - c110) * tz
+    c0 = c00 + (c01 - c00) * ty
+    c1 = c10 + (c11 - c10) * ty
+    d = c0 + (c1 - c0) * tx
+    gx = (c1 - c0) / spacing
+    gy = ((1 - tx) * (c01 - c00) + tx * (c11 - c10)) / spacing
+    dz0 = (1 - ty) * (c001 - c000) + ty * (c011 - c010)
+    dz1 = (1 - ty) * (c101 - c100) + ty * (c111 - c110)
+    gz = ((1 - tx) * dz0 + tx * dz1) / spacing
+    return d, gx, gy, gz
+
+
+@njit(cache=True)
+def law_pressure(law, e):
+    """Pressure (MPa) of the tri-linear law [e1, e2, k1, k2, k3] at strain e."""
+    if e <= 0.0:
+        return 0.0
+    e1, e2, k1, k2, k3 = law[0], law[1], law[2], law[3], law[4]
+    if e <= e1:
+        return k1 * e
+    if e <= e2:
+        return k1 * e1 + k2 * (e - e1)
+    return k1 * e1 + k2 * (e2 - e1) + k3 * (e - e2)
+
+
+@njit(cache=True)
+def law_energy(law, e):
+    """Strain energy density ∫ p de (MPa) of the law from 0 to strain e."""
+    if e <= 0.0:
+        return 0.0
+    e1, e2, k1, k2, k3 = law[0], law[1], law[2], law[3], law[4]
+    if e <= e1:
+        return 0.5 * k1 * e * e
+    w = 0.5 * k1 * e1 * e1
+    p1 = k1 * e1
+    if e <= e2:
+        return w + p1 * (e - e1) + 0.5 * k2 * (e - e1) ** 2
+    w += p1 * (e2 - e1) + 0.5 * k2 * (e2 - e1) ** 2
+    p2 = p1 + k2 * (e2 - e1)
+    return w + p2 * (e - e2) + 0.5 * k3 * (e - e2) ** 2

@@ -1,0 +1,224 @@
+"""Force kernels of one explicit step: contact, fibres, RSC membrane (Numba).
+
+Bodies are indexed as in `wrist_env.model.BONES`. A body's state is its
+rotation R (3, 3), the world position x (3,) of its centre of mass, linear
+velocity v and angular velocity w (world). A neutral-pose point p of the
+body is at R (p − com0) + x. Forces F (N) and torques T (N·mm, about the
+centre of mass) are accumulated into arrays of shape (5, 3).
+
+The kernels work on scalars (3-vectors as tuples) so the hot loops allocate
+nothing.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from wrist_env.solver.contact import OUTSIDE_MM, law_energy, law_pressure, sdf_lookup_scalar
+from wrist_env.solver.ligaments import blankevoort_energy, blankevoort_force
+
+# columns of the per-pair contact statistics
+C_FORCE, C_AREA, C_PEAK = 0, 1, 2
+
+
+@njit(cache=True, inline="always")
+def to_world(R, x, com0, b, px, py, pz):
+    """World position of neutral-pose point p of body b."""
+    qx, qy, qz = px - com0[b, 0], py - com0[b, 1], pz - com0[b, 2]
+    return (R[b, 0, 0] * qx + R[b, 0, 1] * qy + R[b, 0, 2] * qz + x[b, 0],
+            R[b, 1, 0] * qx + R[b, 1, 1] * qy + R[b, 1, 2] * qz + x[b, 1],
+            R[b, 2, 0] * qx + R[b, 2, 1] * qy + R[b, 2, 2] * qz + x[b, 2])
+
+
+@njit(cache=True, inline="always")
+def to_local(R, x, com0, b, wx, wy, wz):
+    """Neutral-pose coordinates in body b of world point w."""
+    qx, qy, qz = wx - x[b, 0], wy - x[b, 1], wz - x[b, 2]
+    return (R[b, 0, 0] * qx + R[b, 1, 0] * qy + R[b, 2, 0] * qz + com0[b, 0],
+            R[b, 0, 1] * qx + R[b, 1, 1] * qy + R[b, 2, 1] * qz + com0[b, 1],
+            R[b, 0, 2] * qx + R[b, 1, 2] * qy + R[b, 2, 2] * qz + com0[b, 2])
+
+
+@njit(cache=True, inline="always")
+def rotate(R, b, gx, gy, gz):
+    return (R[b, 0, 0] * gx + R[b, 0, 1] * gy + R[b, 0, 2] * gz,
+            R[b, 1, 0] * gx + R[b, 1, 1] * gy + R[b, 1, 2] * gz,
+            R[b, 2, 0] * gx + R[b, 2, 1] * gy + R[b, 2, 2] * gz)
+
+
+@njit(cache=True, inline="always")
+def apply_force(F, T, x, b, fx, fy, fz, px, py, pz):
+    """Add force f applied at world point p to body b."""
+    rx, ry, rz = px - x[b, 0], py - x[b, 1], pz - x[b, 2]
+    F[b, 0] += fx
+    F[b, 1] += fy
+    F[b, 2] += fz
+    T[b, 0] += ry * fz - rz * fy
+    T[b, 1] += rz * fx - rx * fz
+    T[b, 2] += rx * fy - ry * fx
+
+
+@njit(cache=True, inline="always")
+def _sample(R, x, com0, grids, s, a, b):
+    p = grids.points
+    wx, wy, wz = to_world(R, x, com0, a, p[s, 0], p[s, 1], p[s, 2])
+    qx, qy, qz = to_local(R, x, com0, b, wx, wy, wz)
+    d, gx, gy, gz = sdf_lookup_scalar(grids.values, grids.offsets[b], grids.shape[b], grids.origin[b], grids.spacing[b], qx, qy, qz)
+    return d, gx, gy, gz, wx, wy, wz
+
+
+@njit(cache=True)
+def rebuild_active(R, x, com0, grids, band_mm, active, n_active):
+    """Refill `active` with the samples of each pair within `band_mm` of contact."""
+    for p in range(grids.pair_bones.shape[0]):
+        a, b = grids.pair_bones[p, 0], grids.pair_bones[p, 1]
+        n = 0
+        start = grids.sample_offsets[p]
+        for s in range(start, grids.sample_offsets[p + 1]):
+            d = _sample(R, x, com0, grids, s, a, b)[0]
+            if d < band_mm:
+                active[start + n] = s
+                n += 1
+        n_active[p] = n
+
+
+@njit(cache=True)
+def contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats):
+    """Contact forces of all pairs' active samples; returns contact energy (N·mm).
+
+    stats (n_pairs, 3) receives per pair: force (N), contacting area (mm²), peak pressure (MPa).
+    """
+    energy = 0.0
+    stats[:] = 0.0
+    for p in range(grids.pair_bones.shape[0]):
+        a, b = grids.pair_bones[p, 0], grids.pair_bones[p, 1]
+        start = grids.sample_offsets[p]
+        for j in range(n_active[p]):
+            s = active[start + j]
+            d, gx, gy, gz, wx, wy, wz = _sample(R, x, com0, grids, s, a, b)
+            if d >= 0.0:
+                continue
+            gn = np.sqrt(gx * gx + gy * gy + gz * gz)
+            if gn < 1e-12:
+                continue
+            h = grids.thickness[s]
+            strain = -d / h
+            pressure = law_pressure(law, strain)
+            area = grids.area[s]
+            scale = pressure * area / gn
+            fx, fy, fz = rotate(R, b, gx * scale, gy * scale, gz * scale)
+            apply_force(F, T, x, a, fx, fy, fz, wx, wy, wz)
+            apply_force(F, T, x, b, -fx, -fy, -fz, wx, wy, wz)
+            energy += area * h * law_energy(law, strain)
+            stats[p, C_FORCE] += pressure * area
+            stats[p, C_AREA] += area
+            if pressure > stats[p, C_PEAK]:
+                stats[p, C_PEAK] = pressure
+    return energy
+
+
+@njit(cache=True)
+def fibre_forces(R, x, v, w, com0, fibres, l0, K, damping_s, F, T, bundle_force):
+    """Blankevoort fibre forces; returns strain energy (N·mm).
+
+    l0, K: per-fibre zero-load length (mm) and scale (N per unit strain), K = 0 if torn.
+    bundle_force (11,) receives the summed tension of each bundle (N).
+    """
+    energy = 0.0
+    o, ins = fibres.origin, fibres.insertion
+    for i in range(l0.shape[0]):
+        if K[i] == 0.0:
+            continue
+        a, b = fibres.bones[i, 0], fibres.bones[i, 1]
+        ax, ay, az = to_world(R, x, com0, a, o[i, 0], o[i, 1], o[i, 2])
+        bx, by, bz = to_world(R, x, com0, b, ins[i, 0], ins[i, 1], ins[i, 2])
+        dx, dy, dz = bx - ax, by - ay, bz - az
+        length = np.sqrt(dx * dx + dy * dy + dz * dz)
+        strain = length / l0[i] - 1.0
+        if strain <= 0.0:
+            continue
+        ux, uy, uz = dx / length, dy / length, dz / length
+        tension = blankevoort_force(K[i], strain)
+        # relative velocity of the ends along the fibre
+        ra = (ax - x[a, 0], ay - x[a, 1], az - x[a, 2])
+        rb = (bx - x[b, 0], by - x[b, 1], bz - x[b, 2])
+        vax = v[a, 0] + w[a, 1] * ra[2] - w[a, 2] * ra[1]
+        vay = v[a, 1] + w[a, 2] * ra[0] - w[a, 0] * ra[2]
+        vaz = v[a, 2] + w[a, 0] * ra[1] - w[a, 1] * ra[0]
+        vbx = v[b, 0] + w[b, 1] * rb[2] - w[b, 2] * rb[1]
+        vby = v[b, 1] + w[b, 2] * rb[0] - w[b, 0] * rb[2]
+        vbz = v[b, 2] + w[b, 0] * rb[1] - w[b, 1] * rb[0]
+        rate = (vbx - vax) * ux + (vby - vay) * uy + (vbz - vaz) * uz
+        if rate > 0.0:
+            tension += damping_s * (K[i] / l0[i]) * rate
+        apply_force(F, T, x, a, tension * ux, tension * uy, tension * uz, ax, ay, az)
+        apply_force(F, T, x, b, -tension * ux, -tension * uy, -tension * uz, bx, by, bz)
+        bundle_force[fibres.ligament[i]] += tension
+        energy += blankevoort_energy(K[i], l0[i], strain)
+    return energy
+
+
+@njit(cache=True)
+def place_nodes(R, x, com0, mem, nodes):
+    """Move the membrane nodes attached to a bone with it."""
+    for i in range(nodes.shape[0]):
+        b = mem.bone[i]
+        if b >= 0:
+            nodes[i, 0], nodes[i, 1], nodes[i, 2] = to_world(R, x, com0, b, mem.rest[i, 0], mem.rest[i, 1], mem.rest[i, 2])
+
+
+@njit(cache=True)
+def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node_force):
+    """RSC membrane: connector tension and node–scaphoid contact.
+
+    nodes (M, 3): world positions (attached nodes already placed on their bones).
+    node_force (M, 3) receives forces on the free nodes; forces on attached
+    nodes go to their bones. Returns (energy N·mm, tension N of the membrane's
+    radial row of along connectors).
+    """
+    energy = 0.0
+    along = 0.0
+    node_force[:] = 0.0
+    for c in range(l0.shape[0]):
+        if K[c] == 0.0:
+            continue
+        i, j = mem.connectors[c, 0], mem.connectors[c, 1]
+        dx, dy, dz = nodes[j, 0] - nodes[i, 0], nodes[j, 1] - nodes[i, 1], nodes[j, 2] - nodes[i, 2]
+        length = np.sqrt(dx * dx + dy * dy + dz * dz)
+        strain = length / l0[c] - 1.0
+        if strain <= 0.0:
+            continue
+        tension = blankevoort_force(K[c], strain) / length
+        node_force[i, 0] += tension * dx
+        node_force[i, 1] += tension * dy
+        node_force[i, 2] += tension * dz
+        node_force[j, 0] -= tension * dx
+        node_force[j, 1] -= tension * dy
+        node_force[j, 2] -= tension * dz
+        energy += blankevoort_energy(K[c], l0[c], strain)
+        if mem.first_row[c]:
+            along += tension * length
+    s = mem.scaphoid
+    for i in range(nodes.shape[0]):
+        if mem.bone[i] >= 0:
+            continue
+        qx, qy, qz = to_local(R, x, com0, s, nodes[i, 0], nodes[i, 1], nodes[i, 2])
+        d, gx, gy, gz = sdf_lookup_scalar(mem.grid_values, mem.grid_offset, mem.grid_shape,
+                                          mem.grid_origin, mem.grid_spacing, qx, qy, qz)
+        if d < 0.0:
+            gn = np.sqrt(gx * gx + gy * gy + gz * gz)
+            if gn > 1e-12:
+                scale = contact_stiffness * -d / gn
+                fx, fy, fz = rotate(R, s, gx * scale, gy * scale, gz * scale)
+                node_force[i, 0] += fx
+                node_force[i, 1] += fy
+                node_force[i, 2] += fz
+                apply_force(F, T, x, s, -fx, -fy, -fz, nodes[i, 0], nodes[i, 1], nodes[i, 2])
+                energy += 0.5 * contact_stiffness * d * d
+    for i in range(nodes.shape[0]):
+        b = mem.bone[i]
+        if b >= 0:
+            apply_force(F, T, x, b, node_force[i, 0], node_force[i, 1], node_force[i, 2], nodes[i, 0], nodes[i, 1], nodes[i, 2])
+            node_force[i, 0] = node_force[i, 1] = node_force[i, 2] = 0.0
+    return energy, along

@@ -1,0 +1,171 @@
+"""The explicit time-stepping kernel: settle → move to the first pose → motion (Numba).
+
+Semi-implicit Euler with implicit mass-proportional damping for a
+quasi-static answer. The radius and ulna are fixed, the scaphoid and lunate
+free in 6 DOF, the capitate driven (all 6 DOF prescribed, or, for the
+idealized driver, rotations prescribed and translations free under a
+compressive load), the RSC membrane's interior nodes free point masses.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from wrist_env.solver.forces import C_AREA, C_FORCE, C_PEAK, contact_forces, fibre_forces, membrane_forces, place_nodes, rebuild_active
+from wrist_env.solver.rigid import interpolate_pose, matrix_to_rotvec, orthonormalize, rotvec_to_matrix, smoothstep
+
+SCAPHOID, LUNATE, CAPITATE = 2, 3, 4
+N_BONES, N_PAIRS, N_LIGAMENTS = 5, 5, 11
+OK, FAILED_NAN, FAILED_DIVERGED = 0, 1, 2
+
+
+@njit(cache=True)
+def _step(R, x, v, w, nodes, nv, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st,
+          active, n_active, F, T, node_force, stats, bundle, capR, capx, step_index):
+    """One explicit step with the capitate at target (capR, capx); returns internal energy (N·mm)."""
+    com0 = bod.com0
+    R[CAPITATE] = capR
+    if st.driver == 0:
+        x[CAPITATE] = capx
+        v[CAPITATE] = 0.0
+    w[CAPITATE] = 0.0
+    if step_index % st.rebuild_every == 0:
+        rebuild_active(R, x, com0, grids, st.active_band_mm, active, n_active)
+    place_nodes(R, x, com0, mem, nodes)
+    F[:] = 0.0
+    T[:] = 0.0
+    bundle[:] = 0.0
+    energy = contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats)
+    energy += fibre_forces(R, x, v, w, com0, fib, f_l0, f_K, st.fibre_damping_s, F, T, bundle)
+    e_mem, rsc = membrane_forces(R, x, com0, mem, nodes, m_l0, m_K, st.membrane_contact_stiffness, F, T, node_force)
+    energy += e_mem
+    bundle[3] += rsc
+    dt = st.dt
+    lin = 1.0 / (1.0 + st.damping * dt)
+    rot = 1.0 / (1.0 + st.rot_damping * dt)
+    for b in (SCAPHOID, LUNATE):
+        v[b] = (v[b] + dt * bod.inv_mass[b] * F[b]) * lin
+        x[b] += dt * v[b]
+        Iinv = R[b] @ bod.inv_inertia[b] @ R[b].T
+        w[b] = (w[b] + dt * (Iinv @ T[b])) * rot
+        R[b] = rotvec_to_matrix(w[b] * dt) @ R[b]
+    if st.driver == 1:
+        v[CAPITATE] = (v[CAPITATE] + dt * bod.inv_mass[CAPITATE] * (F[CAPITATE] + st.load)) * lin
+        x[CAPITATE] += dt * v[CAPITATE]
+    if st.node_mass > 0.0:
+        for i in range(nodes.shape[0]):
+            if mem.bone[i] < 0:
+                nv[i] = (nv[i] + dt / st.node_mass * node_force[i]) * lin
+                nodes[i] += dt * nv[i]
+    if step_index % 100 == 0:
+        for b in (SCAPHOID, LUNATE):
+            R[b] = orthonormalize(R[b])
+    return energy
+
+
+@njit(cache=True)
+def _kinetic(v, w, nv, bod, st):
+    ke = 0.0
+    for b in (SCAPHOID, LUNATE):
+        ke += 0.5 * bod.mass[b] * np.dot(v[b], v[b]) + 0.5 * np.dot(w[b], bod.inertia[b] @ w[b])
+    if st.driver == 1:
+        ke += 0.5 * bod.mass[CAPITATE] * np.dot(v[CAPITATE], v[CAPITATE])
+    for i in range(nv.shape[0]):
+        ke += 0.5 * st.node_mass * np.dot(nv[i], nv[i])
+    return ke
+
+
+@njit(cache=True)
+def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
+        poses, contact, bundle_out, energy_out, residual_out, status):
+    """Simulate one design; fills the per-frame outputs and status[0] (0 ok, 1 NaN, 2 diverged).
+
+    frame_R (n_frames, 3, 3), frame_x (n_frames, 3): capitate rotation and
+    centre-of-mass targets per frame (for the idealized driver the centre is
+    free and frame_x is only the start). Outputs: poses (n_frames, 5, 4, 4);
+    contact (n_frames, 5, 4) mean pressure (MPa), peak pressure (MPa), area
+    (mm²), force (N); bundle_out (n_frames, 11) N; energy_out (n_frames, 2)
+    kinetic, internal (N·mm); residual_out (n_frames, 2) largest net force (N)
+    and moment (N·mm) on the free bones.
+    """
+    com0 = bod.com0
+    n_frames = frame_R.shape[0]
+    R = np.zeros((N_BONES, 3, 3))
+    for b in range(N_BONES):
+        R[b] = np.eye(3)
+    x = com0.copy()
+    v = np.zeros((N_BONES, 3))
+    w = np.zeros((N_BONES, 3))
+    nodes = mem.rest.copy()
+    nv = np.zeros_like(nodes)
+    node_force = np.zeros_like(nodes)
+    active = np.zeros(grids.points.shape[0], np.int64)
+    n_active = np.zeros(grids.pair_bones.shape[0], np.int64)
+    F = np.zeros((N_BONES, 3))
+    T = np.zeros((N_BONES, 3))
+    stats = np.zeros((grids.pair_bones.shape[0], 3))
+    bundle = np.zeros(N_LIGAMENTS)
+    status[0] = OK
+    step = 0
+    R0 = np.eye(3)
+    x0 = com0[CAPITATE].copy()
+    energy = 0.0
+    for f in range(-2, n_frames):
+        if f == -2:  # settle with the capitate at its static pose
+            Ra, xa, Rb, xb, n = R0, x0, R0, x0, st.settle_steps
+        elif f == -1:  # move the capitate to the first pose
+            Ra, xa, Rb, xb, n = R0, x0, frame_R[0], frame_x[0], st.move_steps
+        else:
+            Ra, xa = frame_R[max(f - 1, 0)], frame_x[max(f - 1, 0)]
+            Rb, xb = frame_R[f], frame_x[f]
+            n = st.frame_steps if f > 0 else st.frame_steps // 2
+        moving = max(1.0, (1.0 - st.hold_fraction) * n)
+        for k in range(n):
+            s = smoothstep((k + 1) / moving)
+            capR, capx = interpolate_pose(Ra, xa, Rb, xb, s)
+            energy = _step(R, x, v, w, nodes, nv, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st,
+                           active, n_active, F, T, node_force, stats, bundle, capR, capx, step)
+            step += 1
+        bad = False
+        for b in (SCAPHOID, LUNATE, CAPITATE):
+            for i in range(3):
+                if not np.isfinite(x[b, i]):
+                    bad = True
+        if bad:
+            status[0] = FAILED_NAN
+        else:
+            for b in (SCAPHOID, LUNATE):
+                if np.linalg.norm(x[b] - com0[b]) > st.max_disp_mm:
+                    status[0] = FAILED_DIVERGED
+                rel = matrix_to_rotvec(R[b] @ R[CAPITATE].T)
+                if np.linalg.norm(rel) > st.max_rot_rad:
+                    status[0] = FAILED_DIVERGED
+        if status[0] != OK:
+            return
+        if f < 0:
+            continue
+        for b in range(N_BONES):
+            poses[f, b, :3, :3] = R[b]
+            poses[f, b, :3, 3] = x[b] - R[b] @ com0[b]
+            poses[f, b, 3, 3] = 1.0
+        for p in range(stats.shape[0]):
+            area = stats[p, C_AREA]
+            contact[f, p, 0] = stats[p, C_FORCE] / area if area > 0 else 0.0
+            contact[f, p, 1] = stats[p, C_PEAK]
+            contact[f, p, 2] = area
+            contact[f, p, 3] = stats[p, C_FORCE]
+        bundle_out[f] = bundle
+        energy_out[f, 0] = _kinetic(v, w, nv, bod, st)
+        energy_out[f, 1] = energy
+        residual_out[f, 0] = max(np.linalg.norm(F[SCAPHOID]), np.linalg.norm(F[LUNATE]))
+        residual_out[f, 1] = max(np.linalg.norm(T[SCAPHOID]), np.linalg.norm(T[LUNATE]))
+
+
+@njit(cache=True, parallel=True)
+def run_batch(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
+              poses, contact, bundle_out, energy_out, residual_out, status):
+    """`run` for many designs: f_l0, f_K (n, N), m_l0, m_K (n, C); outputs with a leading n axis."""
+    for i in prange(f_l0.shape[0]):
+        run(bod, grids, law, fib, f_l0[i], f_K[i], mem, m_l0[i], m_K[i], st, frame_R, frame_x,
+            poses[i], contact[i], bundle_out[i], energy_out[i], residual_out[i], status[i])

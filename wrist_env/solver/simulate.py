@@ -1,0 +1,120 @@
+"""`simulate(model, design, driver)`: one simulation as a recipe, and its batched form.
+
+Drivers: `experimental(trial)` prescribes all 6 DOF of the capitate from a
+trial's 4×4 transforms; `idealized(...)` ramps the capitate from maximum
+flexion to maximum extension about the RCS z axis, other rotations held,
+translations free under a small compressive load.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from wrist_env.design import Design
+from wrist_env.model import BONES, Model
+from wrist_env.solver import arrays, kernel
+
+STATUS = {kernel.OK: "ok", kernel.FAILED_NAN: "failed: NaN in the state", kernel.FAILED_DIVERGED: "failed: a free bone diverged"}
+
+
+@dataclass(frozen=True)
+class Driver:
+    """Capitate targets per frame: rotations (n_frames, 3, 3), centre of mass (n_frames, 3) mm.
+
+    mode: arrays.EXPERIMENTAL or arrays.IDEALIZED; angle_deg (n_frames,) the
+    wrist flexion angle of each frame (idealized) or NaN.
+    """
+
+    mode: int
+    rotation: np.ndarray
+    com: np.ndarray
+    angle_deg: np.ndarray
+
+
+def experimental(model: Model, transforms) -> Driver:
+    """Driver from the capitate's 4×4 transforms (n_frames, 4, 4), neutral → frame, RCS mm."""
+    T = np.asarray(transforms, dtype=np.float64)
+    com0 = model.com[BONES.index("capitate")]
+    rotation = np.ascontiguousarray(T[:, :3, :3])
+    com = np.einsum("fij,j->fi", rotation, com0) + T[:, :3, 3]
+    return Driver(arrays.EXPERIMENTAL, rotation, np.ascontiguousarray(com), np.full(len(T), np.nan))
+
+
+def idealized(model: Model, *, flexion_deg: float = 40.0, extension_deg: float = 40.0, n_frames: int = 17) -> Driver:
+    """Smooth sweep from `flexion_deg` of flexion to `extension_deg` of extension about the RCS z axis."""
+    angle = np.linspace(flexion_deg, -extension_deg, n_frames)
+    t = np.radians(angle)
+    c, s = np.cos(t), np.sin(t)
+    rotation = np.zeros((n_frames, 3, 3))
+    rotation[:, 0, 0], rotation[:, 0, 1], rotation[:, 1, 0], rotation[:, 1, 1], rotation[:, 2, 2] = c, -s, s, c, 1.0
+    com = np.tile(model.com[BONES.index("capitate")], (n_frames, 1))
+    return Driver(arrays.IDEALIZED, rotation, com, angle)
+
+
+@dataclass(frozen=True)
+class Result:
+    """Per-frame outputs of one simulation.
+
+    poses (n_frames, 5, 4, 4): neutral → frame transforms of `BONES`, RCS mm.
+    contact (n_frames, 5, 4): per pair (`model.PAIRS`) mean pressure over the
+        contacting area (MPa), peak pressure (MPa), contact area (mm²), force (N).
+    bundle_force (n_frames, 11): tension of each Table 2 ligament (N).
+    energy (n_frames, 2): kinetic and internal energy (N·mm).
+    residual (n_frames, 2): largest net force (N) and moment (N·mm) on the free bones.
+    status: 0 ok, otherwise failed (see `message`); a failed run's frames are NaN.
+    """
+
+    poses: np.ndarray
+    contact: np.ndarray
+    bundle_force: np.ndarray
+    energy: np.ndarray
+    residual: np.ndarray
+    angle_deg: np.ndarray
+    status: int
+    message: str
+
+    @property
+    def ok(self) -> bool:
+        return self.status == kernel.OK
+
+
+def _outputs(n: int, n_frames: int):
+    shape = (n,) if n else ()
+    return (np.full(shape + (n_frames, 5, 4, 4), np.nan), np.full(shape + (n_frames, 5, 4), np.nan),
+            np.full(shape + (n_frames, 11), np.nan), np.full(shape + (n_frames, 2), np.nan),
+            np.full(shape + (n_frames, 2), np.nan), np.zeros(shape + (1,), np.int64))
+
+
+def _prepare(model: Model, settings: arrays.SolverSettings | None, driver: Driver):
+    s = settings or arrays.SolverSettings()
+    bod, grd, fib, mem = arrays.bodies(model, s), arrays.grids(model), arrays.fibres(model), arrays.membrane(model)
+    return s, bod, grd, fib, mem, arrays.settings_tuple(s, driver.mode), np.ascontiguousarray(model.contact_law, dtype=np.float64)
+
+
+def simulate(model: Model, design: Design, driver: Driver, settings: arrays.SolverSettings | None = None) -> Result:
+    """Simulate one design: settle, move the capitate to the first pose, then the motion."""
+    s, bod, grd, fib, mem, st, law = _prepare(model, settings, driver)
+    f_l0, f_K, m_l0, m_K = arrays.design_arrays(model, fib, mem, design)
+    out = _outputs(0, len(driver.rotation))
+    kernel.run(bod, grd, law, fib, f_l0, f_K, mem, m_l0, m_K, st, driver.rotation, driver.com, *out)
+    return _result(out, driver, int(out[-1][0]))
+
+
+def simulate_batch(model: Model, designs, driver: Driver, settings: arrays.SolverSettings | None = None) -> list[Result]:
+    """Simulate many designs in parallel (Numba prange); same results as one at a time."""
+    s, bod, grd, fib, mem, st, law = _prepare(model, settings, driver)
+    per = [arrays.design_arrays(model, fib, mem, d) for d in designs]
+    f_l0, f_K, m_l0, m_K = (np.ascontiguousarray(np.stack([p[i] for p in per])) for i in range(4))
+    out = _outputs(len(per), len(driver.rotation))
+    kernel.run_batch(bod, grd, law, fib, f_l0, f_K, mem, m_l0, m_K, st, driver.rotation, driver.com, *out)
+    return [_result(tuple(o[i] for o in out), driver, int(out[-1][i, 0])) for i in range(len(per))]
+
+
+def _result(out, driver: Driver, status: int) -> Result:
+    poses, contact, bundle, energy, residual, _ = out
+    if status != kernel.OK:
+        for a in (poses, contact, bundle, energy, residual):
+            a[...] = np.nan
+    return Result(poses, contact, bundle, energy, residual, driver.angle_deg, status, STATUS[status])
