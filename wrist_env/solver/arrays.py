@@ -21,7 +21,7 @@ Membrane = namedtuple("Membrane", "connectors kind first_row bone rest scaphoid 
 Settings = namedtuple(
     "Settings",
     "dt settle_steps move_steps frame_steps hold_fraction damping rot_damping fibre_damping_s "
-    "active_band_mm rebuild_every node_mass membrane_contact_stiffness driver load max_disp_mm max_rot_rad",
+    "active_band_mm rebuild_every node_mass membrane_contact_stiffness driver load max_disp_mm max_rot_rad fire_alpha0",
 )
 
 RSC = LIGAMENT_NAMES.index("RSC")
@@ -57,6 +57,7 @@ class SolverSettings:
     compressive_load_n: float = 10.0
     max_disp_mm: float = 15.0
     max_rot_deg: float = 75.0
+    fire_alpha0: float = 0.1
 
     def halved(self) -> "SolverSettings":
         """The same run with half the time step (twice the steps)."""
@@ -141,5 +142,5 @@ def settings_tuple(s: SolverSettings, driver: int) -> Settings:
         float(s.dt_s), int(s.settle_steps), int(s.move_steps), int(s.frame_steps), float(s.hold_fraction),
         float(s.damping_per_s), float(s.rot_damping_per_s), float(s.fibre_damping_s), float(s.active_band_mm),
         int(s.rebuild_every), float(s.node_mass_t), float(s.membrane_contact_stiffness), int(driver), load,
-        float(s.max_disp_mm), float(np.radians(s.max_rot_deg)),
+        float(s.max_disp_mm), float(np.radians(s.max_rot_deg)), float(s.fire_alpha0),
     )

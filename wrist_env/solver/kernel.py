@@ -20,9 +20,53 @@ N_BONES, N_PAIRS, N_LIGAMENTS = 5, 5, 11
 OK, FAILED_NAN, FAILED_DIVERGED = 0, 1, 2
 
 
+FIRE_F_ALPHA, FIRE_N_MIN = 0.99, 5
+
+
+@njit(cache=True)
+def _mix(vel, force, a):
+    """FIRE mixing of one velocity group towards its force direction."""
+    vn = np.sqrt(np.sum(vel * vel))
+    fn = np.sqrt(np.sum(force * force))
+    if fn > 0.0:
+        vel[:] = (1.0 - a) * vel + (a * vn / fn) * force
+
+
+@njit(cache=True)
+def _fire(v, w, nv, F, T, node_force, mem, st, fire):
+    """FIRE relaxation (Bitzek et al. 2006) at a fixed step: mix velocities towards the
+    forces while the power is positive, stop everything when it turns negative.
+    fire = [alpha, steps with positive power]."""
+    power = 0.0
+    for b in (SCAPHOID, LUNATE):
+        power += np.dot(F[b], v[b]) + np.dot(T[b], w[b])
+    if st.driver == 1:
+        power += np.dot(F[CAPITATE], v[CAPITATE])
+    for i in range(nv.shape[0]):
+        if mem.bone[i] < 0:
+            power += np.dot(node_force[i], nv[i])
+    if power > 0.0:
+        a = fire[0]
+        for b in (SCAPHOID, LUNATE):
+            _mix(v[b], F[b], a)
+            _mix(w[b], T[b], a)
+        if st.driver == 1:
+            _mix(v[CAPITATE], F[CAPITATE], a)
+        _mix(nv, node_force, a)
+        fire[1] += 1.0
+        if fire[1] > FIRE_N_MIN:
+            fire[0] *= FIRE_F_ALPHA
+    else:
+        v[:] = 0.0
+        w[:] = 0.0
+        nv[:] = 0.0
+        fire[0] = st.fire_alpha0
+        fire[1] = 0.0
+
+
 @njit(cache=True)
 def _step(R, x, v, w, nodes, nv, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st,
-          active, n_active, F, T, node_force, stats, bundle, capR, capx, step_index):
+          active, n_active, F, T, node_force, stats, bundle, capR, capx, step_index, fire):
     """One explicit step with the capitate at target (capR, capx); returns internal energy (N·mm)."""
     com0 = bod.com0
     R[CAPITATE] = capR
@@ -41,6 +85,10 @@ def _step(R, x, v, w, nodes, nv, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K
     e_mem, rsc = membrane_forces(R, x, com0, mem, nodes, m_l0, m_K, st.membrane_contact_stiffness, F, T, node_force)
     energy += e_mem
     bundle[3] += rsc
+    if st.driver == 1:
+        F[CAPITATE] += st.load
+    if st.fire_alpha0 > 0.0:
+        _fire(v, w, nv, F, T, node_force, mem, st, fire)
     dt = st.dt
     lin = 1.0 / (1.0 + st.damping * dt)
     rot = 1.0 / (1.0 + st.rot_damping * dt)
@@ -51,7 +99,7 @@ def _step(R, x, v, w, nodes, nv, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K
         w[b] = (w[b] + dt * (Iinv @ T[b])) * rot
         R[b] = rotvec_to_matrix(w[b] * dt) @ R[b]
     if st.driver == 1:
-        v[CAPITATE] = (v[CAPITATE] + dt * bod.inv_mass[CAPITATE] * (F[CAPITATE] + st.load)) * lin
+        v[CAPITATE] = (v[CAPITATE] + dt * bod.inv_mass[CAPITATE] * F[CAPITATE]) * lin
         x[CAPITATE] += dt * v[CAPITATE]
     if st.node_mass > 0.0:
         for i in range(nodes.shape[0]):
@@ -111,6 +159,7 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
     R0 = np.eye(3)
     x0 = com0[CAPITATE].copy()
     energy = 0.0
+    fire = np.array([st.fire_alpha0, 0.0])
     for f in range(-2, n_frames):
         if f == -2:  # settle with the capitate at its static pose
             Ra, xa, Rb, xb, n = R0, x0, R0, x0, st.settle_steps
@@ -125,7 +174,7 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
             s = smoothstep((k + 1) / moving)
             capR, capx = interpolate_pose(Ra, xa, Rb, xb, s)
             energy = _step(R, x, v, w, nodes, nv, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st,
-                           active, n_active, F, T, node_force, stats, bundle, capR, capx, step)
+                           active, n_active, F, T, node_force, stats, bundle, capR, capx, step, fire)
             step += 1
         bad = False
         for b in (SCAPHOID, LUNATE, CAPITATE):
