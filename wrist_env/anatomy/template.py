@@ -12,9 +12,9 @@ defined from landmarks, not assumed from the mesh frame:
 - origin: centre of the rebuilt articular surface (scaphoid + lunate fossae).
 
 Bones: the carpal meshes as shipped (watertight, ~0.7 mm edges); the radius
-is the rebuilt articular solid (0.4 mm grid) plus the distal 45 mm of the
+is the rebuilt articular solid (0.4 mm grid) plus the distal 20 mm of the
 shaft subdivided to ≤ 1.5 mm (for ligament sites and display); the ulna is its
-distal 45 mm subdivided likewise.
+distal 20 mm subdivided likewise.
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ from wrist_env.anatomy.radius_cap import build_radius_cap
 
 CARPALS = ("scaphoid", "lunate", "capitate")
 JOINT_SPACE_MM = 1.5  # radiocarpal bone-to-bone joint space of the rebuilt fossae
-SHAFT_LENGTH_MM = 45.0
+SHAFT_LENGTH_MM = 20.0
 SHAFT_EDGE_MM = 1.5
 
 

@@ -3,7 +3,8 @@
 Each grid holds the signed distance (mm, positive outside) to one bone's
 displaced surface (bone with its cartilage), sampled on a regular grid in
 that bone's own frame (the RCS in the neutral pose). Exact distances come
-from libigl; values are clamped to ±`band_mm`.
+from libigl, signed by the fast winding number (robust where a displaced
+cartilage rim folds); values are clamped to ±`band_mm`.
 """
 
 from __future__ import annotations
@@ -36,7 +37,7 @@ def signed_distance_grid(vertices, faces, *, spacing_mm=0.5, margin_mm=3.0, band
     shape = np.ceil((v.max(axis=0) + margin_mm - lo) / spacing_mm).astype(int) + 1
     axes = [lo[i] + spacing_mm * np.arange(shape[i]) for i in range(3)]
     points = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    s = igl.signed_distance(points, v, f)[0]
+    s = igl.signed_distance(points, v, f, sign_type=igl.SignedDistanceType.SIGNED_DISTANCE_TYPE_FAST_WINDING_NUMBER)[0]
     values = np.clip(s, -band_mm, band_mm).reshape(shape).astype(np.float32)
     return DistanceGrid(origin=lo, spacing_mm=float(spacing_mm), values=values)
 
