@@ -38,7 +38,7 @@ def _frame(ax, points, title):
     half = (p.max(axis=0) - p.min(axis=0)).max() / 2
     for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
         setter(c - half, c + half)
-    ax.set_box_aspect((1, 1, 1))
+    ax.set_box_aspect((1, 1, 1), zoom=1.3)
     ax.set_xlabel("radial (mm)")
     ax.set_ylabel("dorsal (mm)")
     ax.set_zlabel("proximal (mm)")
@@ -49,6 +49,21 @@ def _crop(vertices, faces, y_max):
     return faces[(vertices[faces][:, :, 1] < y_max).all(axis=1)]
 
 
+MODEL_PANELS = (("volar view", 0, 0), ("radial view", 0, 90), ("dorsal view", 0, 180))
+
+
+def _display_faces(bone: str, vertices, faces, thickness):
+    """Faces worth drawing: cropped to the wrist, without the radius solid's walls and base."""
+    faces = _crop(vertices, faces, 12.0)
+    if bone == "radius":
+        v = vertices[faces]
+        n = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
+        n /= np.linalg.norm(n, axis=1, keepdims=True) + 1e-12
+        articular = thickness[faces].min(axis=1) > 0
+        faces = faces[articular | (np.abs(n[:, 1]) < 0.9) & (v[:, :, 1].min(axis=1) > 2.0)]
+    return faces
+
+
 def model_figure(name: str, out: Path | None = None) -> Path:
     """Bones, cartilage coloured by thickness, ligament fibres and the RSC membrane of a model."""
     from wrist_env.model import BONES
@@ -56,33 +71,41 @@ def model_figure(name: str, out: Path | None = None) -> Path:
 
     model = load_model(name)
     out = out or FIGURES / f"model_{name}.png"
-    fig = plt.figure(figsize=(16, 6.2))
     norm = matplotlib.colors.Normalize(0.0, 1.1)
     cmap = plt.get_cmap("viridis")
-    for k, (title, elev, azim) in enumerate(VIEWS):
-        ax = fig.add_subplot(1, 3, k + 1, projection="3d")
-        for bone in BONES:
-            v, f = model.bone_mesh(bone)
-            f = _crop(v, f, 14.0)
-            t = model.bone_thickness(bone)
-            ft = t[f].mean(axis=1)
-            colours = np.array([matplotlib.colors.to_rgba(BONE_COLOUR[bone])] * len(f))
-            covered = ft > 0.05
-            colours[covered] = cmap(norm(ft[covered]))
-            _add_mesh(ax, v, f, None, facecolors=colours)
-        segs = np.stack([model.fibre_origin, model.fibre_insertion], axis=1)
-        lc = Line3DCollection(_to_plot(segs), colors=[LIGAMENT_COLOURS[LIGAMENT_NAMES[i]] for i in model.fibre_ligament], linewidths=1.6)
-        ax.add_collection3d(lc)
-        nodes = model.membrane_nodes
-        ms = np.stack([nodes[model.membrane_connectors[:, 0]], nodes[model.membrane_connectors[:, 1]]], axis=1)
-        ax.add_collection3d(Line3DCollection(_to_plot(ms), colors=LIGAMENT_COLOURS["RSC"], linewidths=1.0))
+    tris, colours = [], []
+    for bone in BONES:
+        v, f = model.bone_mesh(bone)
+        t = model.bone_thickness(bone)
+        f = _display_faces(bone, v, f, t)
+        ft = t[f].mean(axis=1)
+        c = np.array([matplotlib.colors.to_rgba(BONE_COLOUR[bone])] * len(f))
+        covered = t[f].min(axis=1) > 0
+        c[covered] = cmap(norm(ft[covered]))
+        tris.append(v[f])
+        colours.append(c)
+    tris, colours = np.concatenate(tris), np.concatenate(colours)
+    fibres = np.stack([model.fibre_origin, model.fibre_insertion], axis=1)
+    fibre_colours = [LIGAMENT_COLOURS[LIGAMENT_NAMES[i]] for i in model.fibre_ligament]
+    nodes = model.membrane_nodes
+    membrane = np.stack([nodes[model.membrane_connectors[:, 0]], nodes[model.membrane_connectors[:, 1]]], axis=1)
+    fig = plt.figure(figsize=(17, 6.5))
+    fig.subplots_adjust(left=0.0, right=0.93, wspace=0.0, top=0.93, bottom=0.08)
+    for k, (title, elev, azim) in enumerate(MODEL_PANELS):
+        ax = fig.add_subplot(1, 3, k + 1, projection="3d", computed_zorder=False)
+        ax.add_collection3d(Poly3DCollection(_to_plot(tris), facecolors=colours, linewidths=0, shade=True,
+                                             lightsource=matplotlib.colors.LightSource(45, 45), zorder=1))
+        ax.add_collection3d(Line3DCollection(_to_plot(fibres), colors=fibre_colours, linewidths=2.0, zorder=3))
+        ax.add_collection3d(Line3DCollection(_to_plot(membrane), colors=LIGAMENT_COLOURS["RSC"], linewidths=1.0, zorder=3))
         ax.view_init(elev=elev, azim=azim - 90)
-        _frame(ax, model.vertices[model.vertices[:, 1] < 14.0], title)
-    handles = [plt.Line2D([], [], color=LIGAMENT_COLOURS[n], lw=2, label=n) for n in LIGAMENT_NAMES]
+        _frame(ax, tris.reshape(-1, 3), title)
+    handles = [plt.Line2D([], [], color=LIGAMENT_COLOURS[n], lw=2, label=n + (" (membrane)" if n == "RSC" else ""))
+               for n in LIGAMENT_NAMES]
     fig.legend(handles=handles, loc="lower center", ncol=11, frameon=False)
     sm = plt.cm.ScalarMappable(norm=norm, cmap=cmap)
-    fig.colorbar(sm, ax=fig.axes, shrink=0.5, label="cartilage thickness (mm)", location="right")
-    fig.suptitle(f"{name}: bones, cartilage thickness, ligament fibres and the RSC membrane (RCS, neutral pose)")
+    fig.colorbar(sm, ax=fig.axes, shrink=0.45, label="cartilage thickness (mm)", location="right")
+    fig.suptitle(f"{name}: bones, cartilage coloured by thickness, ligament fibres (drawn on top) "
+                 "and the RSC membrane; RCS, neutral pose")
     out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(out, dpi=110)
     plt.close(fig)

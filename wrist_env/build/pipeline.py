@@ -8,6 +8,7 @@ membrane → contact law → signed-distance grids and contact samples → mass.
 from __future__ import annotations
 
 import hashlib
+import os
 import json
 import time
 from dataclasses import asdict, dataclass
@@ -25,6 +26,7 @@ from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model, offsets
 
 BUILDER_VERSION = 1
 GRID_BONES = ("radius", "scaphoid", "lunate", "capitate")
+MIN_SITE_VERTICES = 8
 
 
 @dataclass(frozen=True)
@@ -55,28 +57,56 @@ def source_hash(name: str, bones: dict, params: BuildParams) -> str:
     return h.hexdigest()[:16]
 
 
-def _morph_all(bones: dict, seed: int) -> tuple[dict, dict]:
+def _morph_one(args):
+    tv, tf, pv, pf, seed = args
+    return morph.morph(tv, tf, pv, pf, seed=seed)
+
+
+def _morph_all(bones: dict, seed: int, workers: int) -> tuple[dict, dict]:
+    """Morph every template bone onto the participant's, largest first, on `workers` processes."""
     template = load_template().bones
-    results, report = {}, {}
-    for bone in BONES:
-        t, p = template[bone], bones[bone]
-        results[bone] = morph.morph(t.vertices, t.faces, p.vertices, p.faces, seed=seed)
-        report[bone] = {"mean": round(results[bone].error_mean_mm, 4), "max": round(results[bone].error_max_mm, 4)}
+    order = sorted(BONES, key=lambda b: -len(template[b].vertices))
+    jobs = [(template[b].vertices, template[b].faces, bones[b].vertices, bones[b].faces, seed) for b in order]
+    if workers > 1:
+        from concurrent.futures import ProcessPoolExecutor
+
+        with ProcessPoolExecutor(max_workers=workers) as pool:
+            done = list(pool.map(_morph_one, jobs))
+    else:
+        done = [_morph_one(j) for j in jobs]
+    results = dict(zip(order, done))
+    report = {b: {"mean": round(results[b].error_mean_mm, 4), "max": round(results[b].error_max_mm, 4)} for b in BONES}
     return results, report
 
 
-def _transfer(morphs: dict, bones: dict) -> tuple[dict, dict]:
-    """Coverage and ligament site masks on the participant's bones."""
+def _transfer(morphs: dict, bones: dict) -> tuple[dict, dict, list]:
+    """Coverage and ligament site masks on the participant's bones, and the sites relocated.
+
+    A site whose morphed patch finds too few participant vertices (a bone mesh
+    cut shorter than the template's) is placed on the participant vertices
+    nearest the morphed patch instead.
+    """
     ann = template_annotations()
     coverage = {}
     for art, (a, b, ma, mb) in ann.coverage.items():
         coverage[art] = (a, b,
                          morph.transfer_mask(morphs[a], ma, bones[a].vertices) & bones[a].solid,
                          morph.transfer_mask(morphs[b], mb, bones[b].vertices) & bones[b].solid)
-    sites = {}
+    sites, relocated = {}, []
     for lig, (o, i) in ann.sites.items():
-        sites[lig] = tuple((s.bone, morph.transfer_mask(morphs[s.bone], s.mask, bones[s.bone].vertices)) for s in (o, i))
-    return coverage, sites
+        pair = []
+        for site in (o, i):
+            target = bones[site.bone].vertices
+            mask = morph.transfer_mask(morphs[site.bone], site.mask, target)
+            if mask.sum() < MIN_SITE_VERTICES:
+                patch = morphs[site.bone].vertices[site.mask]
+                _, nearest = cKDTree(target).query(patch)
+                mask = np.zeros(len(target), bool)
+                mask[nearest] = True
+                relocated.append(f"{lig}@{site.bone}")
+            pair.append((site.bone, mask))
+        sites[lig] = tuple(pair)
+    return coverage, sites, relocated
 
 
 def _ligaments(bones: dict, sites: dict, params: BuildParams):
@@ -140,9 +170,32 @@ def _contact_samples(bones, thickness, coverage, params):
     return displaced, np.vstack(pts), np.vstack(nrm), np.concatenate(area), np.concatenate(h), offsets(sizes)
 
 
-def build_model(name: str, bones: dict, params: BuildParams | None = None) -> Model:
-    """Build the participant model from its bones (name -> BoneSurface, RCS mm, neutral pose)."""
+def _seat_samples(points, normals, sample_offsets, grids):
+    """Remove what overclosure the grids still see in the neutral pose (interpolation of
+    curved surfaces): each sample inside the opposing grid moves back along its normal.
+
+    Returns the points and the largest correction (mm).
+    """
+    points = points.copy()
+    worst = 0.0
+    for p in range(len(PAIRS)):
+        grid = grids[BONES[PAIR_BONES[p][1]]]
+        sl = slice(sample_offsets[p], sample_offsets[p + 1])
+        for _ in range(3):
+            d, _ = sdf.trilinear(grid, points[sl])
+            inside = np.minimum(d, 0.0)
+            worst = max(worst, float(-inside.min()))
+            points[sl] += inside[:, None] * normals[sl]
+    return points, worst
+
+
+def build_model(name: str, bones: dict, params: BuildParams | None = None, *, workers: int | None = None) -> Model:
+    """Build the participant model from its bones (name -> BoneSurface, RCS mm, neutral pose).
+
+    workers: processes for the morphs (default: the machine's cores, at most 2).
+    """
     params = params or BuildParams()
+    workers = min(2, os.cpu_count() or 1) if workers is None else workers
     missing = [b for b in BONES if b not in bones]
     if missing:
         raise BuildError(f"participant {name!r} lacks bones {missing}")
@@ -155,9 +208,9 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None) -> Mo
         timings[step] = round(now - clock, 3)
         clock = now
 
-    morphs, morph_report = _morph_all(bones, params.seed)
+    morphs, morph_report = _morph_all(bones, params.seed, workers)
     lap("morph")
-    coverage, sites = _transfer(morphs, bones)
+    coverage, sites, relocated = _transfer(morphs, bones)
     articulations = {(a, b): (ma, mb) for (a, b, ma, mb) in coverage.values()}
     verts = {b: bones[b].vertices for b in BONES}
     faces = {b: bones[b].faces for b in BONES}
@@ -174,6 +227,7 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None) -> Mo
     for b in GRID_BONES:
         f = bones[b].faces[bones[b].solid[bones[b].faces].all(axis=1)]
         grids[b] = sdf.signed_distance_grid(displaced[b], f, spacing_mm=params.grid_spacing_mm, margin_mm=params.grid_margin_mm)
+    s_pts, seated = _seat_samples(s_pts, s_nrm, s_off, grids)
     lap("grids")
     masses = [mass.mass_properties(*_solid(bones[b])) if bones[b].solid.any() else (0.0, np.zeros(3), np.zeros((3, 3))) for b in BONES]
     lap("mass")
@@ -183,7 +237,7 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None) -> Mo
     ref_len = np.array([next((bd.reference_length_mm for k2, _, _, bd in bundles if k2 == k), np.nan) for k in range(len(LIGAMENTS))])
     rsc = LIGAMENT_NAMES.index("RSC")
     along = membrane.connector_kind == 0
-    ref_len[rsc] = float(np.mean(membrane.reference_length_mm[along]))
+    ref_len[rsc] = float(np.sum(membrane.reference_length_mm[along]) / membrane.shape[1])  # mean chain length
     membrane_bone = np.full(len(membrane.nodes), -1, np.int64)
     membrane_bone[membrane.radius_nodes] = BONES.index("radius")
     membrane_bone[membrane.capitate_nodes] = BONES.index("capitate")
@@ -196,7 +250,10 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None) -> Mo
         "fibres": {LIGAMENTS[k].name: int(len(bd.origin)) for k, _, _, bd in bundles} | {"RSC": int(len(membrane.connectors))},
         "reference_length_mm": {n: round(float(x), 3) for n, x in zip(LIGAMENT_NAMES, ref_len)},
         "contact_law_r2": round(float(law.r2), 5),
+        "sites_relocated": relocated,
+        **_articulation_summary(cart_report["cartilage"]["articulations"]),
         "contact_samples": {p: int(s_off[i + 1] - s_off[i]) for i, p in enumerate(PAIRS)},
+        "contact_seating_mm": round(seated, 4),
         **cart_report,
     }
     return Model(
@@ -233,6 +290,19 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None) -> Mo
         membrane_length=membrane.reference_length_mm,
         report=report,
     )
+
+
+def _articulation_summary(articulations: dict) -> dict:
+    """Per articulation (`PAIRS` names): cartilage thickness over both layers and the joint space (mm)."""
+    names = dict(zip(("radius-scaphoid", "radius-lunate", "scaphoid-lunate", "scaphoid-capitate", "lunate-capitate"), PAIRS))
+    thickness, space, overclosure = {}, {}, {}
+    for key, art in articulations.items():
+        sides = [v for v in art["thickness_mm"].values() if v]
+        thickness[names[key]] = {"min": min(v["min"] for v in sides), "mean": round(float(np.mean([v["mean"] for v in sides])), 4),
+                                 "max": max(v["max"] for v in sides)}
+        space[names[key]] = art["joint_space_mm"]
+        overclosure[names[key]] = art["overclosure_after_mm"]
+    return {"cartilage_thickness_mm": thickness, "joint_space_mm": space, "overclosure_mm": overclosure}
 
 
 def _solid(bone):

@@ -1,0 +1,33 @@
+"""Shared fixtures: a hermetic model cache and the built-in participants, built once per session."""
+
+import os
+
+import pytest
+
+
+@pytest.fixture(scope="session", autouse=True)
+def model_cache(tmp_path_factory):
+    """Every test session builds into its own cache (so the build itself is tested)."""
+    path = tmp_path_factory.mktemp("wrist_env_cache")
+    old = os.environ.get("WRIST_ENV_CACHE")
+    os.environ["WRIST_ENV_CACHE"] = str(path)
+    yield path
+    if old is None:
+        os.environ.pop("WRIST_ENV_CACHE", None)
+    else:
+        os.environ["WRIST_ENV_CACHE"] = old
+
+
+@pytest.fixture(scope="session")
+def built(model_cache):
+    """Models of P1–P3 (built on first use, then read from the session cache)."""
+    from wrist_env.participants.registry import load_model
+
+    cache = {}
+
+    def get(name):
+        if name not in cache:
+            cache[name] = load_model(name)
+        return cache[name]
+
+    return get

@@ -1,0 +1,51 @@
+"""A user's participant folder becomes a participant that builds like the built-in ones."""
+
+import numpy as np
+import pytest
+import trimesh
+
+from wrist_env.anatomy.template import load_template
+from wrist_env.build.warp import random_warp
+from wrist_env.design import LIGAMENTS
+from wrist_env.errors import ParticipantError
+from wrist_env.participants import registry
+from wrist_env.participants.folder import ParticipantSource, write_participant_folder
+from wrist_env.trial import Trial
+
+
+def warped_template_folder(path, name="U1", seed=7):
+    """A folder made from the template under a warp, with closed forearm bones as a CT
+    segmentation would give: the radius as its articular solid plus the hull of its
+    shaft, the ulna as the hull of its distal end."""
+    warp = random_warp(seed, amplitude_mm=0.7, width_mm=15.0, extent_mm=25.0)
+    bones = {}
+    for bone, surface in load_template().bones.items():
+        mesh = surface.trimesh(solid_only=bone == "radius")
+        if bone == "radius":
+            shaft = trimesh.Trimesh(surface.vertices[~surface.solid]).convex_hull.subdivide_to_size(max_edge=2.0)
+            mesh = trimesh.util.concatenate([mesh, shaft])
+        if bone == "ulna":
+            mesh = mesh.convex_hull.subdivide_to_size(max_edge=2.0)
+        bones[bone] = (warp.apply(mesh.vertices), np.asarray(mesh.faces))
+    transforms = np.tile(np.eye(4), (3, 2, 1, 1))
+    trial = Trial("unresisted", "calibrate", ("scaphoid", "lunate", "capitate"), transforms)
+    source = ParticipantSource(name, {"side": "right", "sex": "female", "age": 30}, bones, {"unresisted": trial}, path)
+    return write_participant_folder(source, path)
+
+
+def test_a_registered_folder_builds_a_model(tmp_path):
+    folder = warped_template_folder(tmp_path / "u1")
+    name = registry.add_folder(folder)
+    assert name == "U1" and "U1" in registry.participants()
+    model = registry.load_model("U1")
+    counts = np.bincount(model.fibre_ligament, minlength=len(LIGAMENTS))
+    assert [int(c) for c in counts] == [lig.fibres for lig in LIGAMENTS]
+    for art, gap in model.report["joint_space_mm"].items():
+        assert 0.5 <= gap <= 2.5, art
+    assert model.report["morph_error_mm"]["scaphoid"]["mean"] < 0.1
+
+
+def test_a_folder_cannot_take_a_builtin_name(tmp_path):
+    folder = warped_template_folder(tmp_path / "p1", name="P1")
+    with pytest.raises(ParticipantError, match=r"participant.toml.*'P1' is taken"):
+        registry.add_folder(folder)
