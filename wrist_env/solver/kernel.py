@@ -197,6 +197,7 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
         for b in range(N_BONES):
             poses[f, b, :3, :3] = R[b]
             poses[f, b, :3, 3] = x[b] - R[b] @ com0[b]
+            poses[f, b, 3, :3] = 0.0
             poses[f, b, 3, 3] = 1.0
         for p in range(stats.shape[0]):
             area = stats[p, C_AREA]
