@@ -1,0 +1,96 @@
+"""The solver on a real participant: plausible, robust, converged, batch-consistent."""
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from wrist_env import design
+from wrist_env.model import BONES, PAIRS
+from wrist_env.participants.builtin import truth
+from wrist_env.solver.arrays import SolverSettings
+from wrist_env.solver.simulate import experimental, idealized, simulate, simulate_batch
+
+SCAPHOID, LUNATE, CAPITATE = (BONES.index(b) for b in ("scaphoid", "lunate", "capitate"))
+
+
+def flexion_deg(poses):
+    """Flexion (+) about the RCS z axis, the first angle of the Cardan Z-X-Y decomposition (SciPy)."""
+    return Rotation.from_matrix(poses[:, :3, :3]).as_euler("ZXY", degrees=True)[:, 0]
+
+
+@pytest.fixture(scope="module")
+def p1(built):
+    return built("P1")
+
+
+@pytest.fixture(scope="module")
+def sweep(p1):
+    return simulate(p1, design.population(), idealized(p1))
+
+
+def test_population_sweep_is_plausible(sweep):
+    assert sweep.ok, sweep.message
+    capitate = flexion_deg(sweep.poses[:, CAPITATE])
+    np.testing.assert_allclose(capitate, sweep.angle_deg, atol=1e-6)
+    moving = np.abs(capitate) >= 10
+    for bone in (SCAPHOID, LUNATE):
+        angle = flexion_deg(sweep.poses[:, bone])
+        assert np.all(np.sign(angle[moving]) == np.sign(capitate[moving])), (BONES[bone], angle.round(1))
+        assert np.all(np.abs(angle[moving]) < np.abs(capitate[moving]))
+    radioscaphoid = sweep.contact[:, PAIRS.index("radioscaphoid"), 0]
+    assert np.all((radioscaphoid > 0.1) & (radioscaphoid < 10.0)), radioscaphoid.round(2)
+
+
+def test_sweep_is_quasi_static(sweep):
+    kinetic, internal = sweep.energy[:, 0], sweep.energy[:, 1]
+    assert kinetic.sum() < 0.05 * internal.sum()
+    loaded = internal > 1.0  # N·mm; near neutral the population wrist is almost unloaded
+    assert np.all(kinetic[loaded] < 0.05 * internal[loaded])
+
+
+def test_halving_the_time_step_changes_little(p1, sweep):
+    finer = simulate(p1, design.population(), idealized(p1), SolverSettings().halved())
+    for bone in (SCAPHOID, LUNATE):
+        a, b = sweep.poses[:, bone], finer.poses[:, bone]
+        com = p1.com[bone]
+        shift = np.linalg.norm(np.einsum("fij,j->fi", a[:, :3, :3] - b[:, :3, :3], com) + a[:, :3, 3] - b[:, :3, 3], axis=1)
+        turn = np.degrees(np.linalg.norm(Rotation.from_matrix(np.einsum("fji,fjk->fik", a[:, :3, :3], b[:, :3, :3])).as_rotvec(), axis=1))
+        assert shift.max() < 0.1 and turn.max() < 0.5, (BONES[bone], shift.max(), turn.max())
+
+
+def test_settling_reaches_equilibrium(p1):
+    """Capitate held at its static pose: the net force and moment on each free bone are
+    below 1 % of the largest ligament force (moment over a 10 mm lever)."""
+    held = experimental(p1, np.tile(np.eye(4), (3, 1, 1)))
+    result = simulate(p1, truth("P1"), held)
+    assert result.ok
+    largest = result.bundle_force[-1].max()
+    assert largest > 1.0
+    force, moment = result.residual[-1]
+    assert force < 0.01 * largest and moment < 0.01 * largest * 10.0, (force, moment, largest)
+
+
+def test_batch_equals_one_at_a_time(p1):
+    rng = np.random.default_rng(3)
+    designs = [design.from_action(rng.uniform(-0.5, 0.5, 27)) for _ in range(4)]
+    batch = simulate_batch(p1, designs, idealized(p1, n_frames=5))
+    for d, b in zip(designs, batch):
+        one = simulate(p1, d, idealized(p1, n_frames=5))
+        assert one.status == b.status
+        np.testing.assert_array_equal(one.poses, b.poses)
+        np.testing.assert_array_equal(one.contact, b.contact)
+
+
+def test_random_designs_across_the_bounds_never_raise(p1):
+    """Designs across the full bounds, tears included: no exception, no NaN in a run
+    reported ok, every failure flagged with NaN outputs and a message."""
+    rng = np.random.default_rng(11)
+    designs = [design.from_action(a) for a in rng.uniform(-1, 1, (120, 27))]
+    results = simulate_batch(p1, designs, idealized(p1, n_frames=9))
+    assert any(d.torn.any() for d in designs)
+    for r in results:
+        if r.ok:
+            assert np.all(np.isfinite(r.poses)) and np.all(np.isfinite(r.contact))
+        else:
+            assert r.message.startswith("failed") and np.all(np.isnan(r.poses))
+    assert sum(r.ok for r in results) > 0.7 * len(results)
