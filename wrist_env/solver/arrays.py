@@ -20,7 +20,7 @@ Fibres = namedtuple("Fibres", "bones origin insertion ligament rest_length")
 Membrane = namedtuple("Membrane", "connectors kind first_row bone rest scaphoid grid_values grid_offset grid_shape grid_origin grid_spacing rest_length")
 Settings = namedtuple(
     "Settings",
-    "dt settle_steps move_steps frame_steps hold_fraction damping rot_damping fibre_damping_s "
+    "dt settle_steps move_steps ramp_steps min_hold_steps max_hold_steps tolerance force_floor damping rot_damping fibre_damping_s "
     "active_band_mm rebuild_every node_mass membrane_contact_stiffness driver load max_disp_mm max_rot_rad fire_alpha0",
 )
 
@@ -32,19 +32,25 @@ EXPERIMENTAL, IDEALIZED = 0, 1
 class SolverSettings:
     """Explicit-integration settings (s, mm, N, t).
 
-    dt_s: time step. settle_steps, move_steps, frame_steps: steps to settle,
-    to move the capitate to the first pose, and per motion frame; the capitate
-    moves during the first (1 − hold_fraction) of a frame's steps and holds
-    for the rest. damping_per_s: mass-proportional damping of translations
-    and rotations. mass_scale, inertia_scale: mass scaling of the free bones
-    (inertia_scale multiplies rotational inertia on top of mass_scale).
+    dt_s: time step. Each stage ramps the capitate (move_steps to the first
+    pose, ramp_steps between frames), then holds it until the free bodies
+    are in equilibrium: net force at most max(force_floor_n, tolerance ×
+    the largest bundle force) and net moment at most that × 10 mm, after at
+    least min_hold_steps and at most max_hold_steps (settling: at most
+    settle_steps). damping_per_s: mass-proportional damping of translations
+    and rotations; fire_alpha0: FIRE mixing (0 turns FIRE off).
+    mass_scale, inertia_scale: mass scaling of the free bones (inertia_scale
+    multiplies rotational inertia on top of mass_scale).
     """
 
     dt_s: float = 6e-5
-    settle_steps: int = 600
-    move_steps: int = 300
-    frame_steps: int = 120
-    hold_fraction: float = 0.4
+    settle_steps: int = 800
+    move_steps: int = 200
+    ramp_steps: int = 60
+    min_hold_steps: int = 10
+    max_hold_steps: int = 400
+    tolerance: float = 0.005
+    force_floor_n: float = 0.05
     damping_per_s: float = 100.0
     rot_damping_per_s: float = 100.0
     fibre_damping_s: float = 2e-4
@@ -63,8 +69,9 @@ class SolverSettings:
         """The same run with half the time step (twice the steps)."""
         from dataclasses import replace
 
-        return replace(self, dt_s=self.dt_s / 2, settle_steps=2 * self.settle_steps,
-                       move_steps=2 * self.move_steps, frame_steps=2 * self.frame_steps)
+        return replace(self, dt_s=self.dt_s / 2, settle_steps=2 * self.settle_steps, move_steps=2 * self.move_steps,
+                       ramp_steps=2 * self.ramp_steps, min_hold_steps=2 * self.min_hold_steps,
+                       max_hold_steps=2 * self.max_hold_steps)
 
 
 def bodies(model: Model, s: SolverSettings) -> Bodies:
@@ -96,7 +103,7 @@ def fibres(model: Model) -> Fibres:
                   np.ascontiguousarray(model.fibre_insertion), np.ascontiguousarray(model.fibre_ligament), rest)
 
 
-def membrane(model: Model) -> Membrane:
+def membrane(model: Model, grd: Grids) -> Membrane:
     s = BONES.index("scaphoid")
     conn = np.ascontiguousarray(model.membrane_connectors)
     radius = BONES.index("radius")
@@ -104,7 +111,7 @@ def membrane(model: Model) -> Membrane:
     return Membrane(
         conn, np.ascontiguousarray(model.membrane_kind), first_row & (model.membrane_kind == 0),
         np.ascontiguousarray(model.membrane_bone), np.ascontiguousarray(model.membrane_nodes), s,
-        np.ascontiguousarray(model.grid_values, dtype=np.float32), int(model.grid_offsets[s]),
+        grd.values, int(grd.offsets[s]),
         np.ascontiguousarray(model.grid_shape[s]), np.ascontiguousarray(model.grid_origin[s]),
         float(model.grid_spacing[s]), np.ascontiguousarray(model.membrane_length),
     )
@@ -139,7 +146,8 @@ def design_arrays(model: Model, fib: Fibres, mem: Membrane, design: Design):
 def settings_tuple(s: SolverSettings, driver: int) -> Settings:
     load = np.array([0.0, s.compressive_load_n if driver == IDEALIZED else 0.0, 0.0])
     return Settings(
-        float(s.dt_s), int(s.settle_steps), int(s.move_steps), int(s.frame_steps), float(s.hold_fraction),
+        float(s.dt_s), int(s.settle_steps), int(s.move_steps), int(s.ramp_steps), int(s.min_hold_steps),
+        int(s.max_hold_steps), float(s.tolerance), float(s.force_floor_n),
         float(s.damping_per_s), float(s.rot_damping_per_s), float(s.fibre_damping_s), float(s.active_band_mm),
         int(s.rebuild_every), float(s.node_mass_t), float(s.membrane_contact_stiffness), int(driver), load,
         float(s.max_disp_mm), float(np.radians(s.max_rot_deg)), float(s.fire_alpha0),

@@ -15,20 +15,24 @@ from numba import njit
 OUTSIDE_MM = 1e3  # distance reported outside a grid: no contact
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def sdf_lookup(values, offset, shape, origin, spacing, q):
     """Trilinear signed distance (mm) and its gradient (3,) at local point q (3,)."""
     d, gx, gy, gz = sdf_lookup_scalar(values, offset, shape, origin, spacing, q[0], q[1], q[2])
     return d, np.array([gx, gy, gz])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def sdf_lookup_scalar(values, offset, shape, origin, spacing, qx, qy, qz):
-    """Trilinear signed distance (mm) and gradient components at local point (qx, qy, qz)."""
+    """Trilinear signed distance (mm) and gradient components at local point (qx, qy, qz).
+
+    values: C-order grids (float32, mm) flattened; offset: the grid's first value.
+    """
     nx, ny, nz = shape[0], shape[1], shape[2]
-    fx = (qx - origin[0]) / spacing
-    fy = (qy - origin[1]) / spacing
-    fz = (qz - origin[2]) / spacing
+    inv = 1.0 / spacing
+    fx = (qx - origin[0]) * inv
+    fy = (qy - origin[1]) * inv
+    fz = (qz - origin[2]) * inv
     if fx < 0.0 or fy < 0.0 or fz < 0.0 or fx >= nx - 1 or fy >= ny - 1 or fz >= nz - 1:
         return OUTSIDE_MM, 0.0, 0.0, 0.0
     i = int(fx)
@@ -55,15 +59,15 @@ def sdf_lookup_scalar(values, offset, shape, origin, spacing, qx, qy, qz):
     c0 = c00 + (c01 - c00) * ty
     c1 = c10 + (c11 - c10) * ty
     d = c0 + (c1 - c0) * tx
-    gx = (c1 - c0) / spacing
-    gy = ((1 - tx) * (c01 - c00) + tx * (c11 - c10)) / spacing
+    gx = (c1 - c0) * inv
+    gy = ((1 - tx) * (c01 - c00) + tx * (c11 - c10)) * inv
     dz0 = (1 - ty) * (c001 - c000) + ty * (c011 - c010)
     dz1 = (1 - ty) * (c101 - c100) + ty * (c111 - c110)
-    gz = ((1 - tx) * dz0 + tx * dz1) / spacing
+    gz = ((1 - tx) * dz0 + tx * dz1) * inv
     return d, gx, gy, gz
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def law_pressure(law, e):
     """Pressure (MPa) of the tri-linear law [e1, e2, k1, k2, k3] at strain e."""
     if e <= 0.0:
@@ -76,7 +80,7 @@ def law_pressure(law, e):
     return k1 * e1 + k2 * (e2 - e1) + k3 * (e - e2)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def law_energy(law, e):
     """Strain energy density ∫ p de (MPa) of the law from 0 to strain e."""
     if e <= 0.0:

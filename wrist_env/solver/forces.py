@@ -22,7 +22,7 @@ from wrist_env.solver.ligaments import blankevoort_energy, blankevoort_force
 C_FORCE, C_AREA, C_PEAK = 0, 1, 2
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def to_world(R, x, com0, b, px, py, pz):
     """World position of neutral-pose point p of body b."""
     qx, qy, qz = px - com0[b, 0], py - com0[b, 1], pz - com0[b, 2]
@@ -31,7 +31,7 @@ def to_world(R, x, com0, b, px, py, pz):
             R[b, 2, 0] * qx + R[b, 2, 1] * qy + R[b, 2, 2] * qz + x[b, 2])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def to_local(R, x, com0, b, wx, wy, wz):
     """Neutral-pose coordinates in body b of world point w."""
     qx, qy, qz = wx - x[b, 0], wy - x[b, 1], wz - x[b, 2]
@@ -40,14 +40,14 @@ def to_local(R, x, com0, b, wx, wy, wz):
             R[b, 0, 2] * qx + R[b, 1, 2] * qy + R[b, 2, 2] * qz + com0[b, 2])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def rotate(R, b, gx, gy, gz):
     return (R[b, 0, 0] * gx + R[b, 0, 1] * gy + R[b, 0, 2] * gz,
             R[b, 1, 0] * gx + R[b, 1, 1] * gy + R[b, 1, 2] * gz,
             R[b, 2, 0] * gx + R[b, 2, 1] * gy + R[b, 2, 2] * gz)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy", inline="always")
 def apply_force(F, T, x, b, fx, fy, fz, px, py, pz):
     """Add force f applied at world point p to body b."""
     rx, ry, rz = px - x[b, 0], py - x[b, 1], pz - x[b, 2]
@@ -59,44 +59,85 @@ def apply_force(F, T, x, b, fx, fy, fz, px, py, pz):
     T[b, 2] += rx * fy - ry * fx
 
 
-@njit(cache=True, inline="always")
-def _sample(R, x, com0, grids, s, a, b):
+@njit(cache=True, error_model="numpy", inline="always")
+def pair_transform(R, x, com0, a, b):
+    """(M, t) as 12 scalars: neutral-pose point p of body a lies at M p + t in body b's neutral frame."""
+    m00 = R[b, 0, 0] * R[a, 0, 0] + R[b, 1, 0] * R[a, 1, 0] + R[b, 2, 0] * R[a, 2, 0]
+    m01 = R[b, 0, 0] * R[a, 0, 1] + R[b, 1, 0] * R[a, 1, 1] + R[b, 2, 0] * R[a, 2, 1]
+    m02 = R[b, 0, 0] * R[a, 0, 2] + R[b, 1, 0] * R[a, 1, 2] + R[b, 2, 0] * R[a, 2, 2]
+    m10 = R[b, 0, 1] * R[a, 0, 0] + R[b, 1, 1] * R[a, 1, 0] + R[b, 2, 1] * R[a, 2, 0]
+    m11 = R[b, 0, 1] * R[a, 0, 1] + R[b, 1, 1] * R[a, 1, 1] + R[b, 2, 1] * R[a, 2, 1]
+    m12 = R[b, 0, 1] * R[a, 0, 2] + R[b, 1, 1] * R[a, 1, 2] + R[b, 2, 1] * R[a, 2, 2]
+    m20 = R[b, 0, 2] * R[a, 0, 0] + R[b, 1, 2] * R[a, 1, 0] + R[b, 2, 2] * R[a, 2, 0]
+    m21 = R[b, 0, 2] * R[a, 0, 1] + R[b, 1, 2] * R[a, 1, 1] + R[b, 2, 2] * R[a, 2, 1]
+    m22 = R[b, 0, 2] * R[a, 0, 2] + R[b, 1, 2] * R[a, 1, 2] + R[b, 2, 2] * R[a, 2, 2]
+    # t = com0_b + R_bᵀ (x_a − x_b) − M com0_a
+    tx, ty, tz = to_local(R, x, com0, b, x[a, 0], x[a, 1], x[a, 2])
+    cx, cy, cz = com0[a, 0], com0[a, 1], com0[a, 2]
+    tx -= m00 * cx + m01 * cy + m02 * cz
+    ty -= m10 * cx + m11 * cy + m12 * cz
+    tz -= m20 * cx + m21 * cy + m22 * cz
+    return m00, m01, m02, m10, m11, m12, m20, m21, m22, tx, ty, tz
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _lookup(grids, b, M, s):
+    """Signed distance (mm), gradient and position (b's neutral frame) of sample s under the pair transform M."""
+    m00, m01, m02, m10, m11, m12, m20, m21, m22, tx, ty, tz = M
     p = grids.points
-    wx, wy, wz = to_world(R, x, com0, a, p[s, 0], p[s, 1], p[s, 2])
-    qx, qy, qz = to_local(R, x, com0, b, wx, wy, wz)
+    px, py, pz = p[s, 0], p[s, 1], p[s, 2]
+    qx = m00 * px + m01 * py + m02 * pz + tx
+    qy = m10 * px + m11 * py + m12 * pz + ty
+    qz = m20 * px + m21 * py + m22 * pz + tz
     d, gx, gy, gz = sdf_lookup_scalar(grids.values, grids.offsets[b], grids.shape[b], grids.origin[b], grids.spacing[b], qx, qy, qz)
-    return d, gx, gy, gz, wx, wy, wz
+    return d, gx, gy, gz, qx, qy, qz
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rebuild_active(R, x, com0, grids, band_mm, active, n_active):
     """Refill `active` with the samples of each pair within `band_mm` of contact."""
     for p in range(grids.pair_bones.shape[0]):
         a, b = grids.pair_bones[p, 0], grids.pair_bones[p, 1]
+        M = pair_transform(R, x, com0, a, b)
         n = 0
         start = grids.sample_offsets[p]
         for s in range(start, grids.sample_offsets[p + 1]):
-            d = _sample(R, x, com0, grids, s, a, b)[0]
-            if d < band_mm:
+            if _lookup(grids, b, M, s)[0] < band_mm:
                 active[start + n] = s
                 n += 1
         n_active[p] = n
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
+def sample_pressures(R, x, com0, grids, law, pressure):
+    """Contact pressure (MPa) of every sample (pressure, shape (n_samples,)) at the state (R, x)."""
+    for p in range(grids.pair_bones.shape[0]):
+        a, b = grids.pair_bones[p, 0], grids.pair_bones[p, 1]
+        M = pair_transform(R, x, com0, a, b)
+        for s in range(grids.sample_offsets[p], grids.sample_offsets[p + 1]):
+            d = _lookup(grids, b, M, s)[0]
+            pressure[s] = law_pressure(law, -d / grids.thickness[s]) if d < 0.0 else 0.0
+
+
+@njit(cache=True, error_model="numpy")
 def contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats):
     """Contact forces of all pairs' active samples; returns contact energy (N·mm).
 
-    stats (n_pairs, 3) receives per pair: force (N), contacting area (mm²), peak pressure (MPa).
+    Each pair's forces and moments are summed in the grid bone's neutral frame
+    and applied to both bodies once. stats (n_pairs, 3) receives per pair:
+    force (N), contacting area (mm²), peak pressure (MPa).
     """
     energy = 0.0
     stats[:] = 0.0
     for p in range(grids.pair_bones.shape[0]):
         a, b = grids.pair_bones[p, 0], grids.pair_bones[p, 1]
+        M = pair_transform(R, x, com0, a, b)
         start = grids.sample_offsets[p]
+        fx = fy = fz = mx = my = mz = 0.0
+        force = area_sum = peak = 0.0
         for j in range(n_active[p]):
             s = active[start + j]
-            d, gx, gy, gz, wx, wy, wz = _sample(R, x, com0, grids, s, a, b)
+            d, gx, gy, gz, qx, qy, qz = _lookup(grids, b, M, s)
             if d >= 0.0:
                 continue
             gn = np.sqrt(gx * gx + gy * gy + gz * gz)
@@ -107,18 +148,47 @@ def contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats):
             pressure = law_pressure(law, strain)
             area = grids.area[s]
             scale = pressure * area / gn
-            fx, fy, fz = rotate(R, b, gx * scale, gy * scale, gz * scale)
-            apply_force(F, T, x, a, fx, fy, fz, wx, wy, wz)
-            apply_force(F, T, x, b, -fx, -fy, -fz, wx, wy, wz)
+            sx, sy, sz = gx * scale, gy * scale, gz * scale
+            fx += sx
+            fy += sy
+            fz += sz
+            mx += qy * sz - qz * sy
+            my += qz * sx - qx * sz
+            mz += qx * sy - qy * sx
             energy += area * h * law_energy(law, strain)
-            stats[p, C_FORCE] += pressure * area
-            stats[p, C_AREA] += area
-            if pressure > stats[p, C_PEAK]:
-                stats[p, C_PEAK] = pressure
+            force += pressure * area
+            area_sum += area
+            if pressure > peak:
+                peak = pressure
+        stats[p, C_FORCE] = force
+        stats[p, C_AREA] = area_sum
+        stats[p, C_PEAK] = peak
+        if area_sum == 0.0:
+            continue
+        # moment about b's centre of mass, then both to world
+        cx, cy, cz = com0[b, 0], com0[b, 1], com0[b, 2]
+        mx -= cy * fz - cz * fy
+        my -= cz * fx - cx * fz
+        mz -= cx * fy - cy * fx
+        Fx, Fy, Fz = rotate(R, b, fx, fy, fz)
+        Mx, My, Mz = rotate(R, b, mx, my, mz)
+        rx, ry, rz = x[b, 0] - x[a, 0], x[b, 1] - x[a, 1], x[b, 2] - x[a, 2]
+        F[a, 0] += Fx
+        F[a, 1] += Fy
+        F[a, 2] += Fz
+        T[a, 0] += Mx + ry * Fz - rz * Fy
+        T[a, 1] += My + rz * Fx - rx * Fz
+        T[a, 2] += Mz + rx * Fy - ry * Fx
+        F[b, 0] -= Fx
+        F[b, 1] -= Fy
+        F[b, 2] -= Fz
+        T[b, 0] -= Mx
+        T[b, 1] -= My
+        T[b, 2] -= Mz
     return energy
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def fibre_forces(R, x, v, w, com0, fibres, l0, K, damping_s, F, T, bundle_force):
     """Blankevoort fibre forces; returns strain energy (N·mm).
 
@@ -159,7 +229,7 @@ def fibre_forces(R, x, v, w, com0, fibres, l0, K, damping_s, F, T, bundle_force)
     return energy
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def place_nodes(R, x, com0, mem, nodes):
     """Move the membrane nodes attached to a bone with it."""
     for i in range(nodes.shape[0]):
@@ -168,7 +238,7 @@ def place_nodes(R, x, com0, mem, nodes):
             nodes[i, 0], nodes[i, 1], nodes[i, 2] = to_world(R, x, com0, b, mem.rest[i, 0], mem.rest[i, 1], mem.rest[i, 2])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node_force):
     """RSC membrane: connector tension and node–scaphoid contact.
 

@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit, prange
 
 from wrist_env.solver.forces import C_AREA, C_FORCE, C_PEAK, contact_forces, fibre_forces, membrane_forces, place_nodes, rebuild_active
-from wrist_env.solver.rigid import interpolate_pose, matrix_to_rotvec, orthonormalize, rotvec_to_matrix, smoothstep
+from wrist_env.solver.rigid import interpolate_pose, matrix_to_rotvec, orthonormalize, rotate_in_place, smoothstep
 
 SCAPHOID, LUNATE, CAPITATE = 2, 3, 4
 N_BONES, N_PAIRS, N_LIGAMENTS = 5, 5, 11
@@ -21,37 +21,45 @@ OK, FAILED_NAN, FAILED_DIVERGED = 0, 1, 2
 
 
 FIRE_F_ALPHA, FIRE_N_MIN = 0.99, 5
+LEVER_MM = 10.0  # moment tolerance = force tolerance × this lever
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy", inline="always")
 def _mix(vel, force, a):
-    """FIRE mixing of one velocity group towards its force direction."""
-    vn = np.sqrt(np.sum(vel * vel))
-    fn = np.sqrt(np.sum(force * force))
+    """FIRE mixing of one velocity group (rows of `vel`) towards its force direction."""
+    vn = 0.0
+    fn = 0.0
+    for i in range(vel.shape[0]):
+        for k in range(3):
+            vn += vel[i, k] * vel[i, k]
+            fn += force[i, k] * force[i, k]
     if fn > 0.0:
-        vel[:] = (1.0 - a) * vel + (a * vn / fn) * force
+        c = a * np.sqrt(vn / fn)
+        for i in range(vel.shape[0]):
+            for k in range(3):
+                vel[i, k] = (1.0 - a) * vel[i, k] + c * force[i, k]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _fire(v, w, nv, F, T, node_force, mem, st, fire):
     """FIRE relaxation (Bitzek et al. 2006) at a fixed step: mix velocities towards the
     forces while the power is positive, stop everything when it turns negative.
     fire = [alpha, steps with positive power]."""
     power = 0.0
-    for b in (SCAPHOID, LUNATE):
-        power += np.dot(F[b], v[b]) + np.dot(T[b], w[b])
-    if st.driver == 1:
-        power += np.dot(F[CAPITATE], v[CAPITATE])
-    for i in range(nv.shape[0]):
-        if mem.bone[i] < 0:
-            power += np.dot(node_force[i], nv[i])
+    for k in range(3):
+        for b in (SCAPHOID, LUNATE):
+            power += F[b, k] * v[b, k] + T[b, k] * w[b, k]
+        if st.driver == 1:
+            power += F[CAPITATE, k] * v[CAPITATE, k]
+        for i in range(nv.shape[0]):
+            power += node_force[i, k] * nv[i, k]
     if power > 0.0:
         a = fire[0]
         for b in (SCAPHOID, LUNATE):
-            _mix(v[b], F[b], a)
-            _mix(w[b], T[b], a)
+            _mix(v[b:b + 1], F[b:b + 1], a)
+            _mix(w[b:b + 1], T[b:b + 1], a)
         if st.driver == 1:
-            _mix(v[CAPITATE], F[CAPITATE], a)
+            _mix(v[CAPITATE:CAPITATE + 1], F[CAPITATE:CAPITATE + 1], a)
         _mix(nv, node_force, a)
         fire[1] += 1.0
         if fire[1] > FIRE_N_MIN:
@@ -64,14 +72,14 @@ def _fire(v, w, nv, F, T, node_force, mem, st, fire):
         fire[1] = 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _step(R, x, v, w, nodes, nv, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st,
           active, n_active, F, T, node_force, stats, bundle, capR, capx, step_index, fire):
     """One explicit step with the capitate at target (capR, capx); returns internal energy (N·mm)."""
     com0 = bod.com0
     R[CAPITATE] = capR
     if st.driver == 0:
-        x[CAPITATE] = capx
+        x[CAPITATE, 0], x[CAPITATE, 1], x[CAPITATE, 2] = capx
         v[CAPITATE] = 0.0
     w[CAPITATE] = 0.0
     if step_index % st.rebuild_every == 0:
@@ -93,26 +101,59 @@ def _step(R, x, v, w, nodes, nv, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K
     lin = 1.0 / (1.0 + st.damping * dt)
     rot = 1.0 / (1.0 + st.rot_damping * dt)
     for b in (SCAPHOID, LUNATE):
-        v[b] = (v[b] + dt * bod.inv_mass[b] * F[b]) * lin
-        x[b] += dt * v[b]
-        Iinv = R[b] @ bod.inv_inertia[b] @ R[b].T
-        w[b] = (w[b] + dt * (Iinv @ T[b])) * rot
-        R[b] = rotvec_to_matrix(w[b] * dt) @ R[b]
+        for k in range(3):
+            v[b, k] = (v[b, k] + dt * bod.inv_mass[b] * F[b, k]) * lin
+            x[b, k] += dt * v[b, k]
+        # angular acceleration R I⁻¹ Rᵀ T, world frame
+        Rb, J = R[b], bod.inv_inertia[b]
+        u0 = Rb[0, 0] * T[b, 0] + Rb[1, 0] * T[b, 1] + Rb[2, 0] * T[b, 2]
+        u1 = Rb[0, 1] * T[b, 0] + Rb[1, 1] * T[b, 1] + Rb[2, 1] * T[b, 2]
+        u2 = Rb[0, 2] * T[b, 0] + Rb[1, 2] * T[b, 1] + Rb[2, 2] * T[b, 2]
+        a0 = J[0, 0] * u0 + J[0, 1] * u1 + J[0, 2] * u2
+        a1 = J[1, 0] * u0 + J[1, 1] * u1 + J[1, 2] * u2
+        a2 = J[2, 0] * u0 + J[2, 1] * u1 + J[2, 2] * u2
+        for k in range(3):
+            w[b, k] = (w[b, k] + dt * (Rb[k, 0] * a0 + Rb[k, 1] * a1 + Rb[k, 2] * a2)) * rot
+        rotate_in_place(Rb, w[b, 0] * dt, w[b, 1] * dt, w[b, 2] * dt)
     if st.driver == 1:
-        v[CAPITATE] = (v[CAPITATE] + dt * bod.inv_mass[CAPITATE] * F[CAPITATE]) * lin
-        x[CAPITATE] += dt * v[CAPITATE]
+        for k in range(3):
+            v[CAPITATE, k] = (v[CAPITATE, k] + dt * bod.inv_mass[CAPITATE] * F[CAPITATE, k]) * lin
+            x[CAPITATE, k] += dt * v[CAPITATE, k]
     if st.node_mass > 0.0:
         for i in range(nodes.shape[0]):
             if mem.bone[i] < 0:
-                nv[i] = (nv[i] + dt / st.node_mass * node_force[i]) * lin
-                nodes[i] += dt * nv[i]
+                for k in range(3):
+                    nv[i, k] = (nv[i, k] + dt / st.node_mass * node_force[i, k]) * lin
+                    nodes[i, k] += dt * nv[i, k]
     if step_index % 100 == 0:
         for b in (SCAPHOID, LUNATE):
             R[b] = orthonormalize(R[b])
     return energy
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
+def _converged(F, T, bundle, st):
+    """Quasi-static equilibrium: the net force (N) on every free body at most
+    max(force_floor, tolerance × largest bundle force), the net moment (N·mm)
+    at most that times LEVER_MM."""
+    largest = 0.0
+    for i in range(bundle.shape[0]):
+        largest = max(largest, bundle[i])
+    tol = max(st.force_floor, st.tolerance * largest)
+    for b in (SCAPHOID, LUNATE, CAPITATE):
+        if b == CAPITATE and st.driver == 0:
+            continue
+        f2 = F[b, 0] * F[b, 0] + F[b, 1] * F[b, 1] + F[b, 2] * F[b, 2]
+        if not f2 <= tol * tol:
+            return False
+        if b != CAPITATE:
+            t2 = T[b, 0] * T[b, 0] + T[b, 1] * T[b, 1] + T[b, 2] * T[b, 2]
+            if not t2 <= (tol * LEVER_MM) ** 2:
+                return False
+    return True
+
+
+@njit(cache=True, error_model="numpy")
 def _kinetic(v, w, nv, bod, st):
     ke = 0.0
     for b in (SCAPHOID, LUNATE):
@@ -124,9 +165,9 @@ def _kinetic(v, w, nv, bod, st):
     return ke
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
-        poses, contact, bundle_out, energy_out, residual_out, status):
+        poses, contact, bundle_out, energy_out, residual_out, steps_out, status):
     """Simulate one design; fills the per-frame outputs and status[0] (0 ok, 1 NaN, 2 diverged).
 
     frame_R (n_frames, 3, 3), frame_x (n_frames, 3): capitate rotation and
@@ -135,7 +176,10 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
     contact (n_frames, 5, 4) mean pressure (MPa), peak pressure (MPa), area
     (mm²), force (N); bundle_out (n_frames, 11) N; energy_out (n_frames, 2)
     kinetic, internal (N·mm); residual_out (n_frames, 2) largest net force (N)
-    and moment (N·mm) on the free bones.
+    and moment (N·mm) on the free bones; steps_out (n_frames,) steps taken.
+    Each stage ramps the capitate over its ramp steps, then holds until
+    `_converged` (at least min_hold_steps, at most max_hold_steps; settling
+    at most settle_steps).
     """
     com0 = bod.com0
     n_frames = frame_R.shape[0]
@@ -160,22 +204,28 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
     x0 = com0[CAPITATE].copy()
     energy = 0.0
     fire = np.array([st.fire_alpha0, 0.0])
+    capR = np.eye(3)
     for f in range(-2, n_frames):
         if f == -2:  # settle with the capitate at its static pose
-            Ra, xa, Rb, xb, n = R0, x0, R0, x0, st.settle_steps
+            Ra, xa, Rb, xb, ramp, most = R0, x0, R0, x0, 0, st.settle_steps
         elif f == -1:  # move the capitate to the first pose
-            Ra, xa, Rb, xb, n = R0, x0, frame_R[0], frame_x[0], st.move_steps
+            Ra, xa, Rb, xb, ramp, most = R0, x0, frame_R[0], frame_x[0], st.move_steps, st.max_hold_steps
         else:
             Ra, xa = frame_R[max(f - 1, 0)], frame_x[max(f - 1, 0)]
             Rb, xb = frame_R[f], frame_x[f]
-            n = st.frame_steps if f > 0 else st.frame_steps // 2
-        moving = max(1.0, (1.0 - st.hold_fraction) * n)
-        for k in range(n):
-            s = smoothstep((k + 1) / moving)
-            capR, capx = interpolate_pose(Ra, xa, Rb, xb, s)
+            ramp, most = (st.ramp_steps if f > 0 else 0), st.max_hold_steps
+        axis = matrix_to_rotvec(Rb @ Ra.T)
+        shift = xb - xa
+        k = 0
+        while True:
+            s = smoothstep((k + 1) / ramp) if ramp > 0 else 1.0
+            capx = interpolate_pose(Ra, xa, axis, capR, shift, s)
             energy = _step(R, x, v, w, nodes, nv, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st,
                            active, n_active, F, T, node_force, stats, bundle, capR, capx, step, fire)
             step += 1
+            k += 1
+            if k >= ramp + most or (k >= ramp + st.min_hold_steps and _converged(F, T, bundle, st)):
+                break
         bad = False
         for b in (SCAPHOID, LUNATE, CAPITATE):
             for i in range(3):
@@ -210,12 +260,13 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
         energy_out[f, 1] = energy
         residual_out[f, 0] = max(np.linalg.norm(F[SCAPHOID]), np.linalg.norm(F[LUNATE]))
         residual_out[f, 1] = max(np.linalg.norm(T[SCAPHOID]), np.linalg.norm(T[LUNATE]))
+        steps_out[f] = k
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, error_model="numpy", parallel=True)
 def run_batch(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
-              poses, contact, bundle_out, energy_out, residual_out, status):
+              poses, contact, bundle_out, energy_out, residual_out, steps_out, status):
     """`run` for many designs: f_l0, f_K (n, N), m_l0, m_K (n, C); outputs with a leading n axis."""
     for i in prange(f_l0.shape[0]):
         run(bod, grids, law, fib, f_l0[i], f_K[i], mem, m_l0[i], m_K[i], st, frame_R, frame_x,
-            poses[i], contact[i], bundle_out[i], energy_out[i], residual_out[i], status[i])
+            poses[i], contact[i], bundle_out[i], energy_out[i], residual_out[i], steps_out[i], status[i])

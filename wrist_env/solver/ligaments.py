@@ -12,7 +12,7 @@ from numba import njit
 EPSILON_L = 0.03
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def blankevoort_force(K, strain):
     """Tension (N) of a fibre of scale K (N per unit strain) at `strain`."""
     if strain <= 0.0:
@@ -22,7 +22,7 @@ def blankevoort_force(K, strain):
     return K * (strain - EPSILON_L)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def blankevoort_energy(K, l0, strain):
     """Strain energy (N·mm) of a fibre of scale K, zero-load length l0 (mm), at `strain`."""
     if strain <= 0.0:

@@ -6,7 +6,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rotvec_to_matrix(w):
     """Rotation matrix (3, 3) of a rotation vector (3,), radians (Rodrigues)."""
     theta = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
@@ -32,7 +32,7 @@ def rotvec_to_matrix(w):
     return R + s * K + (1.0 - c) * (K @ K)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def matrix_to_rotvec(R):
     """Rotation vector (3,), radians, of a rotation matrix (3, 3)."""
     c = (R[0, 0] + R[1, 1] + R[2, 2] - 1.0) * 0.5
@@ -51,7 +51,7 @@ def matrix_to_rotvec(R):
     return v * (theta / (2.0 * s))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def orthonormalize(R):
     """Nearest rotation to R by Gram–Schmidt on its columns (R is (3, 3))."""
     x = R[:, 0] / np.linalg.norm(R[:, 0])
@@ -65,14 +65,43 @@ def orthonormalize(R):
     return out
 
 
-@njit(cache=True)
-def interpolate_pose(R0, t0, R1, t1, s):
-    """Pose a fraction s in [0, 1] from (R0, t0) to (R1, t1): geodesic rotation, linear translation."""
-    w = matrix_to_rotvec(R1 @ R0.T)
-    return rotvec_to_matrix(w * s) @ R0, t0 + s * (t1 - t0)
+@njit(cache=True, error_model="numpy", inline="always")
+def rotate_in_place(R, wx, wy, wz):
+    """R ← exp([w]×) R for a rotation vector w (radians); R is (3, 3), nothing allocated."""
+    theta2 = wx * wx + wy * wy + wz * wz
+    if theta2 < 1e-24:
+        a, c = 1.0, 0.5
+    else:
+        theta = np.sqrt(theta2)
+        a = np.sin(theta) / theta
+        c = (1.0 - np.cos(theta)) / theta2
+    # E = I + a [w]× + c [w]×²
+    e00 = 1.0 - c * (wy * wy + wz * wz)
+    e11 = 1.0 - c * (wx * wx + wz * wz)
+    e22 = 1.0 - c * (wx * wx + wy * wy)
+    e01 = -a * wz + c * wx * wy
+    e10 = a * wz + c * wx * wy
+    e02 = a * wy + c * wx * wz
+    e20 = -a * wy + c * wx * wz
+    e12 = -a * wx + c * wy * wz
+    e21 = a * wx + c * wy * wz
+    for j in range(3):
+        r0, r1, r2 = R[0, j], R[1, j], R[2, j]
+        R[0, j] = e00 * r0 + e01 * r1 + e02 * r2
+        R[1, j] = e10 * r0 + e11 * r1 + e12 * r2
+        R[2, j] = e20 * r0 + e21 * r1 + e22 * r2
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
+def interpolate_pose(R0, t0, axis, R, t, s):
+    """Pose a fraction s in [0, 1] from (R0, t0) along the rotation vector `axis` = log(R1 R0ᵀ)
+    and to t0 + `t` (mm): written into R (3, 3); returns the translation as a tuple."""
+    R[:, :] = R0
+    rotate_in_place(R, s * axis[0], s * axis[1], s * axis[2])
+    return t0[0] + s * t[0], t0[1] + s * t[1], t0[2] + s * t[2]
+
+
+@njit(cache=True, error_model="numpy")
 def smoothstep(s):
     """C1 ramp from 0 to 1 on s in [0, 1] (zero velocity at both ends)."""
     s = min(1.0, max(0.0, s))

@@ -63,6 +63,7 @@ class Result:
     bundle_force (n_frames, 11): tension of each Table 2 ligament (N).
     energy (n_frames, 2): kinetic and internal energy (N·mm).
     residual (n_frames, 2): largest net force (N) and moment (N·mm) on the free bones.
+    steps (n_frames,): explicit steps taken for the frame (ramp + hold to equilibrium).
     status: 0 ok, otherwise failed (see `message`); a failed run's frames are NaN.
     """
 
@@ -71,6 +72,7 @@ class Result:
     bundle_force: np.ndarray
     energy: np.ndarray
     residual: np.ndarray
+    steps: np.ndarray
     angle_deg: np.ndarray
     status: int
     message: str
@@ -84,12 +86,13 @@ def _outputs(n: int, n_frames: int):
     shape = (n,) if n else ()
     return (np.full(shape + (n_frames, 5, 4, 4), np.nan), np.full(shape + (n_frames, 5, 4), np.nan),
             np.full(shape + (n_frames, 11), np.nan), np.full(shape + (n_frames, 2), np.nan),
-            np.full(shape + (n_frames, 2), np.nan), np.zeros(shape + (1,), np.int64))
+            np.full(shape + (n_frames, 2), np.nan), np.zeros(shape + (n_frames,), np.int64), np.zeros(shape + (1,), np.int64))
 
 
 def _prepare(model: Model, settings: arrays.SolverSettings | None, driver: Driver):
     s = settings or arrays.SolverSettings()
-    bod, grd, fib, mem = arrays.bodies(model, s), arrays.grids(model), arrays.fibres(model), arrays.membrane(model)
+    bod, grd, fib = arrays.bodies(model, s), arrays.grids(model), arrays.fibres(model)
+    mem = arrays.membrane(model, grd)
     return s, bod, grd, fib, mem, arrays.settings_tuple(s, driver.mode), np.ascontiguousarray(model.contact_law, dtype=np.float64)
 
 
@@ -113,8 +116,8 @@ def simulate_batch(model: Model, designs, driver: Driver, settings: arrays.Solve
 
 
 def _result(out, driver: Driver, status: int) -> Result:
-    poses, contact, bundle, energy, residual, _ = out
+    poses, contact, bundle, energy, residual, steps, _ = out
     if status != kernel.OK:
         for a in (poses, contact, bundle, energy, residual):
             a[...] = np.nan
-    return Result(poses, contact, bundle, energy, residual, driver.angle_deg, status, STATUS[status])
+    return Result(poses, contact, bundle, energy, residual, steps, driver.angle_deg, status, STATUS[status])
