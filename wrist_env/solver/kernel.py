@@ -176,7 +176,8 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
     contact (n_frames, 5, 4) mean pressure (MPa), peak pressure (MPa), area
     (mm²), force (N); bundle_out (n_frames, 11) N; energy_out (n_frames, 2)
     kinetic, internal (N·mm); residual_out (n_frames, 2) largest net force (N)
-    and moment (N·mm) on the free bones; steps_out (n_frames,) steps taken.
+    and moment (N·mm) on the free bones; steps_out (n_frames,) steps
+    taken since the previous frame (frame 0: settling and the move included).
     Each stage ramps the capitate over its ramp steps, then holds until
     `_converged` (at least min_hold_steps, at most max_hold_steps; settling
     at most settle_steps).
@@ -205,6 +206,7 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
     energy = 0.0
     fire = np.array([st.fire_alpha0, 0.0])
     capR = np.eye(3)
+    taken = 0
     for f in range(-2, n_frames):
         if f == -2:  # settle with the capitate at its static pose
             Ra, xa, Rb, xb, ramp, most = R0, x0, R0, x0, 0, st.settle_steps
@@ -226,6 +228,7 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
             k += 1
             if k >= ramp + most or (k >= ramp + st.min_hold_steps and _converged(F, T, bundle, st)):
                 break
+        taken += k
         bad = False
         for b in (SCAPHOID, LUNATE, CAPITATE):
             for i in range(3):
@@ -260,7 +263,8 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
         energy_out[f, 1] = energy
         residual_out[f, 0] = max(np.linalg.norm(F[SCAPHOID]), np.linalg.norm(F[LUNATE]))
         residual_out[f, 1] = max(np.linalg.norm(T[SCAPHOID]), np.linalg.norm(T[LUNATE]))
-        steps_out[f] = k
+        steps_out[f] = taken
+        taken = 0
 
 
 @njit(cache=True, error_model="numpy", parallel=True)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from wrist_env.design import Design
@@ -42,9 +43,12 @@ def experimental(model: Model, transforms) -> Driver:
     return Driver(arrays.EXPERIMENTAL, rotation, np.ascontiguousarray(com), np.full(len(T), np.nan))
 
 
-def idealized(model: Model, *, flexion_deg: float = 40.0, extension_deg: float = 40.0, n_frames: int = 17) -> Driver:
-    """Smooth sweep from `flexion_deg` of flexion to `extension_deg` of extension about the RCS z axis."""
-    angle = np.linspace(flexion_deg, -extension_deg, n_frames)
+def idealized(model: Model, *, flexion_deg: float = 40.0, extension_deg: float = 40.0, n_frames: int = 17,
+              angles_deg=None) -> Driver:
+    """Smooth sweep from `flexion_deg` of flexion to `extension_deg` of extension about the RCS z axis
+    in `n_frames` equal steps, or through the given capitate angles `angles_deg` (flexion +, deg)."""
+    angle = np.linspace(flexion_deg, -extension_deg, n_frames) if angles_deg is None else np.asarray(angles_deg, float)
+    n_frames = len(angle)
     t = np.radians(angle)
     c, s = np.cos(t), np.sin(t)
     rotation = np.zeros((n_frames, 3, 3))
@@ -63,7 +67,8 @@ class Result:
     bundle_force (n_frames, 11): tension of each Table 2 ligament (N).
     energy (n_frames, 2): kinetic and internal energy (N·mm).
     residual (n_frames, 2): largest net force (N) and moment (N·mm) on the free bones.
-    steps (n_frames,): explicit steps taken for the frame (ramp + hold to equilibrium).
+    steps (n_frames,): explicit steps since the previous frame (ramp + hold to equilibrium;
+        frame 0 includes settling and the move to the first pose).
     status: 0 ok, otherwise failed (see `message`); a failed run's frames are NaN.
     """
 
@@ -111,7 +116,11 @@ def simulate_batch(model: Model, designs, driver: Driver, settings: arrays.Solve
     per = [arrays.design_arrays(model, fib, mem, d) for d in designs]
     f_l0, f_K, m_l0, m_K = (np.ascontiguousarray(np.stack([p[i] for p in per])) for i in range(4))
     out = _outputs(len(per), len(driver.rotation))
-    kernel.run_batch(bod, grd, law, fib, f_l0, f_K, mem, m_l0, m_K, st, driver.rotation, driver.com, *out)
+    previous = numba.set_parallel_chunksize(1)  # designs differ in cost: hand them out one at a time
+    try:
+        kernel.run_batch(bod, grd, law, fib, f_l0, f_K, mem, m_l0, m_K, st, driver.rotation, driver.com, *out)
+    finally:
+        numba.set_parallel_chunksize(previous)
     return [_result(tuple(o[i] for o in out), driver, int(out[-1][i, 0])) for i in range(len(per))]
 
 

@@ -1,0 +1,133 @@
+"""Benchmark: the explicit solver's speed on a built participant (after compilation).
+
+Prints, for P1 (or the participant named on the command line):
+- milliseconds per simulation on one core: the idealized flexion–extension
+  sweep (17 frames, ±40°) with the population design, and a 15-frame
+  experimental trial (one motion cycle 30° flexion → 30° extension → back,
+  the capitate's 6 DOF prescribed from an idealized run of that cycle);
+- simulations per second batched (`simulate_batch`, Numba prange) on all
+  cores, for Monte Carlo designs (Table 2 normals truncated at ±3 SD, each
+  injurable ligament torn with probability 0.3);
+- efficiency: the time of a bare loop doing only the signed-distance
+  look-ups of one step (the active contact samples at the settled neutral
+  pose, plus the amortized active-set rebuild), over the time of a full step;
+- the ratio to the preprint's 45 s per Abaqus simulation.
+
+Run: `python experiments/bench_solver.py [P1]`. Timings are medians of
+repeated runs on a shared machine; expect ±10 %.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+from numba import njit, get_num_threads
+
+from wrist_env import design
+from wrist_env.model import BONES
+from wrist_env.participants.registry import load_model
+from wrist_env.solver import arrays
+from wrist_env.solver.contact import sdf_lookup_scalar
+from wrist_env.solver.forces import pair_transform, rebuild_active
+from wrist_env.solver.simulate import experimental, idealized, simulate, simulate_batch
+
+PREPRINT_SECONDS = 45.0
+CYCLE_DEG = 30.0 * np.cos(np.linspace(0.0, 2.0 * np.pi, 15))
+
+
+def median_seconds(fn, repeats: int = 9) -> float:
+    fn()
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - start)
+    return float(np.median(times))
+
+
+def trial_driver(model):
+    """A 15-frame experimental driver: the capitate poses of an idealized run of one motion cycle."""
+    run = simulate(model, design.population(), idealized(model, angles_deg=CYCLE_DEG))
+    return experimental(model, run.poses[:, BONES.index("capitate")])
+
+
+def monte_carlo_designs(n: int, seed: int = 0):
+    rng = np.random.default_rng(seed)
+    materials = design.sample_materials(n, seed)
+    injury = np.where(rng.random((n, 5)) < 0.3, -0.5, 0.5)
+    return [design.from_action(np.r_[m, i]) for m, i in zip(materials, injury)]
+
+
+@njit(cache=True, error_model="numpy")
+def bare_lookups(repeats, R, x, com0, grids, active, n_active):
+    """Only the signed-distance look-ups of `repeats` steps' active samples (the sum keeps them live)."""
+    total = 0.0
+    for _ in range(repeats):
+        for p in range(grids.pair_bones.shape[0]):
+            a, b = grids.pair_bones[p, 0], grids.pair_bones[p, 1]
+            m00, m01, m02, m10, m11, m12, m20, m21, m22, tx, ty, tz = pair_transform(R, x, com0, a, b)
+            start = grids.sample_offsets[p]
+            for j in range(n_active[p]):
+                s = active[start + j]
+                px, py, pz = grids.points[s, 0], grids.points[s, 1], grids.points[s, 2]
+                total += sdf_lookup_scalar(grids.values, grids.offsets[b], grids.shape[b], grids.origin[b], grids.spacing[b],
+                                           m00 * px + m01 * py + m02 * pz + tx, m10 * px + m11 * py + m12 * pz + ty,
+                                           m20 * px + m21 * py + m22 * pz + tz)[0]
+    return total
+
+
+def efficiency(model, steps_per_sim: float, seconds_per_sim: float) -> tuple[float, float, int]:
+    """(bare look-up µs per step, full µs per step, active samples) at the settled neutral pose."""
+    s = arrays.SolverSettings()
+    settled = simulate(model, design.population(), experimental(model, np.tile(np.eye(4), (2, 1, 1))))
+    pose = settled.poses[-1]
+    R = np.ascontiguousarray(pose[:, :3, :3])
+    x = np.ascontiguousarray(np.einsum("bij,bj->bi", R, model.com) + pose[:, :3, 3])
+    grids = arrays.grids(model)
+    active = np.zeros(len(grids.points), np.int64)
+    n_active = np.zeros(len(grids.pair_bones), np.int64)
+    rebuild_active(R, x, model.com, grids, s.active_band_mm, active, n_active)
+    repeats = 2000
+    per_step = median_seconds(lambda: bare_lookups(repeats, R, x, model.com, grids, active, n_active), 5) / repeats
+    per_step *= 1.0 + len(grids.points) / (s.rebuild_every * n_active.sum())  # amortized rebuilds
+    return per_step * 1e6, seconds_per_sim / steps_per_sim * 1e6, int(n_active.sum())
+
+
+def main(name: str) -> None:
+    model = load_model(name)
+    pop = design.population()
+    sweep, trial = idealized(model), trial_driver(model)
+    rows = []
+    for label, driver in (("idealized sweep, 17 frames", sweep), ("15-frame trial", trial)):
+        seconds = median_seconds(lambda: simulate(model, pop, driver))
+        steps = int(simulate(model, pop, driver).steps.sum())
+        rows.append((label, seconds, steps))
+        print(f"{label:<28} {seconds * 1e3:7.1f} ms on one core  ({steps} steps, {seconds / steps * 1e6:.1f} µs/step, "
+              f"{PREPRINT_SECONDS / seconds:,.0f}× faster than 45 s)")
+    designs = monte_carlo_designs(64)
+    for label, driver in (("idealized sweep, 17 frames", sweep), ("15-frame trial", trial)):
+        simulate_batch(model, designs[:2], driver)
+        start = time.perf_counter()
+        results = simulate_batch(model, designs, driver)
+        rate = len(designs) / (time.perf_counter() - start)
+        ok = sum(r.ok for r in results)
+        print(f"{label:<28} {rate:7.1f} simulations/s batched on {get_num_threads()} threads "
+              f"({ok}/{len(results)} Monte Carlo designs ok)")
+        rows.append((label + " batched", rate, ok))
+    bare, full, n_active = efficiency(model, rows[0][2], rows[0][1])
+    print(f"efficiency: bare look-ups {bare:.1f} µs of a {full:.1f} µs step ({n_active} active samples) = {bare / full:.0%}")
+    print()
+    print("| measure | P1 |")
+    print("|---|---|")
+    print(f"| idealized sweep (17 frames), one core | {rows[0][1] * 1e3:.0f} ms |")
+    print(f"| 15-frame trial, one core | {rows[1][1] * 1e3:.0f} ms |")
+    print(f"| Monte Carlo sweeps batched, {get_num_threads()} cores | {rows[2][1]:.0f} simulations/s |")
+    print(f"| 15-frame trials batched, {get_num_threads()} cores | {rows[3][1]:.0f} simulations/s |")
+    print(f"| look-ups / full step | {bare:.1f} / {full:.1f} µs ({bare / full:.0%}) |")
+    print(f"| vs the preprint's 45 s per simulation | {PREPRINT_SECONDS / rows[1][1]:,.0f}× faster |")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1] if len(sys.argv) > 1 else "P1")
