@@ -17,7 +17,7 @@ from wrist_env.design import Design
 from wrist_env.model import BONES, Model
 from wrist_env.solver import arrays, kernel
 
-STATUS = {kernel.OK: "ok", kernel.FAILED_NAN: "failed: NaN in the state", kernel.FAILED_DIVERGED: "failed: a free bone diverged"}
+STATUS = {kernel.OK: "ok", kernel.FAILED_NAN: "failed: NaN in the state", kernel.FAILED_DIVERGED: "failed: a free bone dislocated (moved beyond max_disp_mm or turned beyond max_rot_deg from the capitate)"}
 
 
 @dataclass(frozen=True)
