@@ -1,0 +1,238 @@
+"""Frames and the 6-DOF decomposition of bone poses (the one owner of both).
+
+Poses are 4×4 homogeneous transforms in the radius coordinate system (RCS, mm,
+right wrist): x volar(+)/dorsal, y proximal(+)/distal, z radial(+)/ulnar. A pose
+`T` maps a bone's neutral (static CT) vertices, in the RCS, to their place at
+one frame, as in `wrist_env.trial.Trial.transforms`.
+
+Six DOF, in the order and with the names of the preprint's Table 3 (`DOF_NAMES`):
+
+    0 Vol/Dor    translation along x, mm, volar +
+    1 Pro/Dis    translation along y, mm, proximal +
+    2 Rad/Uln    translation along z, mm, radial +
+    3 Flex/Ext   rotation about z, degrees, flexion +
+    4 UlnD/RadD  rotation about x', degrees, ulnar deviation +
+    5 Pro/Sup    rotation about y'', degrees, pronation +
+
+Rotations are Cardan Z-X-Y angles, *intrinsic* (rotating axes): first about z,
+then about the once-rotated x', then about the twice-rotated y'', so that
+R = Rz(flex) · Rx(ulnar) · Ry(pronation). This is SciPy's upper-case sequence
+"ZXY" (`Rotation.from_euler("ZXY", ...)`); lower-case "zxy" would be extrinsic
+and is not used. Angles are in (−180, 180], the middle one in [−90, 90].
+
+Translations depend on the point that is tracked. The preprint gives every bone
+a coordinate system aligned with the RCS in the static image and placed at the
+bone's centroid, so its translations are those of the centroid. Every function
+here takes a `reference_point` (mm, RCS, in the neutral pose; default the RCS
+origin): the translation DOF are the displacement T·c − c of that point, so the
+neutral pose (identity) is all zeros for any reference point.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from wrist_env.errors import InputError
+
+DOF_NAMES = ("Vol/Dor", "Pro/Dis", "Rad/Uln", "Flex/Ext", "UlnD/RadD", "Pro/Sup")
+DOF_UNITS = ("mm", "mm", "mm", "deg", "deg", "deg")
+TRANSLATION = slice(0, 3)
+ROTATION = slice(3, 6)
+CARDAN_SEQUENCE = "ZXY"  # SciPy upper case = intrinsic: z, then x', then y''
+EXPRESSED_IN = ("bone", "rcs")
+ORTHONORMAL_TOL = 1e-4  # max |RᵀR − I|, as wrist_env.trial
+BOTTOM_ROW_TOL = 1e-9
+
+
+def validate_poses(poses, name: str = "poses") -> np.ndarray:
+    """The poses as a float64 array of shape (..., 4, 4), or an InputError naming `name`, the entry and its value.
+
+    Rules: shape (..., 4, 4); finite; bottom row 0 0 0 1; rotation orthonormal
+    (max |RᵀR − I| <= 1e-4) and proper (det > 0).
+    """
+    try:
+        t = np.asarray(poses, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name}: must be an array of 4×4 transforms, but cannot be read as numbers: {exc}") from exc
+    if t.ndim < 2 or t.shape[-2:] != (4, 4):
+        raise InputError(f"{name}: must have shape (..., 4, 4), but got {t.shape}.")
+    bad = ~np.isfinite(t)
+    if bad.any():
+        *index, r, c = np.argwhere(bad)[0]
+        raise InputError(f"{name}: must be finite, but entry {_at(index)} has m{r}{c}={t[(*index, r, c)]}.")
+    bottom = np.abs(t[..., 3, :] - [0.0, 0.0, 0.0, 1.0]).max(axis=-1)
+    if (bottom > BOTTOM_ROW_TOL).any():
+        index = np.unravel_index(np.argmax(bottom), bottom.shape)
+        raise InputError(f"{name}: the bottom row must be 0 0 0 1, but entry {_at(index)} has {t[index][3].tolist()}.")
+    rot = t[..., :3, :3]
+    deviation = np.abs(np.swapaxes(rot, -1, -2) @ rot - np.eye(3)).max(axis=(-2, -1))
+    if (deviation > ORTHONORMAL_TOL).any():
+        index = np.unravel_index(np.argmax(deviation), deviation.shape)
+        raise InputError(
+            f"{name}: rotations must be orthonormal (max |RᵀR − I| <= {ORTHONORMAL_TOL}), "
+            f"but entry {_at(index)} has max |RᵀR − I| = {deviation[index]:.3g}."
+        )
+    det = np.linalg.det(rot)
+    if (det <= 0).any():
+        index = np.unravel_index(np.argmin(det), det.shape)
+        raise InputError(f"{name}: rotations must be proper (det = +1), but entry {_at(index)} has det = {det[index]:.6g}.")
+    return t
+
+
+def validate_points(points, name: str = "reference_point") -> np.ndarray:
+    """Points (mm) as a float64 array of shape (..., 3), or an InputError naming `name` and the value."""
+    try:
+        p = np.asarray(points, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name}: must be points of 3 coordinates (mm), but cannot be read as numbers: {exc}") from exc
+    if p.ndim < 1 or p.shape[-1] != 3:
+        raise InputError(f"{name}: must have shape (..., 3) (x, y, z in mm), but got {p.shape}.")
+    if not np.isfinite(p).all():
+        index = tuple(int(i) for i in np.argwhere(~np.isfinite(p))[0])
+        raise InputError(f"{name}: must be finite, but entry {index} is {p[index]}.")
+    return p
+
+
+def cardan_angles(rotations) -> np.ndarray:
+    """Cardan Z-X-Y angles (degrees) of rotation matrices (..., 3, 3): array (..., 3) = Flex/Ext, UlnD/RadD, Pro/Sup.
+
+    Matrices are assumed valid (see validate_poses). Intrinsic: R = Rz(a)·Rx(b)·Ry(c).
+    """
+    r = np.asarray(rotations, dtype=np.float64)
+    lead = r.shape[:-2]
+    flat = r.reshape(-1, 3, 3)
+    if flat.shape[0] == 0:
+        return np.zeros(lead + (3,))
+    return Rotation.from_matrix(flat).as_euler(CARDAN_SEQUENCE, degrees=True).reshape(lead + (3,))
+
+
+def cardan_rotation(angles) -> np.ndarray:
+    """Rotation matrices (..., 3, 3) of Cardan Z-X-Y angles (..., 3) in degrees (Flex/Ext, UlnD/RadD, Pro/Sup)."""
+    a = np.asarray(angles, dtype=np.float64)
+    if a.ndim < 1 or a.shape[-1] != 3:
+        raise InputError(f"angles: must have shape (..., 3) (Flex/Ext, UlnD/RadD, Pro/Sup in degrees), but got {a.shape}.")
+    if not np.isfinite(a).all():
+        raise InputError(f"angles: must be finite, but got {a[~np.isfinite(a)][0]}.")
+    lead = a.shape[:-1]
+    flat = a.reshape(-1, 3)
+    if flat.shape[0] == 0:
+        return np.zeros(lead + (3, 3))
+    return Rotation.from_euler(CARDAN_SEQUENCE, flat, degrees=True).as_matrix().reshape(lead + (3, 3))
+
+
+def apply(poses, points) -> np.ndarray:
+    """Points (..., 3) mm moved by poses (..., 4, 4): R·p + t, broadcast over leading axes."""
+    t = np.asarray(poses, dtype=np.float64)
+    p = np.asarray(points, dtype=np.float64)
+    return (t[..., :3, :3] @ p[..., :, None])[..., 0] + t[..., :3, 3]
+
+
+def invert(poses) -> np.ndarray:
+    """Inverses of rigid transforms (..., 4, 4): [Rᵀ, −Rᵀt; 0 0 0 1]."""
+    t = np.asarray(poses, dtype=np.float64)
+    out = np.zeros_like(t)
+    rt = np.swapaxes(t[..., :3, :3], -1, -2)
+    out[..., :3, :3] = rt
+    out[..., :3, 3] = -(rt @ t[..., :3, 3, None])[..., 0]
+    out[..., 3, 3] = 1.0
+    return out
+
+
+def pose_to_dof(poses, reference_point=None) -> np.ndarray:
+    """Six DOF (..., 6) of poses (..., 4, 4): displacement T·c − c (mm, RCS) of the reference point c, then Cardan angles (deg).
+
+    reference_point: (3,) or broadcastable to poses.shape[:-2] + (3,), mm, RCS, neutral pose;
+    None = the RCS origin (the translation column of T). For per-bone points with poses of shape
+    (n_bones, n_frames, 4, 4) pass shape (n_bones, 1, 3).
+    """
+    t = validate_poses(poses)
+    c = np.zeros(3) if reference_point is None else validate_points(reference_point)
+    return _dof(t, c)
+
+
+def dof_to_pose(dof, reference_point=None) -> np.ndarray:
+    """Poses (..., 4, 4) of six DOF (..., 6) (mm, deg): the inverse of pose_to_dof with the same reference point."""
+    d = np.asarray(dof, dtype=np.float64)
+    if d.ndim < 1 or d.shape[-1] != 6:
+        raise InputError(f"dof: must have shape (..., 6) ({', '.join(DOF_NAMES)}), but got {d.shape}.")
+    if not np.isfinite(d).all():
+        index = tuple(int(i) for i in np.argwhere(~np.isfinite(d))[0])
+        raise InputError(f"dof: must be finite, but entry {index} ({DOF_NAMES[index[-1]]}) is {d[index]}.")
+    c = np.zeros(3) if reference_point is None else validate_points(reference_point)
+    rot = cardan_rotation(d[..., ROTATION])
+    # T·c − c = d  ⇒  t = d + c − R·c
+    translation = d[..., TRANSLATION] + c - (rot @ c[..., :, None])[..., 0]
+    lead = np.broadcast_shapes(rot.shape[:-2], translation.shape[:-1])
+    out = np.zeros(lead + (4, 4))
+    out[..., :3, :3] = rot
+    out[..., :3, 3] = translation
+    out[..., 3, 3] = 1.0
+    return out
+
+
+def error_transform(model, experiment, *, expressed_in: str = "bone") -> np.ndarray:
+    """Error transforms (..., 4, 4) between model and experimental poses of one bone, frame by frame.
+
+    expressed_in="bone" (default): E = T_exp⁻¹ · T_model, the model bone's pose relative to the
+    experimental bone, in the experimental bone's coordinate system (RCS-aligned in the neutral pose);
+    identical poses give the identity. expressed_in="rcs": E = T_model · T_exp⁻¹, the motion in the
+    RCS that carries the experimental bone onto the model bone.
+    """
+    m = validate_poses(model, "model poses")
+    e = validate_poses(experiment, "experimental poses")
+    _same_shape(m, e)
+    if expressed_in == "bone":
+        return invert(e) @ m
+    if expressed_in == "rcs":
+        return m @ invert(e)
+    raise InputError(f"expressed_in must be one of {EXPRESSED_IN}, but got {expressed_in!r}.")
+
+
+def error_dof(model, experiment, reference_point=None, *, expressed_in: str = "bone") -> np.ndarray:
+    """Six-DOF error (..., 6) of model vs experimental poses (..., 4, 4) (mm, deg), model minus experiment.
+
+    The rotation DOF are the Cardan Z-X-Y angles of the error transform's rotation; the
+    translation DOF are the displacement of the bone's reference point c (mm, RCS, neutral
+    pose; default the RCS origin; the preprint tracks the centroid):
+    "bone": R_expᵀ · (T_model·c − T_exp·c), angles of R_expᵀ·R_model (experimental bone's axes);
+    "rcs":  T_model·c − T_exp·c, angles of R_model·R_expᵀ (RCS axes).
+    """
+    e = validate_poses(experiment, "experimental poses")
+    error = error_transform(model, e, expressed_in=expressed_in)
+    c = np.zeros(3) if reference_point is None else validate_points(reference_point)
+    point = c if expressed_in == "bone" else apply(e, c)
+    # not re-validated: a product of two poses within the orthonormality tolerance may exceed it
+    return _dof(error, point)
+
+
+def rmse(model, experiment, reference_point=None, *, expressed_in: str = "bone") -> np.ndarray:
+    """Per-DOF root mean squared error (..., 6) over frames (mm, deg) of poses (..., n_frames, 4, 4).
+
+    The RMSE of error_dof over the frame axis (axis −3 of the poses), as in the preprint's Tables 3–4.
+    For per-bone reference points with poses (n_bones, n_frames, 4, 4) pass shape (n_bones, 1, 3).
+    """
+    e = validate_poses(experiment, "experimental poses")
+    if e.ndim < 3:
+        raise InputError(f"experimental poses: must have shape (..., n_frames, 4, 4), but got {e.shape}.")
+    err = error_dof(model, e, reference_point, expressed_in=expressed_in)
+    return np.sqrt(np.mean(err**2, axis=-2))
+
+
+def _dof(t: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """pose_to_dof of validated poses and points."""
+    displacement = apply(t, c) - c
+    angles = cardan_angles(t[..., :3, :3])
+    displacement, angles = np.broadcast_arrays(displacement, angles)
+    return np.concatenate([displacement, angles], axis=-1)
+
+
+def _same_shape(model: np.ndarray, experiment: np.ndarray) -> None:
+    if model.shape != experiment.shape:
+        raise InputError(
+            f"model and experimental poses must have the same shape, but got {model.shape} and {experiment.shape}."
+        )
+
+
+def _at(index) -> str:
+    return str(tuple(int(i) for i in index))
