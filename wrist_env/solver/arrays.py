@@ -21,11 +21,11 @@ Membrane = namedtuple("Membrane", "connectors kind first_row bone rest scaphoid 
 Settings = namedtuple(
     "Settings",
     "dt settle_steps move_steps ramp_steps min_hold_steps max_hold_steps tolerance force_floor damping rot_damping fibre_damping_s "
-    "active_band_mm rebuild_every node_mass membrane_contact_stiffness driver load max_disp_mm max_rot_rad fire_alpha0",
+    "active_band_mm rebuild_every node_mass membrane_contact_stiffness driver max_disp_mm max_rot_rad fire_alpha0",
 )
 
 RSC = LIGAMENT_NAMES.index("RSC")
-EXPERIMENTAL, IDEALIZED = 0, 1
+EXPERIMENTAL, LOADED = 0, 1
 
 
 @dataclass(frozen=True)
@@ -60,7 +60,6 @@ class SolverSettings:
     rebuild_every: int = 8
     node_mass_t: float = 2e-7
     membrane_contact_stiffness: float = 50.0
-    compressive_load_n: float = 10.0
     max_disp_mm: float = 15.0
     max_rot_deg: float = 75.0
     fire_alpha0: float = 0.1
@@ -144,11 +143,10 @@ def design_arrays(model: Model, fib: Fibres, mem: Membrane, design: Design):
 
 
 def settings_tuple(s: SolverSettings, driver: int) -> Settings:
-    load = np.array([0.0, s.compressive_load_n if driver == IDEALIZED else 0.0, 0.0])
     return Settings(
         float(s.dt_s), int(s.settle_steps), int(s.move_steps), int(s.ramp_steps), int(s.min_hold_steps),
         int(s.max_hold_steps), float(s.tolerance), float(s.force_floor_n),
         float(s.damping_per_s), float(s.rot_damping_per_s), float(s.fibre_damping_s), float(s.active_band_mm),
-        int(s.rebuild_every), float(s.node_mass_t), float(s.membrane_contact_stiffness), int(driver), load,
+        int(s.rebuild_every), float(s.node_mass_t), float(s.membrane_contact_stiffness), int(driver),
         float(s.max_disp_mm), float(np.radians(s.max_rot_deg)), float(s.fire_alpha0),
     )

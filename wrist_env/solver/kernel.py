@@ -74,8 +74,10 @@ def _fire(v, w, nv, F, T, node_force, mem, st, fire):
 
 @njit(cache=True, error_model="numpy")
 def _step(R, x, v, w, nodes, nv, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st,
-          active, n_active, F, T, node_force, stats, bundle, capR, capx, step_index, fire):
-    """One explicit step with the capitate at target (capR, capx); returns internal energy (N·mm)."""
+          active, n_active, F, T, node_force, stats, bundle, capR, capx, load, step_index, fire):
+    """One explicit step with the capitate at target (capR, capx), or, for the loaded
+    driver, at rotation capR under a compressive `load` (N, along +y); returns
+    internal energy (N·mm)."""
     com0 = bod.com0
     R[CAPITATE] = capR
     if st.driver == 0:
@@ -94,7 +96,7 @@ def _step(R, x, v, w, nodes, nv, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K
     energy += e_mem
     bundle[3] += rsc
     if st.driver == 1:
-        F[CAPITATE] += st.load
+        F[CAPITATE, 1] += load
     if st.fire_alpha0 > 0.0:
         _fire(v, w, nv, F, T, node_force, mem, st, fire)
     dt = st.dt
@@ -166,13 +168,14 @@ def _kinetic(v, w, nv, bod, st):
 
 
 @njit(cache=True, error_model="numpy")
-def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
+def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x, frame_load,
         poses, contact, bundle_out, energy_out, residual_out, steps_out, status):
     """Simulate one design; fills the per-frame outputs and status[0] (0 ok, 1 NaN, 2 diverged).
 
     frame_R (n_frames, 3, 3), frame_x (n_frames, 3): capitate rotation and
-    centre-of-mass targets per frame (for the idealized driver the centre is
-    free and frame_x is only the start). Outputs: poses (n_frames, 5, 4, 4);
+    centre-of-mass targets per frame (for the loaded driver the centre is
+    free and frame_x is only the start); frame_load (n_frames,) compressive
+    load on the capitate (N, along +y; loaded driver only). Outputs: poses (n_frames, 5, 4, 4);
     contact (n_frames, 5, 4) mean pressure (MPa), peak pressure (MPa), area
     (mm²), force (N); bundle_out (n_frames, 11) N; energy_out (n_frames, 2)
     kinetic, internal (N·mm); residual_out (n_frames, 2) largest net force (N)
@@ -210,11 +213,13 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
     for f in range(-2, n_frames):
         if f == -2:  # settle with the capitate at its static pose
             Ra, xa, Rb, xb, ramp, most = R0, x0, R0, x0, 0, st.settle_steps
+            la = lb = frame_load[0]
         elif f == -1:  # move the capitate to the first pose
             Ra, xa, Rb, xb, ramp, most = R0, x0, frame_R[0], frame_x[0], st.move_steps, st.max_hold_steps
+            la = lb = frame_load[0]
         else:
-            Ra, xa = frame_R[max(f - 1, 0)], frame_x[max(f - 1, 0)]
-            Rb, xb = frame_R[f], frame_x[f]
+            Ra, xa, la = frame_R[max(f - 1, 0)], frame_x[max(f - 1, 0)], frame_load[max(f - 1, 0)]
+            Rb, xb, lb = frame_R[f], frame_x[f], frame_load[f]
             ramp, most = (st.ramp_steps if f > 0 else 0), st.max_hold_steps
         axis = matrix_to_rotvec(Rb @ Ra.T)
         shift = xb - xa
@@ -222,8 +227,9 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
         while True:
             s = smoothstep((k + 1) / ramp) if ramp > 0 else 1.0
             capx = interpolate_pose(Ra, xa, axis, capR, shift, s)
+            load = la + s * (lb - la)
             energy = _step(R, x, v, w, nodes, nv, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st,
-                           active, n_active, F, T, node_force, stats, bundle, capR, capx, step, fire)
+                           active, n_active, F, T, node_force, stats, bundle, capR, capx, load, step, fire)
             step += 1
             k += 1
             if k >= ramp + most or (k >= ramp + st.min_hold_steps and _converged(F, T, bundle, st)):
@@ -268,9 +274,9 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def run_batch(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x,
+def run_batch(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x, frame_load,
               poses, contact, bundle_out, energy_out, residual_out, steps_out, status):
     """`run` for many designs: f_l0, f_K (n, N), m_l0, m_K (n, C); outputs with a leading n axis."""
     for i in prange(f_l0.shape[0]):
-        run(bod, grids, law, fib, f_l0[i], f_K[i], mem, m_l0[i], m_K[i], st, frame_R, frame_x,
+        run(bod, grids, law, fib, f_l0[i], f_K[i], mem, m_l0[i], m_K[i], st, frame_R, frame_x, frame_load,
             poses[i], contact[i], bundle_out[i], energy_out[i], residual_out[i], steps_out[i], status[i])

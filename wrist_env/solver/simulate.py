@@ -1,9 +1,10 @@
 """`simulate(model, design, driver)`: one simulation as a recipe, and its batched form.
 
-Drivers: `experimental(trial)` prescribes all 6 DOF of the capitate from a
-trial's 4×4 transforms; `idealized(...)` ramps the capitate from maximum
-flexion to maximum extension about the RCS z axis, other rotations held,
-translations free under a small compressive load.
+Drivers: `experimental(model, transforms)` prescribes all 6 DOF of the
+capitate from a trial's 4×4 transforms; `loaded(model, rotations, load_n)`
+prescribes its rotations and leaves its translations free under a
+compressive load; `idealized(model)` is the loaded driver ramping from
+maximum flexion to maximum extension about the RCS z axis.
 """
 
 from __future__ import annotations
@@ -13,10 +14,13 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from scipy.spatial.transform import Rotation
+
 from wrist_env.design import Design
 from wrist_env.model import BONES, Model
 from wrist_env.solver import arrays, kernel
 
+IDEALIZED_LOAD_N = 10.0  # compressive load that keeps the joint in contact (N)
 STATUS = {kernel.OK: "ok", kernel.FAILED_NAN: "failed: NaN in the state", kernel.FAILED_DIVERGED: "failed: a free bone dislocated (moved beyond max_disp_mm or turned beyond max_rot_deg from the capitate)"}
 
 
@@ -24,14 +28,21 @@ STATUS = {kernel.OK: "ok", kernel.FAILED_NAN: "failed: NaN in the state", kernel
 class Driver:
     """Capitate targets per frame: rotations (n_frames, 3, 3), centre of mass (n_frames, 3) mm.
 
-    mode: arrays.EXPERIMENTAL or arrays.IDEALIZED; angle_deg (n_frames,) the
-    wrist flexion angle of each frame (idealized) or NaN.
+    mode: arrays.EXPERIMENTAL (all 6 DOF prescribed) or arrays.LOADED
+    (rotations prescribed, translations free under `load_n`); load_n
+    (n_frames,) compressive load on the capitate along +y (proximal), N;
+    angle_deg (n_frames,) the wrist flexion angle of each frame (idealized) or NaN.
     """
 
     mode: int
     rotation: np.ndarray
     com: np.ndarray
     angle_deg: np.ndarray
+    load_n: np.ndarray
+
+    @property
+    def n_frames(self) -> int:
+        return len(self.rotation)
 
 
 def experimental(model: Model, transforms) -> Driver:
@@ -40,21 +51,28 @@ def experimental(model: Model, transforms) -> Driver:
     com0 = model.com[BONES.index("capitate")]
     rotation = np.ascontiguousarray(T[:, :3, :3])
     com = np.einsum("fij,j->fi", rotation, com0) + T[:, :3, 3]
-    return Driver(arrays.EXPERIMENTAL, rotation, np.ascontiguousarray(com), np.full(len(T), np.nan))
+    return Driver(arrays.EXPERIMENTAL, rotation, np.ascontiguousarray(com), np.full(len(T), np.nan), np.zeros(len(T)))
+
+
+def loaded(model: Model, rotations, load_n=IDEALIZED_LOAD_N, angle_deg=None) -> Driver:
+    """Capitate rotations (n_frames, 3, 3) prescribed, its translations free under a
+    compressive load `load_n` (N along +y; a scalar or one per frame)."""
+    rotation = np.ascontiguousarray(np.asarray(rotations, dtype=np.float64))
+    n = len(rotation)
+    com = np.tile(model.com[BONES.index("capitate")], (n, 1))
+    load = np.broadcast_to(np.asarray(load_n, dtype=np.float64), (n,)).copy()
+    angle = np.full(n, np.nan) if angle_deg is None else np.asarray(angle_deg, dtype=np.float64)
+    return Driver(arrays.LOADED, rotation, com, angle, load)
 
 
 def idealized(model: Model, *, flexion_deg: float = 40.0, extension_deg: float = 40.0, n_frames: int = 17,
-              angles_deg=None) -> Driver:
-    """Smooth sweep from `flexion_deg` of flexion to `extension_deg` of extension about the RCS z axis
-    in `n_frames` equal steps, or through the given capitate angles `angles_deg` (flexion +, deg)."""
+              angles_deg=None, load_n: float = IDEALIZED_LOAD_N) -> Driver:
+    """Idealized flexion–extension (preprint 2.2.3.2): the capitate from `flexion_deg` of
+    flexion to `extension_deg` of extension about the RCS z axis in `n_frames` equal steps
+    (or through `angles_deg`, flexion +), other rotations held, translations free under
+    a small compressive load `load_n` (N)."""
     angle = np.linspace(flexion_deg, -extension_deg, n_frames) if angles_deg is None else np.asarray(angles_deg, float)
-    n_frames = len(angle)
-    t = np.radians(angle)
-    c, s = np.cos(t), np.sin(t)
-    rotation = np.zeros((n_frames, 3, 3))
-    rotation[:, 0, 0], rotation[:, 0, 1], rotation[:, 1, 0], rotation[:, 1, 1], rotation[:, 2, 2] = c, -s, s, c, 1.0
-    com = np.tile(model.com[BONES.index("capitate")], (n_frames, 1))
-    return Driver(arrays.IDEALIZED, rotation, com, angle)
+    return loaded(model, Rotation.from_euler("z", angle[:, None], degrees=True).as_matrix(), load_n, angle)
 
 
 @dataclass(frozen=True)
@@ -106,7 +124,7 @@ def simulate(model: Model, design: Design, driver: Driver, settings: arrays.Solv
     s, bod, grd, fib, mem, st, law = _prepare(model, settings, driver)
     f_l0, f_K, m_l0, m_K = arrays.design_arrays(model, fib, mem, design)
     out = _outputs(0, len(driver.rotation))
-    kernel.run(bod, grd, law, fib, f_l0, f_K, mem, m_l0, m_K, st, driver.rotation, driver.com, *out)
+    kernel.run(bod, grd, law, fib, f_l0, f_K, mem, m_l0, m_K, st, driver.rotation, driver.com, driver.load_n, *out)
     return _result(out, driver, int(out[-1][0]))
 
 
@@ -118,7 +136,7 @@ def simulate_batch(model: Model, designs, driver: Driver, settings: arrays.Solve
     out = _outputs(len(per), len(driver.rotation))
     previous = numba.set_parallel_chunksize(1)  # designs differ in cost: hand them out one at a time
     try:
-        kernel.run_batch(bod, grd, law, fib, f_l0, f_K, mem, m_l0, m_K, st, driver.rotation, driver.com, *out)
+        kernel.run_batch(bod, grd, law, fib, f_l0, f_K, mem, m_l0, m_K, st, driver.rotation, driver.com, driver.load_n, *out)
     finally:
         numba.set_parallel_chunksize(previous)
     return [_result(tuple(o[i] for o in out), driver, int(out[-1][i, 0])) for i in range(len(per))]

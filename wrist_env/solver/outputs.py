@@ -1,0 +1,113 @@
+"""Outputs of a simulation for people and files: per-sample pressure maps and JSON-ready frames.
+
+Thin on purpose: pressures come from `forces.sample_pressures` (the solver's
+own contact law and grids); everything else is read off a `Result`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from wrist_env.design import LIGAMENT_NAMES
+from wrist_env.model import BONES, PAIRS, Model
+from wrist_env.solver import arrays, forces
+
+
+def _state(model: Model, pose_frame):
+    """(R (5, 3, 3), x (5, 3)) of the kernels from one frame's poses (5, 4, 4), neutral → frame."""
+    P = np.asarray(pose_frame, dtype=np.float64)
+    if P.shape != (len(BONES), 4, 4):
+        raise ValueError(f"pose_frame must have shape ({len(BONES)}, 4, 4), but got {P.shape}")
+    R = np.ascontiguousarray(P[:, :3, :3])
+    x = np.ascontiguousarray(np.einsum("bij,bj->bi", R, model.com) + P[:, :3, 3])
+    return R, x
+
+
+def pressure_map(model: Model, pose_frame) -> np.ndarray:
+    """Contact pressure (MPa) of every contact sample, shape (n_samples,), at one frame's poses (5, 4, 4).
+
+    Samples are in `model.sample_points` order (pair-sorted, `PAIRS`; pair p is
+    `model.sample_offsets[p]:model.sample_offsets[p + 1]`); a sample out of
+    contact has pressure 0. Note: the kernel reports `Result.contact` from the
+    forces of its last explicit step, evaluated before that step moved the bones
+    to `Result.poses`, so sums of this map match `Result.contact` to ~1e-3, not exactly.
+    """
+    R, x = _state(model, pose_frame)
+    pressure = np.zeros(len(model.sample_points))
+    forces.sample_pressures(R, x, np.ascontiguousarray(model.com, dtype=np.float64), arrays.grids(model),
+                            np.ascontiguousarray(model.contact_law, dtype=np.float64), pressure)
+    return pressure
+
+
+def pair_slice(model: Model, pair: str) -> slice:
+    """The samples of one articulation (a `PAIRS` name) in `model.sample_points` order."""
+    p = PAIRS.index(pair)
+    return slice(int(model.sample_offsets[p]), int(model.sample_offsets[p + 1]))
+
+
+def cardan_deg(poses) -> np.ndarray:
+    """Cardan Z-X-Y angles (deg) of poses (..., 4, 4) or rotations (..., 3, 3): columns rotation about
+    z (flexion +, radial axis), x (volar axis, ulnar deviation +), y (long axis)."""
+    # TODO: use wrist_env.frames (4×4 ↔ 6 DOF, Cardan Z-X-Y) once it exists.
+    from scipy.spatial.transform import Rotation
+
+    R = np.asarray(poses, dtype=np.float64)[..., :3, :3]
+    flat = R.reshape(-1, 3, 3)
+    out = np.full((len(flat), 3), np.nan)
+    ok = np.isfinite(flat).all(axis=(1, 2))
+    if ok.any():
+        out[ok] = Rotation.from_matrix(flat[ok]).as_euler("ZXY", degrees=True)
+    return out.reshape(R.shape[:-2] + (3,))
+
+
+def _num(value):
+    """A JSON number, or None for NaN/inf."""
+    v = float(value)
+    return v if math.isfinite(v) else None
+
+
+def _matrix(m):
+    return [[_num(v) for v in row] for row in np.asarray(m)]
+
+
+def result_to_dict(result, model: Model) -> dict:
+    """JSON-ready per-frame outputs of a `Result` (NaN → None; strict JSON with `allow_nan=False`).
+
+    {"status", "ok", "message", "n_frames", "bones", "pairs", "ligaments", "frames": [
+      {"frame", "capitate_angle_deg" (driver angle, None for experimental drivers),
+       "rotation_deg": {bone: [about z (flexion +), about x, about y]} (Cardan Z-X-Y of the pose),
+       "poses": {bone: 4×4 neutral → frame, RCS mm},
+       "contact": {pair: {"mean_pressure_mpa", "peak_pressure_mpa", "area_mm2", "force_n"}},
+       "ligament_force_n": {ligament: N}, "kinetic_energy_nmm", "internal_energy_nmm",
+       "residual": {"force_n", "moment_nmm"}, "steps"}, ...]}
+    """
+    n = len(result.poses)
+    angles = cardan_deg(result.poses)
+    frames = []
+    for f in range(n):
+        frames.append({
+            "frame": f,
+            "capitate_angle_deg": _num(result.angle_deg[f]),
+            "rotation_deg": {b: [_num(a) for a in angles[f, i]] for i, b in enumerate(BONES)},
+            "poses": {b: _matrix(result.poses[f, i]) for i, b in enumerate(BONES)},
+            "contact": {p: {"mean_pressure_mpa": _num(c[0]), "peak_pressure_mpa": _num(c[1]),
+                            "area_mm2": _num(c[2]), "force_n": _num(c[3])}
+                        for p, c in zip(PAIRS, result.contact[f])},
+            "ligament_force_n": {name: _num(v) for name, v in zip(LIGAMENT_NAMES, result.bundle_force[f])},
+            "kinetic_energy_nmm": _num(result.energy[f, 0]),
+            "internal_energy_nmm": _num(result.energy[f, 1]),
+            "residual": {"force_n": _num(result.residual[f, 0]), "moment_nmm": _num(result.residual[f, 1])},
+            "steps": int(result.steps[f]),
+        })
+    return {
+        "status": int(result.status),
+        "ok": bool(result.ok),
+        "message": result.message,
+        "n_frames": n,
+        "bones": list(BONES),
+        "pairs": list(PAIRS),
+        "ligaments": list(LIGAMENT_NAMES),
+        "frames": frames,
+    }
