@@ -25,3 +25,65 @@ def test_build_json_has_the_summary_fields(capsys, built):
 def test_unknown_participant_is_a_clear_error(capsys):
     assert main(["build", "P9"]) == 2
     assert "unknown participant 'P9'" in capsys.readouterr().err
+
+
+def test_simulate_json_has_every_frame_and_the_wall_time(capsys, built):
+    import math
+
+    built("P1")
+    assert main(["simulate", "P1", "--motion", "idealized", "--design", "population", "--frames", "5", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    for key in ("participant", "motion", "design", "wall_seconds", "compile_seconds", "status", "message", "frames"):
+        assert key in out, key
+    assert out["status"] == 0 and out["message"] == "ok" and out["wall_seconds"] > 0 and out["compile_seconds"] is None
+    assert out["n_frames"] == len(out["frames"]) == 5
+    assert [f["capitate_angle_deg"] for f in out["frames"]] == [40.0, 20.0, 0.0, -20.0, -40.0]
+
+    def numbers(x):
+        if isinstance(x, dict):
+            return [v for y in x.values() for v in numbers(y)]
+        if isinstance(x, list):
+            return [v for y in x for v in numbers(y)]
+        return [x]
+
+    for frame in out["frames"]:
+        for key in ("poses", "contact", "ligament_force_n", "kinetic_energy_nmm", "internal_energy_nmm", "residual", "steps"):
+            assert key in frame, key
+        values = numbers({k: v for k, v in frame.items()})
+        assert all(isinstance(v, (int, float)) and math.isfinite(v) for v in values)
+        assert set(frame["contact"]["radioscaphoid"]) == {"mean_pressure_mpa", "peak_pressure_mpa", "area_mm2", "force_n"}
+
+
+def test_simulate_static_truth_and_design_file(capsys, built, tmp_path):
+    from wrist_env import design
+    from wrist_env.participants.builtin import truth
+
+    built("P1")
+    assert main(["simulate", "P1", "--motion", "static", "--design", "truth", "--frames", "2", "--warm-up"]) == 0
+    text = capsys.readouterr().out
+    assert "scaphoid" in text and "RS mean MPa" in text and "status: ok" in text and "warm-up" in text
+    assert len([line for line in text.splitlines() if line.strip()[:1].isdigit()]) == 2
+
+    path = tmp_path / "d.json"
+    path.write_text(json.dumps(truth("P1").as_dict()))
+    assert main(["simulate", "P1", "--motion", "static", "--design", str(path), "--frames", "2", "--json"]) == 0
+    from_file = json.loads(capsys.readouterr().out)
+    assert main(["simulate", "P1", "--motion", "static", "--design", "truth", "--frames", "2", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["frames"] == from_file["frames"]
+    assert from_file["frames"][0]["capitate_angle_deg"] is None
+
+    path.write_text(json.dumps({"stiffness": 1}))
+    assert main(["simulate", "P1", "--design", str(path)]) == 2
+    assert "missing variables" in capsys.readouterr().err
+    assert main(["simulate", "P1", "--design", "nonsense"]) == 2
+    assert "'population', 'truth' or a JSON file" in capsys.readouterr().err
+    assert design.population()  # the population design needs no file
+
+
+def test_figure_commands_write_pngs(capsys, built, tmp_path):
+    built("P1")
+    for kind in ("pressure", "kinematics"):
+        out = tmp_path / f"{kind}.png"
+        assert main(["figure", kind, "P1", "--out", str(out)]) == 0
+        assert capsys.readouterr().out.strip() == str(out)
+        assert out.stat().st_size > 10_000 and out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

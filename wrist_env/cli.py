@@ -43,6 +43,92 @@ def _build(args) -> int:
     return 0
 
 
+def load_design(spec: str, participant: str):
+    """`population`, `truth` (a built-in participant's hidden ground truth) or a JSON file of a Design."""
+    from wrist_env import design
+    from wrist_env.errors import DesignError
+    from wrist_env.participants import builtin
+
+    if spec == "population":
+        return design.population()
+    if spec == "truth":
+        if participant not in builtin.BUILTIN:
+            raise DesignError(f"--design truth needs a built-in participant {list(builtin.BUILTIN)}, but got {participant!r}")
+        return builtin.truth(participant)
+    path = Path(spec)
+    if not path.is_file():
+        raise DesignError(f"--design must be 'population', 'truth' or a JSON file of a design, but {spec!r} is none of these")
+    try:
+        data = json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise DesignError(f"{path}: not valid JSON ({exc})") from None
+    if isinstance(data, dict) and isinstance(data.get("design"), dict):
+        data = data["design"]
+    if not isinstance(data, dict):
+        raise DesignError(f"{path}: expected a JSON object of design variables, but got {type(data).__name__}")
+    try:
+        return design.Design.from_dict(data)
+    except DesignError as exc:
+        raise DesignError(f"{path}: {exc}") from None
+
+
+def make_driver(model, motion: str, frames: int | None, flexion: float, extension: float):
+    """The capitate driver of `simulate`: an idealized sweep or the capitate held at neutral."""
+    import numpy as np
+
+    from wrist_env.solver import simulate
+
+    if motion == "idealized":
+        return simulate.idealized(model, flexion_deg=flexion, extension_deg=extension, n_frames=frames or 17)
+    if motion == "static":
+        return simulate.experimental(model, np.tile(np.eye(4), (frames or 3, 1, 1)))
+    raise SystemExit(f"unknown motion {motion!r}")
+
+
+def _simulate(args) -> int:
+    from wrist_env.model import BONES, PAIRS
+    from wrist_env.participants import registry
+    from wrist_env.solver import simulate
+    from wrist_env.solver.outputs import cardan_deg, result_to_dict
+
+    for folder in args.folder or []:
+        registry.add_folder(folder)
+    if args.frames is not None and args.frames < 1:
+        raise SystemExit("wrist-bench simulate: --frames must be at least 1")
+    start = time.perf_counter()
+    model = registry.load_model(args.participant)
+    load_seconds = time.perf_counter() - start
+    d = load_design(args.design, args.participant)
+    driver = make_driver(model, args.motion, args.frames, args.flexion, args.extension)
+    compile_seconds = None
+    if args.warm_up:
+        start = time.perf_counter()
+        simulate.simulate(model, d, make_driver(model, args.motion, 1, 0.0, 0.0))
+        compile_seconds = time.perf_counter() - start
+    start = time.perf_counter()
+    result = simulate.simulate(model, d, driver)
+    wall = time.perf_counter() - start
+    if args.json:
+        out = {"participant": model.name, "motion": args.motion, "design": args.design,
+               "wall_seconds": round(wall, 4),
+               "compile_seconds": None if compile_seconds is None else round(compile_seconds, 4),
+               "load_seconds": round(load_seconds, 4)}
+        out.update(result_to_dict(result, model))
+        print(json.dumps(out, indent=1, allow_nan=False))
+        return 0 if result.ok else 1
+    flex = cardan_deg(result.poses)[..., 0].round(2) + 0.0  # + 0.0: no "-0.00"
+    c, s, l = (BONES.index(b) for b in ("capitate", "scaphoid", "lunate"))
+    rs = PAIRS.index("radioscaphoid")
+    print(f"{model.name}, {args.motion} motion, design {args.design}: flexion (+) about the RCS z axis, deg")
+    print(f"{'frame':>5}  {'capitate':>8}  {'scaphoid':>8}  {'lunate':>8}  {'RS mean MPa':>11}  {'RS peak MPa':>11}")
+    for f in range(len(result.poses)):
+        print(f"{f:>5}  {flex[f, c]:8.2f}  {flex[f, s]:8.2f}  {flex[f, l]:8.2f}  "
+              f"{result.contact[f, rs, 0]:11.3f}  {result.contact[f, rs, 1]:11.3f}")
+    timing = f"simulate {wall:.3f} s" + ("" if compile_seconds is None else f" (warm-up {compile_seconds:.3f} s)")
+    print(f"status: {result.message}; {timing}; model load {load_seconds:.2f} s")
+    return 0 if result.ok else 1
+
+
 def _figure(args) -> int:
     from wrist_env import figures
 
@@ -51,6 +137,10 @@ def _figure(args) -> int:
         path = figures.model_figure(args.participant or "P1", out)
     elif args.kind == "annotations":
         path = figures.annotations_figure(out)
+    elif args.kind == "pressure":
+        path = figures.pressure_figure(args.participant or "P1", out, static=args.static)
+    elif args.kind == "kinematics":
+        path = figures.kinematics_figure(args.participant or "P1", out)
     else:
         raise SystemExit(f"unknown figure {args.kind!r}")
     print(path)
@@ -72,10 +162,39 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("--folder", action="append", help="register this participant folder first")
     s.set_defaults(run=_build)
 
-    s = sub.add_parser("figure", help="write a figure (PNG)")
-    s.add_argument("kind", choices=["model", "annotations"])
+    s = sub.add_parser(
+        "simulate", help="simulate a participant and print the per-frame outputs",
+        description="Simulate one participant and design; print per-frame kinematics, contact, ligament "
+                    "forces and the wall time of the simulate call. The first call in a fresh environment "
+                    "includes Numba compilation (later calls read Numba's on-disk cache; each new process "
+                    "still pays ~0.2 s to load it): --warm-up runs a one-frame simulation first and reports "
+                    "its time as compile_seconds, so that wall_seconds is the solver alone.")
+    s.add_argument("participant")
+    s.add_argument("--motion", choices=["idealized", "static"], default="idealized",
+                   help="idealized: capitate swept from --flexion to --extension about the RCS z axis under a "
+                        "small compressive load (default); static: capitate held at neutral (experimental "
+                        "driver with identity transforms)")
+    s.add_argument("--design", default="population",
+                   help="'population' (Table 2 means, default), 'truth' (a built-in participant's hidden "
+                        "ground truth) or a JSON file of a design (Design.as_dict)")
+    s.add_argument("--frames", type=int, help="number of output frames (default 17 idealized, 3 static)")
+    s.add_argument("--flexion", type=float, default=40.0, help="idealized: first frame's flexion, deg (default 40)")
+    s.add_argument("--extension", type=float, default=40.0, help="idealized: last frame's extension, deg (default 40)")
+    s.add_argument("--warm-up", action="store_true", help="run a one-frame simulation first (compile_seconds)")
+    s.add_argument("--json", action="store_true", help="print all per-frame outputs as JSON")
+    s.add_argument("--folder", action="append", help="register this participant folder first")
+    s.set_defaults(run=_simulate)
+
+    s = sub.add_parser("figure", help="write a figure (PNG)",
+                       description="model: bones, cartilage, ligaments; annotations: the template; pressure: "
+                                   "contact pressure at the neutral pose viewed from distal (population design); "
+                                   "kinematics: scaphoid and lunate rotations over an idealized sweep.")
+    s.add_argument("kind", choices=["model", "annotations", "pressure", "kinematics"])
     s.add_argument("participant", nargs="?")
     s.add_argument("--out", help="output PNG path")
+    s.add_argument("--static", action="store_true",
+                   help="pressure: capitate held at neutral without load, instead of the 0° frame of the "
+                        "idealized sweep (10 N compressive load)")
     s.set_defaults(run=_figure)
     return p
 

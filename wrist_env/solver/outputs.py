@@ -48,17 +48,16 @@ def pair_slice(model: Model, pair: str) -> slice:
 
 
 def cardan_deg(poses) -> np.ndarray:
-    """Cardan Z-X-Y angles (deg) of poses (..., 4, 4) or rotations (..., 3, 3): columns rotation about
-    z (flexion +, radial axis), x (volar axis, ulnar deviation +), y (long axis)."""
-    # TODO: use wrist_env.frames (4×4 ↔ 6 DOF, Cardan Z-X-Y) once it exists.
-    from scipy.spatial.transform import Rotation
+    """Cardan Z-X-Y angles (deg, `wrist_env.frames.cardan_angles`) of poses (..., 4, 4) or rotations
+    (..., 3, 3): Flex/Ext (about z, flexion +), UlnD/RadD (ulnar +), Pro/Sup; NaN where a pose is not finite."""
+    from wrist_env.frames import cardan_angles
 
     R = np.asarray(poses, dtype=np.float64)[..., :3, :3]
     flat = R.reshape(-1, 3, 3)
     out = np.full((len(flat), 3), np.nan)
     ok = np.isfinite(flat).all(axis=(1, 2))
     if ok.any():
-        out[ok] = Rotation.from_matrix(flat[ok]).as_euler("ZXY", degrees=True)
+        out[ok] = cardan_angles(flat[ok])
     return out.reshape(R.shape[:-2] + (3,))
 
 
