@@ -59,6 +59,8 @@ NAMES = tuple(
     + [f"{n}.injury" for n in INJURABLE]
 )
 """Variable names in vector order: 11 stiffnesses, 11 reference strains, 5 injury scalars."""
+INTACT_INJURY = {name: 1.0 for name in NAMES[N_MATERIAL:]}
+"""Normalized injury scalars of intact ligaments: what calibration freezes."""
 
 MEAN = np.concatenate([[l.stiffness_mean for l in LIGAMENTS], np.full(N_LIGAMENTS, REFERENCE_STRAIN_MEAN), np.ones(len(INJURABLE))])
 SD = np.concatenate([[l.stiffness_sd for l in LIGAMENTS], np.full(N_LIGAMENTS, REFERENCE_STRAIN_SD), np.full(len(INJURABLE), np.nan)])

@@ -80,8 +80,6 @@ def test_pressure_map_matches_the_result_contact_force(p1, sweep):
         np.testing.assert_allclose(p[s].max(), sweep.contact[f, RS, 1], rtol=2e-2)
 
 
-@pytest.mark.xfail(strict=True, reason="solver: Result.contact is evaluated one explicit step before Result.poses "
-                                       "(kernel.run records the poses after _step moved the bones); ~1e-3 apart")
 def test_pressure_map_matches_the_result_contact_force_exactly(p1, sweep):
     for f in range(len(sweep.poses)):
         p = pressure_map(p1, sweep.poses[f])

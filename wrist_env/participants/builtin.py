@@ -4,7 +4,8 @@ No 4DCT ships, so each built-in participant is the anatomy template under a
 smooth participant-specific warp and isotropic scale, with hidden
 ground-truth ligament properties drawn from Table 2's distributions (fixed
 seed). `experiments/make_participants.py` writes the data files under
-`participants/data/<name>/` (`participant.json`, `truth.json`).
+`participants/data/<name>/` (`participant.json`, `truth.json`);
+`experiments/make_trials.py` their trials (`trials.json`, `trials/*.csv`).
 """
 
 from __future__ import annotations
@@ -52,6 +53,17 @@ def info(name: str) -> BuiltinInfo:
 def truth(name: str) -> Design:
     """The hidden ground-truth ligament design of a built-in participant."""
     return Design.from_dict(_data(name, "truth.json"))
+
+
+@functools.lru_cache(maxsize=len(BUILTIN))
+def trials(name: str) -> dict:
+    """The participant's synthetic trials {name: Trial} (see `experiments/make_trials.py`)."""
+    from wrist_env.trial import read_trial_csv
+
+    meta = _data(name, "trials.json")
+    root = importlib.resources.files("wrist_env.participants") / "data" / name
+    return {t: read_trial_csv(root / entry["file"], t, entry["role"], n_frames=meta["frames"])
+            for t, entry in meta["trials"].items()}
 
 
 @functools.lru_cache(maxsize=len(BUILTIN))

@@ -54,6 +54,26 @@ def bones(name: str) -> dict:
     return {b: BoneSurface(b, v, f, np.ones(len(v), bool)) for b, (v, f) in source.bones.items()}
 
 
+def trials(name: str) -> dict:
+    """The participant's trials {name: Trial}; at least one has role "calibrate"."""
+    if name in builtin.BUILTIN:
+        return builtin.trials(name)
+    if name not in _FOLDERS:
+        raise ParticipantError(f"unknown participant {name!r}; known: {list(participants())}")
+    from wrist_env.participants.folder import load_participant_folder
+
+    return load_participant_folder(_FOLDERS[name]).trials
+
+
+def trial(name: str, role: str):
+    """The participant's first trial with `role` ("calibrate" or "validate")."""
+    found = [t for t in trials(name).values() if t.role == role]
+    if not found:
+        raise ParticipantError(f"participant {name!r} has no trial with role {role!r}; its trials: "
+                               f"{ {k: t.role for k, t in trials(name).items()} }")
+    return found[0]
+
+
 def load_model(name: str, params: BuildParams | None = None, *, cache: bool = True) -> Model:
     """The participant's model, built on first use and cached by the hash of its inputs."""
     params = params or BuildParams()
@@ -67,4 +87,4 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
     return model
 
 
-__all__ = ["BONES", "add_folder", "bones", "cache_dir", "load_model", "participants"]
+__all__ = ["BONES", "add_folder", "bones", "cache_dir", "load_model", "participants", "trial", "trials"]

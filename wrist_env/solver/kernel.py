@@ -17,6 +17,7 @@ from wrist_env.solver.rigid import interpolate_pose, matrix_to_rotvec, orthonorm
 
 SCAPHOID, LUNATE, CAPITATE = 2, 3, 4
 N_BONES, N_PAIRS, N_LIGAMENTS = 5, 5, 11
+RSC = 3  # Table 2 index of the radioscaphocapitate ligament
 OK, FAILED_NAN, FAILED_DIVERGED = 0, 1, 2
 
 
@@ -73,18 +74,12 @@ def _fire(v, w, nv, F, T, node_force, mem, st, fire):
 
 
 @njit(cache=True, error_model="numpy")
-def _step(R, x, v, w, nodes, nv, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st,
-          active, n_active, F, T, node_force, stats, bundle, capR, capx, load, step_index, fire):
-    """One explicit step with the capitate at target (capR, capx), or, for the loaded
-    driver, at rotation capR under a compressive `load` (N, along +y); returns
-    internal energy (N·mm)."""
+def _forces(R, x, v, w, nodes, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st,
+            active, n_active, F, T, node_force, stats, bundle, load, rebuild):
+    """Forces F (N), torques T (N·mm), contact stats and bundle forces at the current
+    state; rebuilds the active contact set first if `rebuild`; returns internal energy (N·mm)."""
     com0 = bod.com0
-    R[CAPITATE] = capR
-    if st.driver == 0:
-        x[CAPITATE, 0], x[CAPITATE, 1], x[CAPITATE, 2] = capx
-        v[CAPITATE] = 0.0
-    w[CAPITATE] = 0.0
-    if step_index % st.rebuild_every == 0:
+    if rebuild:
         rebuild_active(R, x, com0, grids, st.active_band_mm, active, n_active)
     place_nodes(R, x, com0, mem, nodes)
     F[:] = 0.0
@@ -94,9 +89,25 @@ def _step(R, x, v, w, nodes, nv, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K
     energy += fibre_forces(R, x, v, w, com0, fib, f_l0, f_K, st.fibre_damping_s, F, T, bundle)
     e_mem, rsc = membrane_forces(R, x, com0, mem, nodes, m_l0, m_K, st.membrane_contact_stiffness, F, T, node_force)
     energy += e_mem
-    bundle[3] += rsc
+    bundle[RSC] += rsc
     if st.driver == 1:
         F[CAPITATE, 1] += load
+    return energy
+
+
+@njit(cache=True, error_model="numpy")
+def _step(R, x, v, w, nodes, nv, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st,
+          active, n_active, F, T, node_force, stats, bundle, capR, capx, load, step_index, fire):
+    """One explicit step with the capitate at target (capR, capx), or, for the loaded
+    driver, at rotation capR under a compressive `load` (N, along +y); returns
+    internal energy (N·mm) before the step."""
+    R[CAPITATE] = capR
+    if st.driver == 0:
+        x[CAPITATE, 0], x[CAPITATE, 1], x[CAPITATE, 2] = capx
+        v[CAPITATE] = 0.0
+    w[CAPITATE] = 0.0
+    energy = _forces(R, x, v, w, nodes, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st,
+                     active, n_active, F, T, node_force, stats, bundle, load, step_index % st.rebuild_every == 0)
     if st.fire_alpha0 > 0.0:
         _fire(v, w, nv, F, T, node_force, mem, st, fire)
     dt = st.dt
@@ -224,7 +235,7 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x, f
         axis = matrix_to_rotvec(Rb @ Ra.T)
         shift = xb - xa
         k = 0
-        while True:
+        while k < ramp + most:
             s = smoothstep((k + 1) / ramp) if ramp > 0 else 1.0
             capx = interpolate_pose(Ra, xa, axis, capR, shift, s)
             load = la + s * (lb - la)
@@ -232,7 +243,7 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x, f
                            active, n_active, F, T, node_force, stats, bundle, capR, capx, load, step, fire)
             step += 1
             k += 1
-            if k >= ramp + most or (k >= ramp + st.min_hold_steps and _converged(F, T, bundle, st)):
+            if k >= ramp + st.min_hold_steps and _converged(F, T, bundle, st):
                 break
         taken += k
         bad = False
@@ -253,6 +264,9 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x, f
             return
         if f < 0:
             continue
+        # outputs at the state reached (the last step's forces were those before it)
+        energy = _forces(R, x, v, w, nodes, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st,
+                         active, n_active, F, T, node_force, stats, bundle, lb, True)
         for b in range(N_BONES):
             poses[f, b, :3, :3] = R[b]
             poses[f, b, :3, 3] = x[b] - R[b] @ com0[b]

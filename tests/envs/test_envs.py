@@ -1,0 +1,82 @@
+"""The Gymnasium environments: Gymnasium's own checker, the native vector env, the cost at truth."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import wrist_env
+from wrist_env import design
+from wrist_env.envs.task import task
+from wrist_env.envs.wrappers import FreezeVariables
+from wrist_env.participants import builtin
+
+IDS = wrist_env.registered_ids()
+
+
+def test_every_builtin_participant_has_three_ids():
+    for name in builtin.BUILTIN:
+        for motion in ("Calibrate", "Validate", "Idealized"):
+            assert f"wrist_env/{motion}-{name}-v0" in IDS
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_check_env(env_id):
+    env = gym.make(env_id)
+    check_env(env.unwrapped, skip_render_check=True)
+    obs, _ = env.reset(seed=1)
+    _, reward, terminated, truncated, info = env.step(np.zeros(27, dtype=np.float32))
+    assert terminated and not truncated
+    assert np.isfinite(reward) and not info["failed"]
+
+
+def test_vector_entry_point_matches_single_steps():
+    rng = np.random.default_rng(0)
+    actions = rng.uniform(-0.6, 0.6, (8, 27)).astype(np.float32)
+    vec = gym.make_vec("wrist_env/Calibrate-P1-v0", num_envs=8, vectorization_mode="vector_entry_point")
+    vec.reset(seed=0)
+    _, rewards, terminated, _, infos = vec.step(actions)
+    assert terminated.all()
+    env = gym.make("wrist_env/Calibrate-P1-v0")
+    single = []
+    for a in actions:
+        env.reset(seed=0)
+        single.append(env.step(a)[1])
+    np.testing.assert_array_equal(rewards, single)
+    assert infos["failed"].shape == (8,)
+
+
+@pytest.mark.parametrize("name", builtin.BUILTIN)
+def test_truth_beats_population_but_is_not_perfect(name):
+    calibrate = task(name, "calibrate")
+    at_truth = calibrate.evaluate(builtin.truth(name)).cost
+    at_population = calibrate.evaluate(design.population()).cost
+    assert 0.1 < at_truth < at_population, (at_truth, at_population)
+
+
+def test_idealized_reward_is_zero_at_truth():
+    """The idealized task's reference is the hidden truth's own sweep: the truth scores exactly 0."""
+    evaluation = task("P1", "idealized").evaluate(builtin.truth("P1"))
+    assert evaluation.cost < 1e-9 and not evaluation.failed
+
+
+def test_out_of_range_action_is_a_clear_error():
+    env = gym.make("wrist_env/Calibrate-P1-v0")
+    env.reset()
+    bad = np.zeros(27, dtype=np.float32)
+    bad[2] = 1.5
+    with pytest.raises(ValueError, match="SLIL_d.stiffness=1.5"):
+        env.step(bad)
+    with pytest.raises(ValueError, match=r"shape \(27,\)"):
+        env.step(np.zeros(26))
+
+
+def test_freeze_wrapper_keeps_ligaments_intact():
+    env = FreezeVariables(gym.make("wrist_env/Calibrate-P1-v0"))
+    assert env.action_space.shape == (22,)
+    full = env.action(np.full(22, -1.0, dtype=np.float32))
+    assert np.all(full[22:] == 1.0) and np.all(full[:22] == -1.0)
+    env.reset()
+    _, reward, terminated, _, info = env.step(np.zeros(22, dtype=np.float32))
+    expected = task("P1", "calibrate").evaluate(design.population())
+    assert reward == expected.reward

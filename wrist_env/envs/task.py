@@ -1,0 +1,121 @@
+"""One calibration task: a participant model, a capitate driver and the reference kinematics.
+
+The thin layer between the environments (and the runners) and the solver:
+designs in, rewards and JSON-ready outputs out. Simulation is `simulate` /
+`simulate_batch`; the cost is `wrist_env.cost`; nothing is recomputed here.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+
+from wrist_env import design as design_vars
+from wrist_env.cost import COST_BONES, CostWeights, kinematic_cost
+from wrist_env.design import LIGAMENT_NAMES, Design
+from wrist_env.model import BONES, PAIRS, Model
+from wrist_env.participants import builtin, registry
+from wrist_env.solver.arrays import SolverSettings
+from wrist_env.solver.simulate import Driver, Result, experimental, idealized, simulate, simulate_batch
+
+MOTIONS = ("calibrate", "validate", "idealized")
+CONTACT_FIELDS = ("mean_pressure_mpa", "peak_pressure_mpa", "area_mm2", "force_n")
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """The outcome of one design: reward = −cost; `info` is deterministic and NaN-free."""
+
+    reward: float
+    cost: float
+    failed: bool
+    info: dict
+    result: Result
+
+
+class Task:
+    """Participant × motion: "calibrate" (unresisted trial), "validate" (held-out resisted
+    trial) or "idealized" (flexion–extension sweep; reference = the hidden truth's
+    sweep for built-in participants, none for user participants → reward 0)."""
+
+    def __init__(self, participant: str, motion: str = "calibrate", *, settings: SolverSettings | None = None,
+                 weights: CostWeights | None = None):
+        if motion not in MOTIONS:
+            raise ValueError(f"motion must be one of {MOTIONS}, but got {motion!r}")
+        self.participant, self.motion = participant, motion
+        self.settings, self.weights = settings, weights
+        self.model: Model = registry.load_model(participant)
+        self.driver, self.reference = self._driver_and_reference()
+        self.reference_points = self.model.com[[BONES.index(b) for b in COST_BONES]]
+
+    def _driver_and_reference(self) -> tuple[Driver, np.ndarray | None]:
+        if self.motion == "idealized":
+            driver = idealized(self.model)
+            if self.participant not in builtin.BUILTIN:
+                return driver, None
+            truth = simulate(self.model, builtin.truth(self.participant), driver, self.settings)
+            return driver, _cost_poses(truth.poses)
+        trial = registry.trial(self.participant, "calibrate" if self.motion == "calibrate" else "validate")
+        driver = experimental(self.model, trial.pose("capitate"))
+        return driver, np.stack([trial.pose(b) for b in COST_BONES])
+
+    def evaluate(self, design: Design) -> Evaluation:
+        """Simulate one design and score it."""
+        return self._score(design, simulate(self.model, design, self.driver, self.settings))
+
+    def evaluate_batch(self, designs) -> list[Evaluation]:
+        """Simulate many designs at once (Numba prange); the same numbers as one at a time."""
+        designs = list(designs)
+        return [self._score(d, r) for d, r in zip(designs, simulate_batch(self.model, designs, self.driver, self.settings))]
+
+    def evaluate_action(self, action) -> Evaluation:
+        return self.evaluate(design_vars.from_action(action))
+
+    def _score(self, design: Design, result: Result) -> Evaluation:
+        if self.reference is None:
+            cost, report = 0.0, None
+        else:
+            report = kinematic_cost(_cost_poses(result.poses), self.reference, reference_points=self.reference_points,
+                                    weights=self.weights)
+            cost = float(report.total)
+        failed = not result.ok or (report is not None and report.failed)
+        return Evaluation(-cost, cost, failed, outputs(result, report), result)
+
+
+def _cost_poses(poses: np.ndarray) -> np.ndarray:
+    """(n_frames, 5, 4, 4) → (2, n_frames, 4, 4) for the cost's bones."""
+    return np.stack([poses[:, BONES.index(b)] for b in COST_BONES])
+
+
+def outputs(result: Result, report=None) -> dict:
+    """JSON-ready, NaN-free per-frame outputs (a failed run's arrays are zeros, `failed` True)."""
+    def clean(a):
+        return np.nan_to_num(np.asarray(a, dtype=np.float64), nan=0.0)
+
+    info = {
+        "failed": not result.ok,
+        "status": result.message,
+        "poses": clean(result.poses),
+        "contact": {pair: {field: clean(result.contact[:, p, k]) for k, field in enumerate(CONTACT_FIELDS)}
+                    for p, pair in enumerate(PAIRS)},
+        "bundle_force_n": {lig: clean(result.bundle_force[:, i]) for i, lig in enumerate(LIGAMENT_NAMES)},
+        "kinetic_energy_nmm": clean(result.energy[:, 0]),
+        "internal_energy_nmm": clean(result.energy[:, 1]),
+        "steps": np.asarray(result.steps, dtype=np.int64),
+    }
+    if report is not None:
+        r = report.to_dict()
+        info["cost"] = r["total"]
+        info["failed"] = info["failed"] or r["failed"]
+        info["error_p75"] = r["error_p75"]
+        info["rmse"] = r["rmse"]
+        info["cost_terms"] = r["terms"]
+    return info
+
+
+@functools.lru_cache(maxsize=32)
+def task(participant: str, motion: str) -> Task:
+    """A shared Task per participant and motion with default settings (models are big; build once)."""
+    return Task(participant, motion)

@@ -1,0 +1,82 @@
+"""Gymnasium environments: one step is one simulation of a 27-variable ligament design.
+
+`reset` returns a fixed context observation (the population-mean design in
+normalized units, zeros); `step(action)` maps the action in [-1, 1]^27 to a
+design (`wrist_env.design`), simulates it and returns reward = −cost,
+`terminated=True`. `WristVectorEnv` is the native batched form over
+`simulate_batch`: a population of designs is one call.
+"""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+from gymnasium.vector import AutoresetMode, VectorEnv
+
+from wrist_env import design
+from wrist_env.envs.task import task
+
+OBSERVATION = np.zeros(design.N_DESIGN, dtype=np.float32)
+
+
+def _spaces():
+    box = gym.spaces.Box(-1.0, 1.0, (design.N_DESIGN,), dtype=np.float32)
+    return box, gym.spaces.Box(-1.0, 1.0, (design.N_DESIGN,), dtype=np.float32)
+
+
+class WristEnv(gym.Env):
+    """Calibrate, validate or sweep one participant (see `wrist_env.envs.task.Task`).
+
+    participant: a registered participant name; motion: "calibrate",
+    "validate" or "idealized". info: cost, per-DOF 75th-percentile errors and
+    RMSE (mm, deg), per-frame contact (MPa, mm², N), bundle forces (N),
+    energies (N·mm), poses, and `failed` — deterministic, NaN-free.
+    """
+
+    metadata = {"render_modes": []}
+
+    def __init__(self, participant: str = "P1", motion: str = "calibrate"):
+        self.participant, self.motion = participant, motion
+        self.task = task(participant, motion)
+        self.action_space, self.observation_space = _spaces()
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        return OBSERVATION.copy(), {}
+
+    def step(self, action):
+        evaluation = self.task.evaluate_action(design.check_action(action))
+        return OBSERVATION.copy(), float(evaluation.reward), True, False, evaluation.info
+
+
+class WristVectorEnv(VectorEnv):
+    """`num_envs` designs per `step`, simulated in one batched call (same numbers as `WristEnv`)."""
+
+    metadata = {"autoreset_mode": AutoresetMode.SAME_STEP, "render_modes": []}
+
+    def __init__(self, num_envs: int = 1, participant: str = "P1", motion: str = "calibrate", **_):
+        self.num_envs = int(num_envs)
+        self.participant, self.motion = participant, motion
+        self.task = task(participant, motion)
+        self.single_action_space, self.single_observation_space = _spaces()
+        self.action_space = gym.vector.utils.batch_space(self.single_action_space, self.num_envs)
+        self.observation_space = gym.vector.utils.batch_space(self.single_observation_space, self.num_envs)
+
+    def _observations(self):
+        return np.tile(OBSERVATION, (self.num_envs, 1))
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        return self._observations(), {}
+
+    def step(self, actions):
+        actions = np.asarray(actions)
+        if actions.shape != (self.num_envs, design.N_DESIGN):
+            raise ValueError(f"actions must have shape ({self.num_envs}, {design.N_DESIGN}), but got {actions.shape}")
+        evaluations = self.task.evaluate_batch(design.from_action(design.check_action(a)) for a in actions)
+        infos = {}
+        for i, e in enumerate(evaluations):
+            infos = self._add_info(infos, e.info, i)
+        rewards = np.array([e.reward for e in evaluations], dtype=np.float64)
+        done = np.ones(self.num_envs, dtype=bool)
+        return self._observations(), rewards, done, np.zeros(self.num_envs, dtype=bool), infos
