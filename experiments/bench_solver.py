@@ -2,9 +2,8 @@
 
 Prints, for P1 (or the participant named on the command line):
 - milliseconds per simulation on one core: the idealized flexion–extension
-  sweep (17 frames, ±40°) with the population design, and a 15-frame
-  experimental trial (one motion cycle 30° flexion → 30° extension → back,
-  the capitate's 6 DOF prescribed from an idealized run of that cycle);
+  sweep (17 frames, ±40°) with the population design, and the participant's
+  15-frame calibration trial (the capitate's 6 DOF prescribed);
 - simulations per second batched (`simulate_batch`, Numba prange) on all
   cores, for Monte Carlo designs (Table 2 normals truncated at ±3 SD, each
   injurable ligament torn with probability 0.3);
@@ -26,7 +25,7 @@ import numpy as np
 from numba import njit, get_num_threads
 
 from wrist_env import design
-from wrist_env.model import BONES
+from wrist_env.participants import registry
 from wrist_env.participants.registry import load_model
 from wrist_env.solver import arrays
 from wrist_env.solver.contact import sdf_lookup_scalar
@@ -34,7 +33,6 @@ from wrist_env.solver.forces import pair_transform, rebuild_active
 from wrist_env.solver.simulate import experimental, idealized, simulate, simulate_batch
 
 PREPRINT_SECONDS = 45.0
-CYCLE_DEG = 30.0 * np.cos(np.linspace(0.0, 2.0 * np.pi, 15))
 
 
 def median_seconds(fn, repeats: int = 9) -> float:
@@ -47,10 +45,9 @@ def median_seconds(fn, repeats: int = 9) -> float:
     return float(np.median(times))
 
 
-def trial_driver(model):
-    """A 15-frame experimental driver: the capitate poses of an idealized run of one motion cycle."""
-    run = simulate(model, design.population(), idealized(model, angles_deg=CYCLE_DEG))
-    return experimental(model, run.poses[:, BONES.index("capitate")])
+def trial_driver(name: str, model):
+    """The participant's 15-frame calibration trial: the capitate's 6 DOF prescribed."""
+    return experimental(model, registry.trial(name, "calibrate").pose("capitate"))
 
 
 def monte_carlo_designs(n: int, seed: int = 0):
@@ -98,7 +95,7 @@ def efficiency(model, steps_per_sim: float, seconds_per_sim: float) -> tuple[flo
 def main(name: str) -> None:
     model = load_model(name)
     pop = design.population()
-    sweep, trial = idealized(model), trial_driver(model)
+    sweep, trial = idealized(model), trial_driver(name, model)
     rows = []
     for label, driver in (("idealized sweep, 17 frames", sweep), ("15-frame trial", trial)):
         seconds = median_seconds(lambda: simulate(model, pop, driver))
