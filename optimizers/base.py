@@ -1,0 +1,126 @@
+"""The calibrator interface: ask/tell over batches, one result type.
+
+A calibrator minimizes f: [lower, upper]^dim → R within a budget of
+evaluations. `ask()` proposes a batch (k, dim) — a whole CMA-ES population is
+one batch, so one vector-env call — never more points than the budget has
+left; `tell(x, y)` returns their values. `minimize` drives the loop.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class OptimizeResult:
+    """SciPy's field names plus the history.
+
+    x (dim,) the best point; fun its value; nfev evaluations used; success,
+    message as SciPy's; history_x (nfev, dim) and history_fun (nfev,) every
+    evaluation in the order told.
+    """
+
+    x: np.ndarray
+    fun: float
+    nfev: int
+    success: bool
+    message: str
+    history_x: np.ndarray = field(repr=False)
+    history_fun: np.ndarray = field(repr=False)
+
+
+class Optimizer(ABC):
+    """Base of every calibrator: bounds, budget, seed, bookkeeping of what was told.
+
+    Subclasses implement `_ask(n_max)` → (k, dim) with 1 ≤ k ≤ n_max and
+    `_tell(x, y)`; they read `self.rng` (a seeded numpy Generator) and the
+    bounds `self.lower`, `self.upper` (dim,).
+    """
+
+    name: str = ""
+
+    def __init__(self, dim: int, budget: int, seed: int = 0, lower=-1.0, upper=1.0, **options):
+        if dim < 1 or budget < 1:
+            raise ValueError(f"dim and budget must be ≥ 1, but got dim={dim}, budget={budget}")
+        self.dim, self.budget, self.seed = int(dim), int(budget), int(seed)
+        self.lower = np.broadcast_to(np.asarray(lower, dtype=np.float64), (self.dim,)).copy()
+        self.upper = np.broadcast_to(np.asarray(upper, dtype=np.float64), (self.dim,)).copy()
+        if not np.all(self.lower < self.upper):
+            raise ValueError(f"bounds must satisfy lower < upper, but got {self.lower} and {self.upper}")
+        self.options = dict(options)
+        self.rng = np.random.default_rng(self.seed)
+        self._xs: list[np.ndarray] = []
+        self._ys: list[float] = []
+        self._pending = 0
+
+    @property
+    def nfev(self) -> int:
+        return len(self._ys)
+
+    @property
+    def remaining(self) -> int:
+        return self.budget - self.nfev
+
+    @property
+    def done(self) -> bool:
+        return self.remaining <= 0 or self._stopped()
+
+    def _stopped(self) -> bool:
+        """True when the method has nothing more to propose (before the budget)."""
+        return False
+
+    def ask(self) -> np.ndarray:
+        """A batch of points (k, dim) inside the bounds, k ≤ the remaining budget."""
+        if self.done:
+            raise RuntimeError(f"{self.name}: the budget of {self.budget} evaluations is spent")
+        x = np.atleast_2d(np.asarray(self._ask(self.remaining), dtype=np.float64))
+        if x.shape[1] != self.dim or not 1 <= len(x) <= self.remaining:
+            raise RuntimeError(f"{self.name}: asked {x.shape}, but at most ({self.remaining}, {self.dim}) is allowed")
+        x = np.clip(x, self.lower, self.upper)
+        self._pending = len(x)
+        return x
+
+    def tell(self, x, y) -> None:
+        """The values y (k,) of the points x (k, dim) last asked."""
+        x = np.atleast_2d(np.asarray(x, dtype=np.float64))
+        y = np.atleast_1d(np.asarray(y, dtype=np.float64))
+        if len(x) != len(y) or len(x) != self._pending:
+            raise ValueError(f"{self.name}: tell {len(y)} values for the {self._pending} points asked")
+        y = np.where(np.isfinite(y), y, np.inf)
+        self._pending = 0
+        self._xs.extend(x)
+        self._ys.extend(y.tolist())
+        self._tell(x, y)
+
+    def result(self) -> OptimizeResult:
+        if not self._ys:
+            raise RuntimeError(f"{self.name}: nothing evaluated yet")
+        ys = np.array(self._ys)
+        best = int(np.argmin(ys))
+        stopped = self._stopped() and self.remaining > 0
+        message = "the method converged before the budget" if stopped else f"budget of {self.budget} evaluations used"
+        return OptimizeResult(np.array(self._xs[best]), float(ys[best]), self.nfev, bool(np.isfinite(ys[best])),
+                              message, np.array(self._xs), ys)
+
+    @abstractmethod
+    def _ask(self, n_max: int) -> np.ndarray: ...
+
+    @abstractmethod
+    def _tell(self, x: np.ndarray, y: np.ndarray) -> None: ...
+
+
+def minimize(optimizer: Optimizer, fun_batch, callback=None) -> OptimizeResult:
+    """Run `optimizer` on `fun_batch` ((k, dim) → (k,)) until its budget is spent or it stops.
+
+    callback(x, y) is called after every batch (e.g. to log evaluations).
+    """
+    while not optimizer.done:
+        x = optimizer.ask()
+        y = np.asarray(fun_batch(x), dtype=np.float64)
+        optimizer.tell(x, y)
+        if callback is not None:
+            callback(x, y)
+    return optimizer.result()

@@ -1,0 +1,59 @@
+"""Calibrators by name: a decorator for ours, the entry-point group `wrist_env.optimizers` for others'.
+
+A third-party package adds one without touching wrist-env::
+
+    [project.entry-points."wrist_env.optimizers"]
+    my-method = "my_package.module:MyOptimizer"
+"""
+
+from __future__ import annotations
+
+from importlib.metadata import entry_points
+
+ENTRY_POINT_GROUP = "wrist_env.optimizers"
+_REGISTRY: dict[str, type] = {}
+
+
+class UnknownOptimizerError(KeyError):
+    """An optimizer name that is not registered (the message lists the valid ones)."""
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
+def register(name: str):
+    """Class decorator: make an `Optimizer` subclass available under `name`."""
+    def decorate(cls):
+        if name in _REGISTRY and _REGISTRY[name] is not cls:
+            raise ValueError(f"optimizer name {name!r} is already taken by {_REGISTRY[name].__qualname__}")
+        cls.name = name
+        _REGISTRY[name] = cls
+        return cls
+    return decorate
+
+
+def _load_plugins() -> None:
+    for ep in entry_points(group=ENTRY_POINT_GROUP):
+        if ep.name not in _REGISTRY:
+            cls = ep.load()
+            register(ep.name)(cls)
+
+
+def available() -> tuple[str, ...]:
+    """Names of all registered calibrators: built-in and from the entry-point group, sorted."""
+    _load_plugins()
+    return tuple(sorted(_REGISTRY))
+
+
+def get(name: str) -> type:
+    """The calibrator class registered as `name`."""
+    if name not in _REGISTRY:
+        _load_plugins()
+    if name not in _REGISTRY:
+        raise UnknownOptimizerError(f"unknown optimizer {name!r}; available: {', '.join(available())}")
+    return _REGISTRY[name]
+
+
+def make(name: str, dim: int, budget: int, seed: int = 0, **options):
+    """An instance of the calibrator `name`."""
+    return get(name)(dim=dim, budget=budget, seed=seed, **options)
