@@ -41,42 +41,45 @@ TRANSLATION = slice(0, 3)
 ROTATION = slice(3, 6)
 CARDAN_SEQUENCE = "ZXY"  # SciPy upper case = intrinsic: z, then x', then y''
 EXPRESSED_IN = ("bone", "rcs")
-ORTHONORMAL_TOL = 1e-4  # max |RᵀR − I|, as wrist_env.trial
+ORTHONORMAL_TOL = 1e-4  # max |RᵀR − I|
 BOTTOM_ROW_TOL = 1e-9
 
 
-def validate_poses(poses, name: str = "poses") -> np.ndarray:
-    """The poses as a float64 array of shape (..., 4, 4), or an InputError naming `name`, the entry and its value.
+def validate_poses(poses, name: str = "poses", *, error: type = InputError, where=None) -> np.ndarray:
+    """The poses as a float64 array of shape (..., 4, 4), or `error` naming `name`, the entry and its value.
 
     Rules: shape (..., 4, 4); finite; bottom row 0 0 0 1; rotation orthonormal
-    (max |RᵀR − I| <= 1e-4) and proper (det > 0).
+    (max |RᵀR − I| <= 1e-4) and proper (det > 0). where(index) names an entry
+    (default "entry (i, j)").
     """
     try:
         t = np.asarray(poses, dtype=np.float64)
     except (TypeError, ValueError) as exc:
-        raise InputError(f"{name}: must be an array of 4×4 transforms, but cannot be read as numbers: {exc}") from exc
+        raise error(f"{name}: must be an array of 4×4 transforms, but cannot be read as numbers: {exc}") from exc
     if t.ndim < 2 or t.shape[-2:] != (4, 4):
-        raise InputError(f"{name}: must have shape (..., 4, 4), but got {t.shape}.")
+        raise error(f"{name}: must have shape (..., 4, 4), but got {t.shape}.")
+    where = where or (lambda index: f"entry {_at(index)}")
     bad = ~np.isfinite(t)
     if bad.any():
         *index, r, c = np.argwhere(bad)[0]
-        raise InputError(f"{name}: must be finite, but entry {_at(index)} has m{r}{c}={t[(*index, r, c)]}.")
+        raise error(f"{name}: must be finite, but {where(index)} has m{r}{c}={t[(*index, r, c)]}.")
     bottom = np.abs(t[..., 3, :] - [0.0, 0.0, 0.0, 1.0]).max(axis=-1)
     if (bottom > BOTTOM_ROW_TOL).any():
         index = np.unravel_index(np.argmax(bottom), bottom.shape)
-        raise InputError(f"{name}: the bottom row must be 0 0 0 1, but entry {_at(index)} has {t[index][3].tolist()}.")
+        raise error(f"{name}: the bottom row must be 0 0 0 1, but {where(index)} has {t[index][3].tolist()}.")
     rot = t[..., :3, :3]
     deviation = np.abs(np.swapaxes(rot, -1, -2) @ rot - np.eye(3)).max(axis=(-2, -1))
     if (deviation > ORTHONORMAL_TOL).any():
         index = np.unravel_index(np.argmax(deviation), deviation.shape)
-        raise InputError(
+        raise error(
             f"{name}: rotations must be orthonormal (max |RᵀR − I| <= {ORTHONORMAL_TOL}), "
-            f"but entry {_at(index)} has max |RᵀR − I| = {deviation[index]:.3g}."
+            f"but {where(index)} has max |RᵀR − I| = {deviation[index]:.3g}."
         )
     det = np.linalg.det(rot)
     if (det <= 0).any():
         index = np.unravel_index(np.argmin(det), det.shape)
-        raise InputError(f"{name}: rotations must be proper (det = +1), but entry {_at(index)} has det = {det[index]:.6g}.")
+        raise error(f"{name}: rotations must be proper (det = +1), but {where(index)} has det = {det[index]:.6g} "
+                    f"(a reflection; mirror left wrists instead).")
     return t
 
 

@@ -19,13 +19,12 @@ import pandas as pd
 
 from wrist_env.anatomy.myosim import BONES
 from wrist_env.errors import TrialError
+from wrist_env.frames import validate_poses
 
 ROLES = ("calibrate", "validate", "other")
 REQUIRED_BONES = ("scaphoid", "lunate", "capitate")
 MATRIX_COLUMNS = tuple(f"m{r}{c}" for r in range(3) for c in range(4))
 COLUMNS = ("frame", "bone") + MATRIX_COLUMNS
-ORTHONORMAL_TOL = 1e-4  # max |RᵀR − I|
-BOTTOM_ROW_TOL = 1e-9
 METRES_TRANSLATION_MM = 0.5  # all |t| below this while rotations vary ...
 METRES_ROTATION_DEG = 5.0  # ... by more than this: translations are in metres
 MIRROR = np.diag([1.0, 1.0, -1.0, 1.0])
@@ -86,41 +85,18 @@ def validate_transforms(array, source: str, bones: tuple[str, ...] | None = None
     Rules: finite; bottom row 0 0 0 1; rotation orthonormal (max |RᵀR − I| <= 1e-4) and proper
     (det > 0); translations in mm, not metres. `bones` names axis 0 of a (n_bones, n_frames, 4, 4) array.
     """
-    t = np.asarray(array, dtype=np.float64)
-    if t.ndim < 2 or t.shape[-2:] != (4, 4):
-        raise TrialError(f"{source}: transforms must have shape (..., 4, 4), but got {t.shape}.")
+    shape = np.shape(array)
 
     def where(index) -> str:
         index = tuple(int(i) for i in index)
-        if t.ndim == 4 and bones is not None:
+        if len(shape) == 4 and bones is not None:
             return f"bone {bones[index[0]]!r} frame {index[1]}"
-        if t.ndim == 3:
+        if len(shape) == 3:
             return f"frame {index[0]}"
         return f"index {index}"
 
-    bad = ~np.isfinite(t)
-    if bad.any():
-        *index, r, c = np.argwhere(bad)[0]
-        raise TrialError(f"{source}: transforms must be finite, but {where(index)} has m{r}{c}={t[(*index, r, c)]}.")
-    bottom = np.abs(t[..., 3, :] - [0.0, 0.0, 0.0, 1.0]).max(axis=-1)
-    if (bottom > BOTTOM_ROW_TOL).any():
-        index = np.unravel_index(np.argmax(bottom), bottom.shape)
-        raise TrialError(f"{source}: the bottom row must be 0 0 0 1, but {where(index)} has {t[index][3].tolist()}.")
+    t = validate_poses(array, source, error=TrialError, where=where)
     rot = t[..., :3, :3]
-    deviation = np.abs(np.swapaxes(rot, -1, -2) @ rot - np.eye(3)).max(axis=(-2, -1))
-    if (deviation > ORTHONORMAL_TOL).any():
-        index = np.unravel_index(np.argmax(deviation), deviation.shape)
-        raise TrialError(
-            f"{source}: rotations must be orthonormal (max |RᵀR − I| <= {ORTHONORMAL_TOL}), "
-            f"but {where(index)} has max |RᵀR − I| = {deviation[index]:.3g}."
-        )
-    det = np.linalg.det(rot)
-    if (det < 0).any():
-        index = np.unravel_index(np.argmin(det), det.shape)
-        raise TrialError(
-            f"{source}: rotations must be proper (det = +1), but {where(index)} has det = {det[index]:.6g} "
-            f"(a reflection; mirror left wrists with side = \"left\" instead)."
-        )
     if t.ndim >= 3:
         # rotation of every frame relative to the first frame of the same bone
         relative = np.swapaxes(rot[..., :1, :, :], -1, -2) @ rot
