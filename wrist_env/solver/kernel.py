@@ -167,14 +167,22 @@ def _converged(F, T, bundle, st):
 
 
 @njit(cache=True, error_model="numpy")
-def _kinetic(v, w, nv, bod, st):
+def _kinetic(R, v, w, nv, bod, st):
+    """Kinetic energy (N·mm) of the free bodies and membrane nodes (mass-scaled)."""
     ke = 0.0
     for b in (SCAPHOID, LUNATE):
-        ke += 0.5 * bod.mass[b] * np.dot(v[b], v[b]) + 0.5 * np.dot(w[b], bod.inertia[b] @ w[b])
+        # body-frame angular velocity Rᵀw against the neutral-pose inertia
+        u0 = R[b, 0, 0] * w[b, 0] + R[b, 1, 0] * w[b, 1] + R[b, 2, 0] * w[b, 2]
+        u1 = R[b, 0, 1] * w[b, 0] + R[b, 1, 1] * w[b, 1] + R[b, 2, 1] * w[b, 2]
+        u2 = R[b, 0, 2] * w[b, 0] + R[b, 1, 2] * w[b, 1] + R[b, 2, 2] * w[b, 2]
+        I = bod.inertia[b]
+        rot = (u0 * (I[0, 0] * u0 + I[0, 1] * u1 + I[0, 2] * u2) + u1 * (I[1, 0] * u0 + I[1, 1] * u1 + I[1, 2] * u2)
+               + u2 * (I[2, 0] * u0 + I[2, 1] * u1 + I[2, 2] * u2))
+        ke += 0.5 * bod.mass[b] * (v[b, 0] ** 2 + v[b, 1] ** 2 + v[b, 2] ** 2) + 0.5 * rot
     if st.driver == 1:
-        ke += 0.5 * bod.mass[CAPITATE] * np.dot(v[CAPITATE], v[CAPITATE])
+        ke += 0.5 * bod.mass[CAPITATE] * (v[CAPITATE, 0] ** 2 + v[CAPITATE, 1] ** 2 + v[CAPITATE, 2] ** 2)
     for i in range(nv.shape[0]):
-        ke += 0.5 * st.node_mass * np.dot(nv[i], nv[i])
+        ke += 0.5 * st.node_mass * (nv[i, 0] ** 2 + nv[i, 1] ** 2 + nv[i, 2] ** 2)
     return ke
 
 
@@ -279,7 +287,7 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x, f
             contact[f, p, 2] = area
             contact[f, p, 3] = stats[p, C_FORCE]
         bundle_out[f] = bundle
-        energy_out[f, 0] = _kinetic(v, w, nv, bod, st)
+        energy_out[f, 0] = _kinetic(R, v, w, nv, bod, st)
         energy_out[f, 1] = energy
         residual_out[f, 0] = max(np.linalg.norm(F[SCAPHOID]), np.linalg.norm(F[LUNATE]))
         residual_out[f, 1] = max(np.linalg.norm(T[SCAPHOID]), np.linalg.norm(T[LUNATE]))
