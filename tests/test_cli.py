@@ -87,3 +87,42 @@ def test_figure_commands_write_pngs(capsys, built, tmp_path):
         assert main(["figure", kind, "P1", "--out", str(out)]) == 0
         assert capsys.readouterr().out.strip() == str(out)
         assert out.stat().st_size > 10_000 and out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_evaluate_json_truth_beats_population(capsys, built):
+    import math
+
+    built("P1")
+    out = {}
+    for spec in ("population", "truth"):
+        assert main(["evaluate", "P1", "--design", spec, "--json"]) == 0
+        out[spec] = json.loads(capsys.readouterr().out)
+    for spec, o in out.items():
+        for key in ("participant", "motion", "design", "failed", "status", "cost", "error_p75", "rmse", "wall_seconds"):
+            assert key in o, key
+        assert (o["participant"], o["motion"], o["design"]) == ("P1", "calibrate", spec)
+        assert o["failed"] is False and o["status"] == "ok" and o["wall_seconds"] > 0
+        for name in ("error_p75", "rmse"):
+            assert set(o[name]) == {"scaphoid", "lunate"}
+            values = [v for bone in o[name].values() for v in bone.values()]
+            assert len(values) == 12 and all(isinstance(v, float) and math.isfinite(v) and v >= 0 for v in values)
+    assert 0 < out["truth"]["cost"] < out["population"]["cost"]
+
+
+def test_evaluate_table_and_design_file(capsys, built, tmp_path):
+    from wrist_env.participants.builtin import truth
+
+    built("P1")
+    assert main(["evaluate", "P1", "--design", "truth", "--json"]) == 0
+    at_truth = json.loads(capsys.readouterr().out)["cost"]
+    path = tmp_path / "d.json"
+    path.write_text(json.dumps(truth("P1").as_dict()))
+    assert main(["evaluate", "P1", "--design", str(path), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["cost"] == at_truth
+    assert main(["evaluate", "P1", "--design", "truth"]) == 0
+    text = capsys.readouterr().out
+    assert "p75 error" in text and "RMSE" in text and f"cost {at_truth:.4f}" in text
+    rows = [line.split() for line in text.splitlines() if line.startswith(("scaphoid", "lunate"))]
+    assert len(rows) == 12 and {r[-1] for r in rows} == {"mm", "deg"}
+    assert main(["evaluate", "P9"]) == 2
+    assert "unknown participant 'P9'" in capsys.readouterr().err

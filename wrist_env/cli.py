@@ -129,6 +129,47 @@ def _simulate(args) -> int:
     return 0 if result.ok else 1
 
 
+def _evaluate(args) -> int:
+    from wrist_env.envs.task import task
+    from wrist_env.errors import ParticipantError
+    from wrist_env.frames import DOF_NAMES, DOF_UNITS
+    from wrist_env.participants import registry
+
+    for folder in args.folder or []:
+        registry.add_folder(folder)
+    if args.participant not in registry.participants():
+        raise ParticipantError(f"unknown participant {args.participant!r}; known: {list(registry.participants())}")
+    d = load_design(args.design, args.participant)
+    start = time.perf_counter()
+    t = task(args.participant, args.motion)
+    load_seconds = time.perf_counter() - start
+    start = time.perf_counter()
+    evaluation = t.evaluate(d)
+    wall = time.perf_counter() - start
+    info = evaluation.info
+    out = {"participant": args.participant, "motion": args.motion, "design": args.design,
+           "failed": bool(evaluation.failed), "status": info["status"], "cost": evaluation.cost,
+           "error_p75": info.get("error_p75"), "rmse": info.get("rmse"), "cost_terms": info.get("cost_terms"),
+           "units": dict(zip(DOF_NAMES, DOF_UNITS)), "n_frames": len(evaluation.result.poses),
+           "wall_seconds": round(wall, 4), "load_seconds": round(load_seconds, 4)}
+    if args.json:
+        print(json.dumps(out, indent=1, allow_nan=False))
+        return 1 if evaluation.failed else 0
+    print(f"{args.participant}, {args.motion} motion ({out['n_frames']} frames), design {args.design}")
+    if out["error_p75"] is None:
+        print("no reference kinematics (a user participant's idealized sweep): cost 0 by definition")
+    else:
+        print(f"{'bone':<9} {'DOF':<10} {'p75 error':>9} {'RMSE':>8}  unit")
+        for bone, errors in out["error_p75"].items():
+            for dof, unit in zip(DOF_NAMES, DOF_UNITS):
+                p75, rmse = errors[dof], out["rmse"][bone][dof]
+                p75, rmse = ("nan" if x is None else f"{x:.3f}" for x in (p75, rmse))
+                print(f"{bone:<9} {dof:<10} {p75:>9} {rmse:>8}  {unit}")
+    print(f"cost {evaluation.cost:.4f}{' (failed)' if evaluation.failed else ''}; status: {info['status']}; "
+          f"evaluate {wall:.3f} s; task setup {load_seconds:.2f} s")
+    return 1 if evaluation.failed else 0
+
+
 def _figure(args) -> int:
     from wrist_env import figures
 
@@ -184,6 +225,24 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true", help="print all per-frame outputs as JSON")
     s.add_argument("--folder", action="append", help="register this participant folder first")
     s.set_defaults(run=_simulate)
+
+    s = sub.add_parser(
+        "evaluate", help="score one design on a participant's task (cost, per-DOF errors)",
+        description="Simulate one design on a participant's task and print its kinematic cost with the 75th "
+                    "percentile |error| and the RMSE of each scaphoid and lunate DOF (mm, deg) against the "
+                    "reference: the calibration trial (default), the held-out validation trial, or the idealized "
+                    "sweep (reference: the hidden truth's sweep for built-in participants; none, cost 0, for "
+                    "user participants). Exit status 1 if the simulation failed.")
+    s.add_argument("participant")
+    s.add_argument("--motion", choices=["calibrate", "validate", "idealized"], default="calibrate",
+                   help="calibrate: the trial with role calibrate (default); validate: the trial with role "
+                        "validate; idealized: the flexion-extension sweep")
+    s.add_argument("--design", default="population",
+                   help="'population' (Table 2 means, default), 'truth' (a built-in participant's hidden "
+                        "ground truth) or a JSON file of a design (Design.as_dict)")
+    s.add_argument("--json", action="store_true", help="print the cost, per-DOF errors and timings as JSON")
+    s.add_argument("--folder", action="append", help="register this participant folder first")
+    s.set_defaults(run=_evaluate)
 
     s = sub.add_parser("figure", help="write a figure (PNG)",
                        description="model: bones, cartilage, ligaments; annotations: the template; pressure: "
