@@ -1,0 +1,169 @@
+"""Nelder–Mead: SciPy's bounded simplex method behind ask/tell, restarted until the budget is spent.
+
+SciPy drives the objective itself (callback style), so control is inverted:
+SciPy runs in a daemon worker thread whose objective hands each point to
+`ask` through a queue and blocks until `tell` sends the value back. Only one
+side runs at a time, so the run is deterministic. When the budget is spent
+(or the optimizer is closed or garbage-collected) the objective raises a
+private exception inside SciPy, which unwinds the worker thread.
+"""
+
+from __future__ import annotations
+
+import queue
+import threading
+
+import numpy as np
+from scipy.optimize import Bounds
+from scipy.optimize import minimize as scipy_minimize
+
+from optimizers.base import Optimizer
+from optimizers.registry import register
+
+
+class _Stop(Exception):
+    """Raised inside SciPy's objective to end the worker thread."""
+
+
+_STOP = object()   # sent on the reply queue instead of a value
+_END = object()    # posted on the request queue when the worker has finished
+
+
+def initial_simplex(x0, lower, upper, scale: float = 0.25) -> np.ndarray:
+    """(dim + 1, dim): x0 and x0 ± scale·(upper − lower) along each axis.
+
+    Each step goes up unless that leaves the box, then down (SciPy would
+    otherwise clip or reflect the vertex).
+    """
+    x0 = np.asarray(x0, dtype=np.float64)
+    step = scale * (upper - lower)
+    step = np.where(x0 + step <= upper, step, -step)
+    sim = np.tile(x0, (len(x0) + 1, 1))
+    sim[1:] += np.diag(step)
+    return sim
+
+
+def _worker(requests, replies, budget, lower, upper, x0, rng, scale, restart, perturb, options):
+    """Run SciPy's Nelder–Mead with restarts until `budget` evaluations, talking through the queues."""
+    evals = 0
+    best_x, best_f = None, np.inf
+
+    def fun(x):
+        nonlocal evals, best_x, best_f
+        if evals >= budget:
+            raise _Stop
+        x = np.array(x, dtype=np.float64)
+        requests.put(x)
+        y = replies.get()
+        if y is _STOP:
+            raise _Stop
+        evals += 1
+        if y < best_f:
+            best_x, best_f = x, y
+        return y
+
+    bounds = Bounds(lower, upper)
+    start = x0
+    try:
+        while evals < budget:
+            # inf values (failed evaluations) make SciPy compute inf - inf; np.errstate is
+            # thread-local (unlike warnings.catch_warnings, which must not be used here)
+            with np.errstate(invalid="ignore", over="ignore"):
+                scipy_minimize(fun, start, method="Nelder-Mead", bounds=bounds,
+                               options={**options, "maxfev": budget - evals,
+                                        "initial_simplex": initial_simplex(start, lower, upper, scale)})
+            if evals >= budget:
+                break
+            # converged before the budget: restart
+            if restart == "best" and best_x is not None:
+                start = np.clip(best_x + rng.normal(0.0, perturb, len(lower)) * (upper - lower), lower, upper)
+            else:
+                start = rng.uniform(lower, upper)
+        requests.put(_END)
+    except _Stop:
+        requests.put(_END)
+    except BaseException as error:  # noqa: BLE001  (handed to the main thread)
+        requests.put(error)
+
+
+@register("nelder-mead")
+class NelderMead(Optimizer):
+    """`scipy.optimize.minimize(method="Nelder-Mead", bounds=...)`, one point per ask, restarted until the budget.
+
+    Options:
+      x0: start of the first run (default the box centre);
+      simplex_scale: initial simplex x0 + simplex_scale·(upper − lower)·e_i
+        (default 0.25; steps go down where up would leave the box);
+      restart: where a run starts after SciPy converges before the budget —
+        "random" (uniform in the box, default) or "best" (the best point so
+        far plus N(0, perturb·(upper − lower)), clipped);
+      perturb: default 0.1;
+      xatol, fatol, adaptive: SciPy's (defaults 1e-4, 1e-4, False).
+    Each run gets maxfev = the remaining budget. The first run is
+    deterministic (independent of the seed); restarts draw from `self.rng`.
+    """
+
+    def __init__(self, dim: int, budget: int, seed: int = 0, lower=-1.0, upper=1.0, **options):
+        super().__init__(dim, budget, seed, lower, upper, **options)
+        x0 = options.get("x0")
+        self.x0 = 0.5 * (self.lower + self.upper) if x0 is None else np.clip(
+            np.broadcast_to(np.asarray(x0, dtype=np.float64), (self.dim,)), self.lower, self.upper)
+        self.restart = options.get("restart", "random")
+        if self.restart not in ("random", "best"):
+            raise ValueError(f"restart must be 'random' or 'best', but got {self.restart!r}")
+        self._scipy_options = {"xatol": float(options.get("xatol", 1e-4)), "fatol": float(options.get("fatol", 1e-4)),
+                               "adaptive": bool(options.get("adaptive", False))}
+        self._requests: queue.Queue = queue.Queue()
+        self._replies: queue.Queue = queue.Queue()
+        self._thread: threading.Thread | None = None
+        self._finished = False
+
+    def _next(self):
+        item = self._requests.get()
+        if isinstance(item, BaseException):
+            self._finished = True
+            raise RuntimeError(f"{self.name}: SciPy's Nelder-Mead failed") from item
+        return item
+
+    def _ask(self, n_max: int) -> np.ndarray:
+        if self._finished:
+            raise RuntimeError(f"{self.name}: the optimizer was closed")
+        if self._thread is None:
+            self._thread = threading.Thread(
+                target=_worker, name=f"nelder-mead-{id(self):x}", daemon=True,
+                args=(self._requests, self._replies, self.budget, self.lower, self.upper, self.x0, self.rng,
+                      float(self.options.get("simplex_scale", 0.25)), self.restart,
+                      float(self.options.get("perturb", 0.1)), self._scipy_options))
+            self._thread.start()
+        x = self._next()
+        if x is _END:  # cannot happen while budget remains; kept as a guard
+            self._finished = True
+            raise RuntimeError(f"{self.name}: the worker ended with {self.remaining} evaluations left")
+        return x[None, :]
+
+    def _tell(self, x, y) -> None:
+        self._replies.put(float(y[0]))
+        if self.remaining <= 0:
+            self.close()
+
+    def close(self) -> None:
+        """End the worker thread (done automatically when the budget is spent)."""
+        if self._thread is None or self._finished:
+            return
+        self._finished = True
+        if self._pending:  # a point was asked and not told: the worker waits for its value
+            self._replies.put(_STOP)
+        else:
+            item = self._requests.get()  # the worker's next request, or its end
+            if item is not _END and not isinstance(item, BaseException):
+                self._replies.put(_STOP)
+                self._requests.get()     # _END
+        self._thread.join()
+
+    def __del__(self):
+        # the worker holds no reference to self; unblock it so the thread ends
+        try:
+            if getattr(self, "_thread", None) is not None and not self._finished and self._thread.is_alive():
+                self._replies.put(_STOP)
+        except Exception:  # noqa: BLE001  (interpreter shutdown)
+            pass
