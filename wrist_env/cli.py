@@ -188,6 +188,39 @@ def _figure(args) -> int:
     return 0
 
 
+def _montecarlo(args) -> int:
+    from wrist_env.errors import ParticipantError
+    from wrist_env.montecarlo.study import StudyConfig, run_study
+    from wrist_env.participants import registry
+
+    for folder in args.folder or []:
+        registry.add_folder(folder)
+    unknown = [p for p in args.participants if p not in registry.participants()]
+    if unknown:
+        raise ParticipantError(f"unknown participants {unknown}; known: {list(registry.participants())}")
+    config = StudyConfig(tuple(args.participants), args.n, args.seed, args.tear_probability)
+    where = (f"the dask scheduler {args.scheduler}" if args.scheduler else
+             f"{args.workers} local worker processes" if args.workers else "this process (Numba threads on every core)")
+    print(f"Monte Carlo: {', '.join(config.participants)}, {config.n:,} successful runs each, seed {config.seed}, "
+          f"batch {args.batch}, on {where}; run log {args.out}", flush=True)
+    summary = run_study(config, args.out, batch=args.batch, scheduler=args.scheduler, workers=args.workers,
+                        folders=tuple(args.folder or ()), progress=not args.no_progress)
+    print(summary.line())
+    return 0
+
+
+def _montecarlo_report(args) -> int:
+    from wrist_env.montecarlo.report import write_report
+
+    if not Path(args.runs).is_dir():
+        raise SystemExit(f"wrist-bench montecarlo-report: no Monte Carlo run log at {args.runs}")
+    summary = write_report(args.runs, args.out, max_runs=args.max_runs)
+    t5 = summary["table5"]
+    print(f"Table 5: {t5['runs']:,} runs, {t5['rows']:,} rows, fit {t5['fit_seconds']} s; "
+          f"report {summary['report_seconds']} s; written to {args.out}")
+    return 0
+
+
 def parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="wrist-bench", description=__doc__)
     sub = p.add_subparsers(dest="command", required=True)
@@ -255,6 +288,36 @@ def parser() -> argparse.ArgumentParser:
                    help="pressure: capitate held at neutral without load, instead of the 0° frame of the "
                         "idealized sweep (10 N compressive load)")
     s.set_defaults(run=_figure)
+
+    s = sub.add_parser(
+        "montecarlo", help="Monte Carlo injury study: n successful idealized sweeps per participant (preprint 2.3.2)",
+        description="Latin hypercube over the 27 design variables (materials from Table 2's normals truncated at "
+                    "+-3 SD, each of SLIL_v, SLIL_p, SLIL_d, RSC, LRL torn with probability 0.3), simulated through "
+                    "the Idealized environment; runs whose radioscaphoid mean pressure exceeds 16.5 MPa at any frame "
+                    "are excluded and, like solver failures, replaced until n runs succeed. Every run is logged to "
+                    "Parquet in --out as its batch finishes; run the same command again to resume.")
+    s.add_argument("participants", nargs="+")
+    s.add_argument("--n", type=int, default=12500, help="successful runs per participant (default 12500)")
+    s.add_argument("--seed", type=int, default=0, help="study seed (default 0)")
+    s.add_argument("--tear-probability", type=float, default=0.3, help="chance of each tear (default 0.3)")
+    s.add_argument("--out", default="runs/montecarlo", help="run-log folder (default runs/montecarlo)")
+    s.add_argument("--scheduler", help="dask.distributed scheduler address (e.g. tcp://host:8786); one task per batch")
+    s.add_argument("--batch", type=int, default=64, help="runs per batch: one vector-env step, one log part (default 64)")
+    s.add_argument("--workers", type=int, default=0,
+                   help="local worker processes (default 0: this process, Numba threads on every core)")
+    s.add_argument("--no-progress", action="store_true", help="no progress bar")
+    s.add_argument("--folder", action="append", help="register this participant folder (in every worker)")
+    s.set_defaults(run=_montecarlo)
+
+    s = sub.add_parser("montecarlo-report", help="Tables 5-6 and Figures 8-10 of a Monte Carlo run log",
+                       description="Mixed-effects fits (statsmodels MixedLM) of radioscaphoid pressure on a 2-df "
+                                   "angle spline and the tears (Table 5) and of SLIL bundle forces in intact runs "
+                                   "(Table 6), with a random intercept per run; tables as Markdown and CSV, figures "
+                                   "as PNG, summary.json and report.md.")
+    s.add_argument("--runs", default="runs/montecarlo", help="run-log folder (default runs/montecarlo)")
+    s.add_argument("--out", default="leaderboards/montecarlo", help="output folder (default leaderboards/montecarlo)")
+    s.add_argument("--max-runs", type=int, help="fit on a seeded random subset of this many runs (default: all)")
+    s.set_defaults(run=_montecarlo_report)
     return p
 
 

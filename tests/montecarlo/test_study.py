@@ -1,0 +1,135 @@
+"""The Monte Carlo study on the solver: the same log twice, on a LocalCluster, after a kill; exclusions; report."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pyarrow as pa
+import pytest
+
+from wrist_env.design import NAMES
+from wrist_env.montecarlo import StudyConfig, StudyError, read_runs, run_study
+from wrist_env.montecarlo.log import PartExistsError, PartLog
+from wrist_env.montecarlo.sampler import FRAME_COLUMNS, SCHEMA, TEAR_COLUMNS
+
+CONFIG = StudyConfig(("P1",), n=40, seed=3)
+
+
+@pytest.fixture(scope="module")
+def reference(built, tmp_path_factory):
+    """The uninterrupted study in this process, batch 5: its folder and log."""
+    built("P1")
+    out = tmp_path_factory.mktemp("mc_reference")
+    summary = run_study(CONFIG, out, batch=5)
+    assert summary.done and summary.counts["P1"].succeeded == 40
+    return out, read_runs(out)
+
+
+def test_log_rows_hold_the_design_tears_and_frames(reference):
+    out, log = reference
+    assert log.schema.equals(SCHEMA)
+    assert log["sample_id"].to_pylist() == list(range(log.num_rows))
+    rows = log.to_pylist()
+    ok = [r for r in rows if r["ok"]]
+    assert sum(r["ok"] and not r["excluded"] for r in rows) == 40
+    for r in ok:
+        assert all(len(r[c]) == 17 for c in FRAME_COLUMNS)
+        assert r["angle_deg"][0] == 40.0 and r["angle_deg"][-1] == -40.0
+        assert all(r[t] == (r[n] < 0) for t, n in zip(TEAR_COLUMNS, NAMES[22:]))
+        for t in TEAR_COLUMNS:  # a torn ligament carries no load
+            if r[t]:
+                assert max(r[t.replace(".torn", ".force_n")]) == 0.0
+    for r in rows:
+        if not r["ok"]:
+            assert r["status"] != "ok" and r["rs_mean_mpa"] is None and r["angle_deg"] is not None
+    assert not any(p.name.startswith(".") for p in (out / "runs").iterdir())
+
+
+def test_seeded_log_is_identical_twice_with_another_batch_size(reference, tmp_path):
+    summary = run_study(CONFIG, tmp_path, batch=7)
+    assert summary.simulated == reference[1].num_rows
+    assert read_runs(tmp_path).equals(reference[1])
+    # rerunning a finished study simulates nothing and changes nothing
+    again = run_study(CONFIG, tmp_path, batch=7)
+    assert again.simulated == 0 and again.done and read_runs(tmp_path).equals(reference[1])
+
+
+def test_seeded_log_is_identical_on_a_local_cluster(reference, tmp_path):
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
+                      processes=True) as cluster:
+        summary = run_study(CONFIG, tmp_path, batch=8, scheduler=cluster.scheduler_address)
+    assert summary.done
+    assert read_runs(tmp_path).equals(reference[1])
+
+
+def test_killed_study_resumes_with_no_run_lost_or_repeated(reference, tmp_path):
+    cmd = [sys.executable, "-m", "wrist_env.cli", "montecarlo", "P1", "--n", "40", "--seed", "3", "--batch", "2",
+           "--out", str(tmp_path), "--no-progress"]
+    proc = subprocess.Popen(cmd, env=dict(os.environ), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    runs = tmp_path / "runs"
+    deadline = time.monotonic() + 120
+    try:
+        while time.monotonic() < deadline and proc.poll() is None:
+            if runs.is_dir() and len(list(runs.glob("*.parquet"))) >= 3:
+                break
+            time.sleep(0.01)
+        assert proc.poll() is None, f"the study ended before the kill: {proc.stderr.read().decode()[-2000:]}"
+        os.kill(proc.pid, signal.SIGKILL)
+    finally:
+        proc.wait(timeout=30)
+    partial = read_runs(tmp_path)
+    assert partial is not None and 0 < partial.num_rows < reference[1].num_rows
+    summary = run_study(CONFIG, tmp_path, batch=5)
+    assert summary.done and summary.simulated == reference[1].num_rows - partial.num_rows
+    assert read_runs(tmp_path).equals(reference[1])
+
+
+def test_excluded_runs_are_flagged_counted_and_replaced(built, tmp_path):
+    config = StudyConfig(("P1",), n=8, seed=3, exclude_above_mpa=1.5)
+    summary = run_study(config, tmp_path, batch=4)
+    log = read_runs(tmp_path).to_pandas()
+    c = summary.counts["P1"]
+    assert c.succeeded == 8 and c.excluded > 0 and c.attempts == len(log) == 8 + c.excluded + c.failed
+    assert ((log["ok"]) & (~log["excluded"])).sum() == 8
+    peak = log["rs_mean_mpa"].map(lambda x: -1.0 if x is None else np.max(x))
+    assert (log["excluded"] == (log["ok"] & (peak > 1.5))).all()
+    assert log["block"].max() == c.blocks - 1 >= 1
+    assert summary.excluded == c.excluded and "excluded" in summary.line()
+
+
+def test_another_study_in_the_same_folder_is_refused(reference):
+    out, _ = reference
+    with pytest.raises(StudyError, match="seed"):
+        run_study(StudyConfig(("P1",), n=40, seed=4), out)
+
+
+def test_part_log_writes_once_and_atomically(tmp_path):
+    log = PartLog(tmp_path / "parts")
+    assert log.read() is None
+    t = pa.table({"x": [1, 2]})
+    log.write("a-1", t)
+    with pytest.raises(PartExistsError):
+        log.write("a-1", t)
+    (tmp_path / "parts" / ".a-2.parquet.dead.tmp").write_bytes(b"half a file")
+    assert log.names() == ["a-1"] and log.read().equals(t)
+    assert log.clean() == 1
+
+
+def test_report_writes_tables_and_figures(reference, tmp_path):
+    from wrist_env import cli
+
+    out, _ = reference
+    assert cli.main(["montecarlo-report", "--runs", str(out), "--out", str(tmp_path)]) == 0
+    for name in ("table5.md", "table5.csv", "table6.md", "table6.csv", "figure8.png", "figure9.png", "figure10.png",
+                 "summary.json", "report.md"):
+        assert (tmp_path / name).stat().st_size > 100, name
+    import pandas as pd
+
+    t5 = pd.read_csv(tmp_path / "table5.csv")
+    assert list(t5["term"]) == ["Intercept", "s1", "s2", "SLIL_v", "SLIL_p", "SLIL_d", "RSC", "LRL"]
+    assert "| Ligament injury | Volar SLIL |" in (tmp_path / "table5.md").read_text()

@@ -1,0 +1,159 @@
+"""The Monte Carlo sampler: seeded Latin-hypercube blocks of designs, run through the Idealized environment.
+
+Draws (preprint 2.3.2; the distributions are `wrist_env.design.monte_carlo_actions`):
+a participant's runs come in blocks; block b is a Latin hypercube over all 27
+variables of its own size, seeded by `block_seed(seed, participant, b)` —
+a `numpy.random.SeedSequence` of the study seed with the spawn key
+(CRC-32 of the participant's name, b) — so every draw, first or
+replacement, is a pure function of (seed, participant, block, size).
+Materials come from Table 2's normals truncated at ±3 SD by inverse CDF;
+each injurable ligament is torn (action −0.5) with probability 0.3, else
+intact (+1), independently.
+
+Simulation: `run_chunk` steps the native vector env
+`gymnasium.make_vec("wrist_env/Idealized-<P>-v0", num_envs=k,
+vectorization_mode="vector_entry_point")` once with the chunk's k actions —
+no second path into the solver — and reads every per-run output from the
+step's `infos` (per-frame contact per pair, bundle forces, status). The
+wrist angle of each frame is the environment's driver's
+(`env.unwrapped.task.driver.angle_deg`: the capitate's prescribed flexion,
+flexion +, extension −), which `infos` do not carry.
+
+Exclusion (preprint 2.3.2: "models with contact pressures exceeding 16.5 MPa
+yielded unrealistic simulations"): a run is excluded when its radioscaphoid
+mean pressure (the pair's mean over its contacting area) exceeds
+`EXCLUDE_ABOVE_MPA` at any frame of the sweep. We read the preprint's
+"contact pressures exceeding" as the curve crossing the line somewhere (it
+was found "upon visual inspection" of the runs), not the sweep's average;
+the log keeps every frame, so the other reading can be recomputed from it.
+"""
+
+from __future__ import annotations
+
+import zlib
+
+import numpy as np
+import pyarrow as pa
+
+from wrist_env import design
+from wrist_env.design import INJURABLE, LIGAMENT_NAMES, NAMES
+
+EXCLUDE_ABOVE_MPA = 16.5
+RS_PAIR = "radioscaphoid"
+TEAR_COLUMNS = tuple(f"{n}.torn" for n in INJURABLE)
+FORCE_COLUMNS = tuple(f"{n}.force_n" for n in LIGAMENT_NAMES)
+FRAME_COLUMNS = ("angle_deg", "rs_mean_mpa", "rs_peak_mpa", "rs_area_mm2") + FORCE_COLUMNS
+"""Per-frame columns (lists, one value per frame): wrist angle (deg, flexion +), radioscaphoid
+mean pressure over the contacting area and peak pressure (MPa), contact area (mm²), and the
+tension of every Table 2 ligament (N)."""
+_FRAMES = pa.list_(pa.float64())
+SCHEMA = pa.schema(
+    [("participant", pa.string()), ("sample_id", pa.int64()), ("block", pa.int64())]
+    + [(n, pa.float64()) for n in NAMES]
+    + [(c, pa.bool_()) for c in TEAR_COLUMNS]
+    + [(c, _FRAMES) for c in FRAME_COLUMNS]
+    + [("status", pa.string()), ("ok", pa.bool_()), ("excluded", pa.bool_())]
+)
+"""One row per run: participant, sample id (0, 1, … over the participant's blocks), block,
+the 27 design variables in physical units (`design.NAMES`; injury scalars as actions), the five
+tear indicators, the per-frame outputs (`FRAME_COLUMNS`; null for a failed run, whose outputs
+are NaN — null keeps two logs comparable with `Table.equals`), the solver's
+status, `ok` (the solver succeeded) and `excluded` (ok, but over the exclusion threshold)."""
+
+
+def participant_key(participant: str) -> int:
+    """A stable 32-bit key of a participant's name (CRC-32; Python's hash() is salted)."""
+    return zlib.crc32(participant.encode("utf-8"))
+
+
+def block_seed(seed: int, participant: str, block: int) -> np.random.SeedSequence:
+    """The seed of one block of draws: the study seed, spawn key (participant key, block)."""
+    if int(seed) < 0:
+        raise ValueError(f"seed must be >= 0, but got {seed}")
+    return np.random.SeedSequence(int(seed), spawn_key=(participant_key(participant), int(block)))
+
+
+def block_actions(seed: int, participant: str, block: int, size: int,
+                  tear_probability: float = design.TEAR_PROBABILITY) -> np.ndarray:
+    """Normalized actions (size, 27) of one block: a Latin hypercube of `size` points."""
+    return design.monte_carlo_actions(size, block_seed(seed, participant, block), tear_probability=tear_probability)
+
+
+_ENVS: dict = {}
+
+
+def vector_env(participant: str, num_envs: int):
+    """The participant's Idealized vector env with `num_envs` slots (one per process and size)."""
+    import gymnasium as gym
+
+    from wrist_env.envs import env_id, register_ids
+
+    key = (participant, int(num_envs))
+    if key not in _ENVS:
+        register_ids(participant, ("idealized",))
+        env = gym.make_vec(env_id(participant, "idealized"), num_envs=int(num_envs),
+                           vectorization_mode="vector_entry_point")
+        env.reset(seed=0)
+        _ENVS[key] = env
+    return _ENVS[key]
+
+
+def _frames(rows: np.ndarray, missing=None) -> pa.Array:
+    """Rows (n, n_frames) as a list column; rows where `missing` is True are null."""
+    rows = np.ascontiguousarray(rows, dtype=np.float64)
+    n, f = rows.shape
+    mask = None if missing is None else pa.array(np.asarray(missing, dtype=bool))
+    return pa.ListArray.from_arrays(pa.array(np.arange(0, n * f + 1, f, dtype=np.int32)), pa.array(rows.ravel()),
+                                    mask=mask)
+
+
+def run_chunk(participant: str, sample_ids, blocks, actions, *, exclude_above_mpa: float = EXCLUDE_ABOVE_MPA,
+              folders=(), threads: int | None = None) -> pa.Table:
+    """Simulate k runs (actions of shape (k, 27)) in one vector-env step; their log rows (`SCHEMA`).
+
+    Runs wherever it is called: in this process, a local worker process or a dask worker
+    (`folders`: user participant folders to register there first; `threads`: Numba threads).
+    """
+    if threads:
+        import numba
+
+        numba.set_num_threads(min(int(threads), numba.config.NUMBA_NUM_THREADS))
+    if folders:
+        from wrist_env.participants import registry
+
+        known = set(registry.participants())
+        for folder in folders:
+            if participant not in known:
+                registry.add_folder(folder)
+    actions = np.asarray(actions, dtype=np.float64)
+    k = len(actions)
+    env = vector_env(participant, k)
+    _, _, _, _, infos = env.step(actions)
+    angle = np.asarray(env.unwrapped.task.driver.angle_deg, dtype=np.float64)
+    n_frames = len(angle)
+    status = [str(s) for s in infos["status"]]
+    ok = ~np.asarray(infos["failed"], dtype=bool) & np.array([s == "ok" for s in status])
+    contact = infos["contact"][RS_PAIR]
+
+    def frames(values):
+        values = np.array(values, dtype=np.float64).reshape(k, n_frames)
+        values[~ok] = 0.0  # infos hold zeros for a failed run; the log holds null (below)
+        return values
+
+    rs_mean = frames(contact["mean_pressure_mpa"])
+    excluded = ok & np.any(rs_mean > exclude_above_mpa, axis=1)
+    physical = np.stack([design.from_action(a).vector for a in actions]) if k else np.zeros((0, len(NAMES)))
+    columns = {"participant": [participant] * k, "sample_id": np.asarray(sample_ids, dtype=np.int64),
+               "block": np.asarray(blocks, dtype=np.int64)}
+    columns.update({n: physical[:, i] for i, n in enumerate(NAMES)})
+    columns.update({c: actions[:, design.N_MATERIAL + i] < 0 for i, c in enumerate(TEAR_COLUMNS)})
+    columns["angle_deg"] = _frames(np.tile(angle, (k, 1)))
+    columns["rs_mean_mpa"] = _frames(rs_mean, ~ok)
+    columns["rs_peak_mpa"] = _frames(frames(contact["peak_pressure_mpa"]), ~ok)
+    columns["rs_area_mm2"] = _frames(frames(contact["area_mm2"]), ~ok)
+    for lig, c in zip(LIGAMENT_NAMES, FORCE_COLUMNS):
+        columns[c] = _frames(frames(infos["bundle_force_n"][lig]), ~ok)
+    columns["status"] = status
+    columns["ok"] = ok
+    columns["excluded"] = excluded
+    return pa.Table.from_pydict(columns, schema=SCHEMA)

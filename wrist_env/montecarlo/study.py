@@ -1,0 +1,420 @@
+"""The Monte Carlo study: n successful runs per participant, logged as chunks finish, resumable.
+
+Rounds (per participant): round 0 runs block 0, a Latin hypercube of n draws
+(sample ids 0 … n−1). When a round is complete, the runs that failed in the
+solver or were excluded (`sampler` docstring) are counted, and round r + 1
+runs block r + 1, a fresh Latin hypercube of exactly as many draws as are
+missing, with the next sample ids — until n runs have succeeded. Every draw is
+a pure function of (seed, participant, block, size) and every outcome of its
+draw, so the set of runs, and the log, do not depend on batch size, worker
+count, scheduler, or on being killed and resumed.
+
+Log: `<out>/runs/<participant>-<first id>-<end id>.parquet`, one part per
+chunk, written atomically by this process as the chunk finishes
+(`wrist_env.montecarlo.log.PartLog`; rows: `sampler.SCHEMA`), and
+`<out>/study.json` (participants, n, seed, tear probability, exclusion
+threshold). Rerunning the same command resumes: logged runs are read back,
+only missing sample ids are simulated. A different seed, n, tear probability
+or threshold in the same folder is refused.
+
+Where chunks run: in this process (`workers=0`: one batched call at a time,
+Numba's prange on every core — the default, measured fastest on this 2-core
+machine), in `workers` local processes (each with cores / workers Numba
+threads), or on a `dask.distributed` scheduler (`scheduler="tcp://…"`, or a
+`distributed.Client`); workers only compute, this process writes the log.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Iterator
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+
+from wrist_env import design
+from wrist_env.errors import WristEnvError
+from wrist_env.montecarlo import sampler
+from wrist_env.montecarlo.log import PartLog, write_json
+
+MANIFEST = "study.json"
+RUNS = "runs"
+VERSION = 1
+
+
+class StudyError(WristEnvError):
+    """A study that cannot run: a folder holding another study, a duplicated run, no successes."""
+
+
+@dataclass(frozen=True)
+class StudyConfig:
+    """What a study is: these decide every run (how it is run does not)."""
+
+    participants: tuple[str, ...]
+    n: int
+    seed: int = 0
+    tear_probability: float = design.TEAR_PROBABILITY
+    exclude_above_mpa: float = sampler.EXCLUDE_ABOVE_MPA
+    max_attempts: int | None = None
+    """Give up (StudyError) after this many runs of one participant; default 5 n + 100."""
+
+    def __post_init__(self):
+        object.__setattr__(self, "participants", tuple(self.participants))
+        if not self.participants:
+            raise StudyError("a study needs at least one participant")
+        if len(set(self.participants)) != len(self.participants):
+            raise StudyError(f"participants repeat: {list(self.participants)}")
+        if int(self.n) < 1:
+            raise StudyError(f"n must be at least 1, but got {self.n}")
+        if int(self.seed) < 0:
+            raise StudyError(f"seed must be >= 0, but got {self.seed}")
+        if not 0.0 <= self.tear_probability <= 1.0:
+            raise StudyError(f"tear_probability must be in [0, 1], but got {self.tear_probability}")
+
+    @property
+    def attempt_limit(self) -> int:
+        return int(self.max_attempts) if self.max_attempts is not None else 5 * int(self.n) + 100
+
+    def key(self) -> dict:
+        """The fields that must match to resume a study in the same folder."""
+        return {"version": VERSION, "n": int(self.n), "seed": int(self.seed),
+                "tear_probability": float(self.tear_probability), "exclude_above_mpa": float(self.exclude_above_mpa)}
+
+
+@dataclass
+class ParticipantCounts:
+    """A participant's runs so far: attempts = succeeded + excluded + failed."""
+
+    participant: str
+    attempts: int = 0
+    succeeded: int = 0
+    excluded: int = 0
+    failed: int = 0
+    blocks: int = 0
+
+
+@dataclass
+class StudySummary:
+    config: StudyConfig
+    counts: dict[str, ParticipantCounts]
+    simulated: int = 0
+    """Runs simulated by this call (resumed runs not included)."""
+    wall_seconds: float = 0.0
+    out: Path | None = None
+    done: bool = False
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def excluded(self) -> int:
+        return sum(c.excluded for c in self.counts.values())
+
+    @property
+    def failed(self) -> int:
+        return sum(c.failed for c in self.counts.values())
+
+    @property
+    def attempts(self) -> int:
+        return sum(c.attempts for c in self.counts.values())
+
+    def line(self) -> str:
+        rate = self.simulated / self.wall_seconds if self.wall_seconds > 0 else float("nan")
+        per = "; ".join(f"{p} {c.succeeded} ok, {c.excluded} excluded, {c.failed} failed" for p, c in self.counts.items())
+        return (f"wall {self.wall_seconds:.1f} s for {self.simulated} simulations ({rate:.1f}/s); "
+                f"excluded {self.excluded} ({100 * self.excluded / max(self.attempts, 1):.2f} %), "
+                f"failed {self.failed} ({100 * self.failed / max(self.attempts, 1):.2f} %) of {self.attempts} runs; {per}")
+
+
+# ---------------------------------------------------------------------------- the log
+
+
+def runs_log(out) -> PartLog:
+    return PartLog(Path(out) / RUNS)
+
+
+def read_runs(out, columns=None) -> pa.Table | None:
+    """Every logged run of the study in `out`, sorted by (participant, sample_id); None if empty.
+    StudyError if a run is logged twice."""
+    table = runs_log(out).read(schema=sampler.SCHEMA, columns=columns)
+    if table is None:
+        return None
+    keys = ["participant", "sample_id"]
+    if columns is not None and not set(keys) <= set(columns):
+        return table
+    table = table.sort_by([(k, "ascending") for k in keys])
+    p, s = table["participant"].to_numpy(zero_copy_only=False), table["sample_id"].to_numpy()
+    if len(p) > 1:
+        dup = (p[1:] == p[:-1]) & (s[1:] == s[:-1])
+        if dup.any():
+            i = int(np.flatnonzero(dup)[0])
+            raise StudyError(f"{Path(out) / RUNS}: run {p[i]} #{s[i]} is logged twice")
+    return table
+
+
+def _manifest(out: Path, config: StudyConfig) -> None:
+    path = out / MANIFEST
+    key = config.key()
+    participants = list(config.participants)
+    if path.is_file():
+        import json
+
+        old = json.loads(path.read_text())
+        old_key = {k: old.get(k) for k in key}
+        if old_key != key:
+            diff = ", ".join(f"{k} {old_key[k]!r} (asked {key[k]!r})" for k in key if old_key[k] != key[k])
+            raise StudyError(f"{out} holds another study ({diff}); use another --out or the same settings")
+        participants = list(old.get("participants", [])) + [p for p in participants if p not in old.get("participants", [])]
+        if participants == old.get("participants"):
+            return
+    write_json(path, {**key, "participants": participants})
+
+
+def read_manifest(out) -> dict:
+    import json
+
+    path = Path(out) / MANIFEST
+    if not path.is_file():
+        raise StudyError(f"{out} holds no Monte Carlo study (no {MANIFEST})")
+    return json.loads(path.read_text())
+
+
+# ---------------------------------------------------------------------------- rounds
+
+
+@dataclass(frozen=True)
+class Round:
+    participant: str
+    block: int
+    start: int
+    size: int
+    missing: tuple[int, ...]
+
+
+def _plan(participant: str, config: StudyConfig, outcomes: dict) -> tuple[Round | None, ParticipantCounts]:
+    """The participant's first incomplete round (None when n runs succeeded) and its counts so far.
+
+    outcomes: {sample_id: (ok, excluded)} of the logged runs.
+    """
+    counts = ParticipantCounts(participant)
+    start, size, block = 0, int(config.n), 0
+    while True:
+        ids = range(start, start + size)
+        missing = tuple(i for i in ids if i not in outcomes)
+        for i in ids:
+            if i in outcomes:
+                ok, excluded = outcomes[i]
+                counts.attempts += 1
+                counts.succeeded += ok and not excluded
+                counts.excluded += ok and excluded
+                counts.failed += not ok
+        counts.blocks = block + 1
+        if missing:
+            return Round(participant, block, start, size, missing), counts
+        deficit = int(config.n) - counts.succeeded
+        if deficit <= 0:
+            return None, counts
+        start, block, size = start + size, block + 1, deficit
+        if start + size > config.attempt_limit:
+            raise StudyError(f"{participant}: {counts.attempts} runs gave only {counts.succeeded} of {config.n} "
+                             f"successes ({counts.excluded} excluded, {counts.failed} failed); giving up")
+
+
+def _chunks(ids: tuple[int, ...], batch: int) -> Iterator[tuple[int, ...]]:
+    """Consecutive runs of ids, at most `batch` long."""
+    run: list[int] = []
+    for i in ids:
+        if run and (i != run[-1] + 1 or len(run) == batch):
+            yield tuple(run)
+            run = []
+        run.append(i)
+    if run:
+        yield tuple(run)
+
+
+def part_name(participant: str, ids: tuple[int, ...]) -> str:
+    return f"{participant}-{ids[0]:07d}-{ids[-1] + 1:07d}"
+
+
+# ---------------------------------------------------------------------------- executors
+
+
+class _Inline:
+    """Chunks in this process, one at a time (each a batched prange call over every core)."""
+
+    def submit(self, fn, *args, **kwargs):
+        return (fn, args, kwargs)
+
+    def as_completed(self, tasks):
+        for fn, args, kwargs in tasks:
+            yield fn(*args, **kwargs)
+
+    def close(self):
+        pass
+
+
+class _Pool:
+    """Chunks on local worker processes (spawned; Numba threads split between them)."""
+
+    def __init__(self, workers: int):
+        import multiprocessing
+        from concurrent.futures import ProcessPoolExecutor
+
+        self.threads = max(1, (os.cpu_count() or 1) // workers)
+        self.pool = ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))
+
+    def submit(self, fn, *args, **kwargs):
+        return self.pool.submit(fn, *args, threads=self.threads, **kwargs)
+
+    def as_completed(self, futures):
+        from concurrent.futures import as_completed
+
+        for f in as_completed(futures):
+            yield f.result()
+
+    def close(self):
+        self.pool.shutdown(cancel_futures=True)
+
+
+class _Dask:
+    """Chunks on a dask.distributed scheduler (an address or a Client)."""
+
+    def __init__(self, scheduler):
+        from distributed import Client
+
+        self.own = not isinstance(scheduler, Client)
+        self.client = Client(scheduler) if self.own else scheduler
+
+    def submit(self, fn, *args, **kwargs):
+        return self.client.submit(fn, *args, pure=False, **kwargs)
+
+    def as_completed(self, futures):
+        from distributed import as_completed
+
+        for f in as_completed(futures):
+            yield f.result()
+
+    def close(self):
+        if self.own:
+            self.client.close()
+
+
+def _executor(scheduler, workers: int):
+    if scheduler is not None:
+        return _Dask(scheduler)
+    if workers and workers > 0:
+        return _Pool(int(workers))
+    return _Inline()
+
+
+# ---------------------------------------------------------------------------- the study
+
+
+def run_study(config: StudyConfig, out, *, batch: int = 64, scheduler=None, workers: int = 0, folders=(),
+              progress: bool = False) -> StudySummary:
+    """Run (or resume) a study into the folder `out`; returns the counts and the wall time.
+
+    batch: runs per chunk (one vector-env step, one log part). scheduler: a dask.distributed
+    address or Client (default: local). workers: local worker processes (0: this process).
+    folders: user participant folders (registered here and on every worker). progress: a tqdm
+    bar of successful runs (postfix: excluded and failed so far).
+    """
+    if int(batch) < 1:
+        raise StudyError(f"batch must be at least 1, but got {batch}")
+    start_time = time.perf_counter()
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    _manifest(out, config)
+    log = runs_log(out)
+    log.clean()
+    outcomes: dict[str, dict[int, tuple[bool, bool]]] = {p: {} for p in config.participants}
+    logged = read_runs(out, None)
+    if logged is not None:
+        cols = logged.select(["participant", "sample_id", "ok", "excluded"]).to_pydict()
+        for p, s, ok, ex in zip(cols["participant"], cols["sample_id"], cols["ok"], cols["excluded"]):
+            if p in outcomes:
+                outcomes[p][int(s)] = (bool(ok), bool(ex))
+    folders = tuple(str(f) for f in folders)
+    if folders:
+        from wrist_env.participants import registry
+
+        for f in folders:
+            registry.add_folder(f)
+
+    summary = StudySummary(config, {}, out=out)
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=config.n * len(config.participants), unit="run", desc="Monte Carlo", smoothing=0.05)
+    executor = _executor(scheduler, workers)
+    try:
+        while True:
+            rounds = {}
+            for p in config.participants:
+                rnd, summary.counts[p] = _plan(p, config, outcomes[p])
+                if rnd is not None:
+                    rounds[p] = rnd
+            excluded, failed = summary.excluded, summary.failed
+            if bar is not None:
+                bar.n = sum(c.succeeded for c in summary.counts.values())
+                bar.set_postfix(excluded=excluded, failed=failed)
+                bar.refresh()
+            if not rounds:
+                summary.done = True
+                break
+            tasks = []
+            for p, rnd in rounds.items():
+                block = sampler.block_actions(config.seed, p, rnd.block, rnd.size, config.tear_probability)
+                for ids in _chunks(rnd.missing, int(batch)):
+                    rows = np.asarray(ids) - rnd.start
+                    tasks.append(executor.submit(sampler.run_chunk, p, ids, [rnd.block] * len(ids), block[rows],
+                                                 exclude_above_mpa=config.exclude_above_mpa, folders=folders))
+            for table in executor.as_completed(tasks):
+                cols = table.select(["participant", "sample_id", "ok", "excluded"]).to_pydict()
+                p = cols["participant"][0]
+                ids = tuple(int(s) for s in cols["sample_id"])
+                log.write(part_name(p, ids), table)
+                good = 0
+                for s, ok, ex in zip(ids, cols["ok"], cols["excluded"]):
+                    outcomes[p][s] = (bool(ok), bool(ex))
+                    good += bool(ok) and not bool(ex)
+                    excluded += bool(ok) and bool(ex)
+                    failed += not bool(ok)
+                summary.simulated += len(ids)
+                if bar is not None:
+                    bar.update(good)
+                    bar.set_postfix(excluded=excluded, failed=failed)
+    finally:
+        executor.close()
+        if bar is not None:
+            bar.close()
+    for p in config.participants:  # recount from the log's outcomes
+        summary.counts[p] = _plan(p, config, outcomes[p])[1]
+    summary.wall_seconds = time.perf_counter() - start_time
+    return summary
+
+
+def config_of(out, participants=None) -> StudyConfig:
+    """The StudyConfig recorded in a study folder (optionally for other participants)."""
+    m = read_manifest(out)
+    return StudyConfig(tuple(participants or m["participants"]), m["n"], m["seed"], m["tear_probability"],
+                       m["exclude_above_mpa"])
+
+
+def counts(out) -> dict[str, ParticipantCounts]:
+    """Per-participant counts of a study folder, from its log."""
+    config = config_of(out)
+    table = read_runs(out)
+    outcomes: dict[str, dict[int, tuple[bool, bool]]] = {p: {} for p in config.participants}
+    if table is not None:
+        cols = table.select(["participant", "sample_id", "ok", "excluded"]).to_pydict()
+        for p, s, ok, ex in zip(cols["participant"], cols["sample_id"], cols["ok"], cols["excluded"]):
+            outcomes.setdefault(p, {})[int(s)] = (bool(ok), bool(ex))
+    return {p: _plan(p, config, outcomes[p])[1] for p in config.participants}
+
+
+def summary_dict(summary: StudySummary) -> dict:
+    return {"config": asdict(summary.config), "counts": {p: asdict(c) for p, c in summary.counts.items()},
+            "simulated": summary.simulated, "wall_seconds": round(summary.wall_seconds, 3), "done": summary.done}
