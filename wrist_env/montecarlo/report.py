@@ -126,9 +126,9 @@ def _report_md(s: dict, t5: stats.Fit, t6: stats.Fit | None) -> str:
               "| | mean RS pressure, all frames (MPa) | RS pressure at 30° ext., all runs (MPa) | RS pressure at 30° ext., intact (MPa) | total SLIL force at 30° ext., intact (N) |",
               "|---|---|---|---|---|"]
     for key, v in n.items():
-        if key == "angle_deg":
+        if key == "angle_deg" or (key == "all" and len(n) == 3):  # one participant: "all" repeats it
             continue
-        lines.append(f"| {key} | {v['mean_pressure_mpa']:.3f} | {v['pressure_at_angle_mpa']:.3f} | "
+        lines.append(f"| {'pooled' if key == 'all' else key} | {v['mean_pressure_mpa']:.3f} | {v['pressure_at_angle_mpa']:.3f} | "
                      f"{v['intact_pressure_at_angle_mpa']:.3f} | {v['intact_total_slil_force_at_angle_n']:.1f} ± "
                      f"{v['intact_total_slil_force_at_angle_sd_n']:.1f} |")
     lines += ["| preprint (Andreassen et al.) | 0.65 | | | 26.0 |", "| cadaveric (preprint ref. 63) | | | | 20.0 ± 3.3 |", "",
