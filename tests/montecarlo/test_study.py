@@ -67,6 +67,11 @@ def test_seeded_log_is_identical_on_a_local_cluster(reference, tmp_path):
     assert read_runs(tmp_path).equals(reference[1])
 
 
+def test_seeded_log_is_identical_on_local_worker_processes(reference, tmp_path):
+    summary = run_study(CONFIG, tmp_path, batch=6, workers=2)
+    assert summary.done and read_runs(tmp_path).equals(reference[1])
+
+
 def test_killed_study_resumes_with_no_run_lost_or_repeated(reference, tmp_path):
     cmd = [sys.executable, "-m", "wrist_env.cli", "montecarlo", "P1", "--n", "40", "--seed", "3", "--batch", "2",
            "--out", str(tmp_path), "--no-progress"]
