@@ -188,6 +188,113 @@ def _figure(args) -> int:
     return 0
 
 
+def _bench_errors(run):
+    """Unknown calibrators are a clear error, like unknown participants."""
+    def wrapped(args) -> int:
+        from optimizers import UnknownOptimizerError
+
+        try:
+            return run(args)
+        except UnknownOptimizerError as exc:
+            print(f"wrist-bench: error: {exc}", file=sys.stderr)
+            return 2
+    return wrapped
+
+
+def _calibrate(args) -> int:
+    from wrist_env.bench.calibrate import calibrate
+    from wrist_env.bench.leaderboard import reference
+    from wrist_env.design import LIGAMENT_NAMES
+    from wrist_env.errors import ParticipantError
+    from wrist_env.participants import registry
+
+    for folder in args.folder or []:
+        registry.add_folder(folder)
+    if args.participant not in registry.participants():
+        raise ParticipantError(f"unknown participant {args.participant!r}; known: {list(registry.participants())}")
+    if args.budget < 1:
+        raise SystemExit("wrist-bench calibrate: --budget must be at least 1")
+    start = time.perf_counter()
+    run = calibrate(args.participant, args.optimizer, args.budget, args.seed, log=args.log, storage=args.storage)
+    wall = time.perf_counter() - start
+    ref = reference(args.participant)
+    out = run.to_dict(history=True)
+    out["wall_seconds"] = round(wall, 3)
+    out["population"] = {m: ref.population[m]["cost"] for m in ("calibrate", "validate")}
+    out["truth"] = None if ref.truth is None else {m: ref.truth[m]["cost"] for m in ("calibrate", "validate")}
+    if args.out:
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.out).write_text(json.dumps(out, indent=1, allow_nan=False))
+    if args.json:
+        print(json.dumps(out, indent=1, allow_nan=False))
+        return 0
+    truth = out["truth"]
+    print(f"{args.participant}: {args.optimizer}, seed {args.seed}: {run.result.nfev} evaluations"
+          f"{f' ({run.replayed} replayed from the log)' if run.replayed else ''} in {wall:.1f} s; {run.result.message}")
+    for motion, name in (("calibrate", "calibration trial"), ("validate", "held-out resisted trial")):
+        score = getattr(run, motion)
+        print(f"{name + ' cost:':<30} population {out['population'][motion]:.3f} -> calibrated {score['cost']:.3f}"
+              + ("" if truth is None else f"  (hidden truth {truth[motion]:.3f})")
+              + (" FAILED" if score["failed"] else ""))
+    if run.recovery_z is not None:
+        print(f"{'parameter recovery:':<30} {run.recovery_z:.3f} SD from the truth (population design "
+              f"{run.recovery_z_population:.3f})")
+    d = run.design
+    print("calibrated design (injury scalars intact):")
+    print(f"  {'ligament':<8} {'stiffness N/mm':>15} {'reference strain':>17}")
+    for i, lig in enumerate(LIGAMENT_NAMES):
+        print(f"  {lig:<8} {d.stiffness[i]:15.2f} {d.reference_strain[i]:17.4f}")
+    if args.out:
+        print(f"written to {args.out} (usable as --design of simulate and evaluate)")
+    return 0
+
+
+def _benchmark(args) -> int:
+    import optimizers
+    from wrist_env.bench.leaderboard import write_leaderboard
+    from wrist_env.bench.runner import benchmark, make_cells
+    from wrist_env.participants import builtin, registry
+
+    for folder in args.folder or []:
+        registry.add_folder(folder)
+    participants = args.participants or list(builtin.BUILTIN)
+    names = args.optimizers or list(optimizers.available())
+    if args.seeds < 1 or args.budget < 1:
+        raise SystemExit("wrist-bench benchmark: --seeds and --budget must be at least 1")
+    cells = make_cells(participants, names, args.seeds, args.budget)
+    where = f"the dask scheduler {args.scheduler}" if args.scheduler else "local processes"
+    print(f"{len(cells)} cells: participants {', '.join(participants)} x calibrators {', '.join(names)} x "
+          f"{args.seeds} seeds, budget {args.budget}; on {where}; run log {args.out}", flush=True)
+    report = benchmark(participants, names, args.seeds, args.budget, args.out, workers=args.workers,
+                       scheduler=args.scheduler, progress=not args.no_progress, storage=args.storage,
+                       threads=args.threads, folders=tuple(args.folder or ()))
+    print(f"ran {len(report.ran)} cells, skipped {len(report.skipped)} already finished, "
+          f"{len(report.failed)} failed; {report.evaluations} evaluations logged")
+    for key, error in report.failed:
+        print(f"  failed {key.name}: {error}", file=sys.stderr)
+    if args.scheduler is None:
+        print(f"local: {report.workers} worker process(es) x {report.threads} Numba thread(s)")
+    print(f"wall time {report.wall_seconds:.1f} s")
+    leaderboard = Path(args.leaderboard) if args.leaderboard else Path(args.out) / "leaderboards"
+    if report.ran or report.skipped:
+        path = write_leaderboard(args.out, leaderboard)
+        print(f"leaderboard: {path}")
+    return 1 if report.failed else 0
+
+
+def _leaderboard(args) -> int:
+    from wrist_env.bench.leaderboard import write_leaderboard
+    from wrist_env.participants import registry
+
+    for folder in args.folder or []:
+        registry.add_folder(folder)
+    if not Path(args.runs).is_dir():
+        raise SystemExit(f"wrist-bench leaderboard: no run log at {args.runs}")
+    path = write_leaderboard(args.runs, args.out, title=args.title)
+    print(path)
+    return 0
+
+
 def _montecarlo(args) -> int:
     from wrist_env.errors import ParticipantError
     from wrist_env.montecarlo.study import StudyConfig, run_study
@@ -288,6 +395,55 @@ def parser() -> argparse.ArgumentParser:
                    help="pressure: capitate held at neutral without load, instead of the 0° frame of the "
                         "idealized sweep (10 N compressive load)")
     s.set_defaults(run=_figure)
+
+    s = sub.add_parser(
+        "calibrate", help="calibrate a participant's ligament materials with one calibrator",
+        description="Search the 22 ligament material variables (injury scalars intact) to minimize the kinematic "
+                    "cost on the participant's calibration trial, with a registered calibrator "
+                    "(`optimizers.available()`); then score the calibrated design on the held-out resisted trial "
+                    "and, for built-in participants, against the hidden truth (parameter recovery, Table 2 SD "
+                    "units). Prints the calibrated design in physical units.")
+    s.add_argument("participant")
+    s.add_argument("--optimizer", default="cmaes", help="calibrator name (default cmaes)")
+    s.add_argument("--budget", type=int, default=300, help="simulations allowed (default 300)")
+    s.add_argument("--seed", type=int, default=0, help="calibrator seed (default 0)")
+    s.add_argument("--log", help="run-log folder: log every batch, resume this run if it was cut short")
+    s.add_argument("--storage", help="Optuna storage URL for Optuna calibrators (default: in memory)")
+    s.add_argument("--out", help="also write the JSON result to this file (usable as --design elsewhere)")
+    s.add_argument("--json", action="store_true", help="print the result, design and held-out cost as JSON")
+    s.add_argument("--folder", action="append", help="register this participant folder first")
+    s.set_defaults(run=_bench_errors(_calibrate))
+
+    s = sub.add_parser(
+        "benchmark", help="run participants x calibrators x seeds into a resumable run log, then the leaderboard",
+        description="Cross participants x calibrators x seeds, one cell each, on local processes (default) or a "
+                    "dask.distributed scheduler; every evaluation is logged to Parquet in --out as its batch "
+                    "finishes. Run the same command again to resume after an interruption: finished cells are "
+                    "skipped, unfinished ones replay their logged evaluations. Writes the leaderboard at the end.")
+    s.add_argument("--participants", nargs="+", help="default: the built-in P1 P2 P3")
+    s.add_argument("--optimizers", nargs="+", help="default: every registered calibrator")
+    s.add_argument("--seeds", type=int, default=5, help="seeds 0 .. N-1 per participant and calibrator (default 5)")
+    s.add_argument("--budget", type=int, default=300, help="simulations per run (default 300)")
+    s.add_argument("--out", default="runs/benchmark", help="run-log folder (default runs/benchmark)")
+    s.add_argument("--scheduler", help="dask.distributed scheduler address (e.g. tcp://host:8786); one task per cell")
+    s.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
+    s.add_argument("--threads", type=int, help="Numba threads per local worker (default: cores / workers)")
+    s.add_argument("--storage", help="Optuna storage URL, '{cell}' replaced by the cell's key (default: "
+                                     "sqlite:///<out>/optuna/{cell}.db); 'memory': studies in memory only")
+    s.add_argument("--leaderboard", help="leaderboard folder (default: <out>/leaderboards)")
+    s.add_argument("--no-progress", action="store_true", help="no progress bar")
+    s.add_argument("--folder", action="append", help="register this participant folder (in every worker)")
+    s.set_defaults(run=_bench_errors(_benchmark))
+
+    s = sub.add_parser("leaderboard", help="write the leaderboards of a benchmark run log",
+                       description="Tables (Markdown, CSV) and figures (PNG) from a benchmark run log: best cost "
+                                   "at the budget, evaluations to cost targets, ECDF and convergence plots, "
+                                   "parameter recovery, the held-out trial, the preprint's Tables 3-4.")
+    s.add_argument("--runs", default="runs/benchmark", help="run-log folder (default runs/benchmark)")
+    s.add_argument("--out", default="leaderboards", help="output folder (default leaderboards)")
+    s.add_argument("--title", help="title of the README.md")
+    s.add_argument("--folder", action="append", help="register this participant folder first")
+    s.set_defaults(run=_leaderboard)
 
     s = sub.add_parser(
         "montecarlo", help="Monte Carlo injury study: n successful idealized sweeps per participant (preprint 2.3.2)",

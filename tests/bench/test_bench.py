@@ -1,0 +1,169 @@
+"""The benchmark: run log, runner (local processes, kill-and-resume, dask), leaderboards, CLI."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import optimizers
+import wrist_env
+from wrist_env.bench import DuplicateEvaluationError, ResumeError, RunKey, RunLog, benchmark, calibrate
+from wrist_env.bench.calibrate import accepts_storage
+from wrist_env.bench.leaderboard import write_leaderboard
+from wrist_env.bench.log import KEY_FIELDS
+from wrist_env.cli import main
+
+REPO = Path(wrist_env.__file__).resolve().parent.parent
+TINY = ["random", "lhs"] if "lhs" in optimizers.available() else ["random"]
+LEADERBOARD_FILES = ("README.md", "best_cost.csv", "evals_to_target.csv", "recovery.csv", "heldout.csv",
+                     "table3_rmse_calibrate.csv", "table4_rmse_validate.csv", "dof_improved.csv", "runs.csv",
+                     "targets.csv", "ecdf.png", "convergence.png")
+
+
+@pytest.fixture(scope="module")
+def p1(built):
+    built("P1")  # in the session's model cache, which subprocesses and dask workers inherit
+    return "P1"
+
+
+def _duplicates(frame) -> int:
+    return int(frame.duplicated(list(KEY_FIELDS) + ["eval"]).sum())
+
+
+def test_tiny_benchmark_logs_every_evaluation_once_and_writes_the_leaderboard(p1, tmp_path):
+    report = benchmark([p1], TINY, 2, 12, tmp_path / "runs", workers=2, progress=False)
+    assert not report.failed and len(report.ran) == len(TINY) * 2 and report.workers == 2
+    rows = RunLog(tmp_path / "runs").read(dedupe=False)
+    assert len(rows) == 1 * len(TINY) * 2 * 12
+    assert _duplicates(rows) == 0 and np.isfinite(rows.cost).all()
+    for (_, group) in rows.groupby(list(KEY_FIELDS)):
+        assert group["eval"].tolist() == list(range(12))
+    path = write_leaderboard(tmp_path / "runs", tmp_path / "lb")
+    for name in LEADERBOARD_FILES:
+        assert (tmp_path / "lb" / name).is_file(), name
+    assert "Tables 3–4" in path.read_text()
+    # a second call finds every cell finished and runs nothing
+    again = benchmark([p1], TINY, 2, 12, tmp_path / "runs", workers=2, progress=False)
+    assert not again.ran and len(again.skipped) == len(TINY) * 2
+    assert len(RunLog(tmp_path / "runs").read(dedupe=False)) == len(rows)
+
+
+def _csvs(folder: Path) -> dict:
+    return {p.name: p.read_text() for p in sorted(folder.glob("*.csv"))}
+
+
+def test_killed_benchmark_resumes_to_the_same_leaderboard(p1, tmp_path):
+    args = ["--participants", p1, "--optimizers", *TINY, "--seeds", "2", "--budget", "48"]
+    reference = benchmark([p1], TINY, 2, 48, tmp_path / "reference", workers=1, progress=False)
+    assert not reference.failed
+    write_leaderboard(tmp_path / "reference", tmp_path / "lb_reference")
+
+    out = tmp_path / "killed"
+    env = dict(os.environ, PYTHONPATH=str(REPO))
+    proc = subprocess.Popen([sys.executable, "-m", "wrist_env.cli", "benchmark", *args, "--out", str(out),
+                             "--workers", "1", "--no-progress"], env=env, cwd=tmp_path, start_new_session=True,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 90
+    while time.monotonic() < deadline and proc.poll() is None:
+        if list((out / "evals").glob("part-*.parquet")):  # a cell is half done
+            break
+        time.sleep(0.01)
+    assert proc.poll() is None, f"the benchmark ended before it could be killed: {proc.stderr.read()}"
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    log = RunLog(out)
+    logged = sum(log.progress().values())
+    assert 0 < logged < len(TINY) * 2 * 48
+    assert list((out / "evals").glob("part-*.parquet")), "no cell was left half done"
+
+    assert main(["benchmark", *args, "--out", str(out), "--workers", "1", "--no-progress",
+                 "--leaderboard", str(tmp_path / "lb_resumed")]) == 0
+    rows = log.read(dedupe=False)
+    assert len(rows) == len(TINY) * 2 * 48 and _duplicates(rows) == 0
+    assert sum(s["replayed"] for s in log.summaries()) > 0  # the half-done cell resumed by replay
+    assert _csvs(tmp_path / "lb_resumed") == _csvs(tmp_path / "lb_reference")
+
+
+def test_dask_local_cluster_gives_the_same_costs_as_local(p1, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    sys_path = os.environ.get("PYTHONPATH")
+    os.environ["PYTHONPATH"] = str(REPO)  # the worker processes import this checkout
+    try:
+        with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                      dashboard_address=None) as cluster:
+            report = benchmark([p1], ["random"], [0], 16, tmp_path / "dask", scheduler=cluster.scheduler_address,
+                               progress=False)
+    finally:
+        if sys_path is None:
+            os.environ.pop("PYTHONPATH", None)
+        else:
+            os.environ["PYTHONPATH"] = sys_path
+    assert not report.failed and len(report.ran) == 1
+    local = benchmark([p1], ["random"], [0], 16, tmp_path / "local", workers=1, progress=False)
+    assert not local.failed
+    on_dask, here = RunLog(tmp_path / "dask").read(), RunLog(tmp_path / "local").read()
+    assert len(on_dask) == 16
+    np.testing.assert_array_equal(on_dask.cost.to_numpy(), here.cost.to_numpy())
+
+
+def test_cli_calibrate_json_parses(p1, capsys):
+    assert main(["calibrate", p1, "--optimizer", "random", "--budget", "8", "--seed", "0", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["nfev"] == 8 and len(out["history_fun"]) == 8 and out["best_cost"] == min(out["history_fun"])
+    assert len(out["design"]) == 27 and all(out["design"][f"{n}.injury"] == 1.0
+                                             for n in ("SLIL_v", "SLIL_p", "SLIL_d", "RSC", "LRL"))
+    assert 5 < out["design"]["SLIL_d.stiffness"] < 160  # physical units (N/mm), not normalized
+    assert np.isfinite(out["validate"]["cost"]) and out["recovery_z"] > 0
+    assert out["calibrate"]["cost"] == pytest.approx(out["best_cost"])
+
+
+def test_log_refuses_an_evaluation_twice(tmp_path):
+    log, key = RunLog(tmp_path), RunKey("P1", "random", 0, 4)
+    x, rmse = np.zeros((2, 22)), np.zeros((2, 12))
+    log.append(key, 0, 0, x, [1.0, 2.0], [False, False], rmse)
+    with pytest.raises(DuplicateEvaluationError):
+        log.append(key, 0, 0, x, [1.0, 2.0], [False, False], rmse)
+    with pytest.raises(DuplicateEvaluationError):
+        log.append(key, 1, 1, x, [1.0, 2.0], [False, False], rmse)  # overlaps evaluation 1
+    log.append(key, 1, 2, x, [3.0, 4.0], [False, False], rmse)
+    assert log.read()["eval"].tolist() == [0, 1, 2, 3]
+
+
+class _Unseeded(optimizers.Optimizer):
+    """Ignores its seed: cannot be resumed by replay."""
+
+    name = "test-unseeded"
+
+    def _ask(self, n_max):
+        return np.random.default_rng().uniform(-0.5, 0.5, (min(n_max, 4), self.dim))
+
+    def _tell(self, x, y):
+        pass
+
+
+def test_a_calibrator_that_ignores_its_seed_cannot_resume(p1, tmp_path, monkeypatch):
+    monkeypatch.setitem(optimizers.registry._REGISTRY, _Unseeded.name, _Unseeded)  # registered for this test only
+
+    class Stop(Exception):
+        pass
+
+    def stop(n_new, nfev):
+        raise Stop
+
+    with pytest.raises(Stop):
+        calibrate(p1, "test-unseeded", 8, 0, log=tmp_path, callback=stop)
+    with pytest.raises(ResumeError, match="not deterministic"):
+        calibrate(p1, "test-unseeded", 8, 0, log=tmp_path)
+
+
+def test_only_optuna_calibrators_take_a_storage():
+    assert not accepts_storage(optimizers.get("random"))
+    for name in ("optuna-tpe", "optuna-cmaes"):
+        if name in optimizers.available():
+            assert accepts_storage(optimizers.get(name))

@@ -1,0 +1,18 @@
+"""The calibration benchmark: one calibration (`calibrate`), the runner over participants ×
+calibrators × seeds (`benchmark`), its Parquet run log (`RunLog`) and the leaderboards
+(`write_leaderboard`). `wrist-bench calibrate | benchmark | leaderboard` are the commands."""
+
+from wrist_env.bench.calibrate import CalibrationRun, ResumeError, calibrate
+from wrist_env.bench.log import DuplicateEvaluationError, RunKey, RunLog
+from wrist_env.bench.runner import BenchmarkReport, benchmark
+
+
+def write_leaderboard(runs, out, **kwargs):
+    """Write the leaderboards of the run log in `runs` to the folder `out` (see `leaderboard`)."""
+    from wrist_env.bench.leaderboard import write_leaderboard as write
+
+    return write(runs, out, **kwargs)
+
+
+__all__ = ["BenchmarkReport", "CalibrationRun", "DuplicateEvaluationError", "ResumeError", "RunKey", "RunLog",
+           "benchmark", "calibrate", "write_leaderboard"]

@@ -1,0 +1,242 @@
+"""The benchmark's run log: append-only Parquet, one row per evaluation, resumable.
+
+Layout of a run directory (`RunLog(root)`)::
+
+    root/evals/part-<cell>-b00003-e000048-000064.parquet   one file per batch, as it finishes
+    root/evals/cell-<cell>-n000300.parquet                 a finished cell's batches, compacted
+    root/cells/<cell>.json                                 a finished cell's summary (calibrated design,
+                                                           held-out cost, parameter recovery)
+    root/locks/<cell>.lock                                 held (flock) while a process runs the cell
+
+Every file is written to a temporary name in the same folder and moved into
+place with `os.replace`, so a reader (or a killed writer) never sees half a
+file. A row is one evaluation: the run key (participant, optimizer, seed,
+budget), its index in the run (`eval`, 0-based, the optimizer's order) and
+batch (`batch`), the 22 normalized material variables (`x.<name>`), the
+kinematic cost on the calibration trial, `failed`, and the RMSE of the 12
+scaphoid and lunate DOF (`rmse.<bone>.<DOF>`, mm and deg; NaN if failed).
+
+No evaluation is logged twice: `append` refuses a batch whose file or eval
+indices already exist, and `read` drops duplicate (run key, eval) rows (the
+only way to get them is a crash between writing a compacted cell file and
+removing its batch files, which the next compaction repairs).
+"""
+
+from __future__ import annotations
+
+import fcntl
+import json
+import os
+import re
+import time
+import uuid
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from wrist_env.cost import COST_BONES
+from wrist_env.design import N_MATERIAL, NAMES
+from wrist_env.frames import DOF_NAMES
+
+KEY_FIELDS = ("participant", "optimizer", "seed", "budget")
+X_COLUMNS = tuple(f"x.{n}" for n in NAMES[:N_MATERIAL])
+RMSE_COLUMNS = tuple(f"rmse.{bone}.{dof}" for bone in COST_BONES for dof in DOF_NAMES)
+SCHEMA = pa.schema(
+    [("participant", pa.string()), ("optimizer", pa.string()), ("seed", pa.int64()), ("budget", pa.int64()),
+     ("eval", pa.int64()), ("batch", pa.int64()), ("time", pa.float64())]
+    + [(c, pa.float64()) for c in X_COLUMNS]
+    + [("cost", pa.float64()), ("failed", pa.bool_())]
+    + [(c, pa.float64()) for c in RMSE_COLUMNS]
+)
+"""Columns of the evaluation log; `time` is the Unix time the batch finished."""
+
+_PART = re.compile(r"^part-(?P<cell>.+)-b(?P<batch>\d+)-e(?P<start>\d+)-(?P<end>\d+)\.parquet$")
+_CELL = re.compile(r"^cell-(?P<cell>.+)-n(?P<n>\d+)\.parquet$")
+
+
+class DuplicateEvaluationError(RuntimeError):
+    """An attempt to log an evaluation that is already in the log."""
+
+
+@dataclass(frozen=True, order=True)
+class RunKey:
+    """One benchmark cell: a calibrator run on a participant with a seed and a budget."""
+
+    participant: str
+    optimizer: str
+    seed: int
+    budget: int
+
+    @property
+    def name(self) -> str:
+        """A file-name-safe identifier, also the Optuna study name."""
+        safe = re.sub(r"[^A-Za-z0-9_.+-]", "_", f"{self.participant}.{self.optimizer}")
+        return f"{safe}.seed{self.seed}.budget{self.budget}"
+
+    def as_dict(self) -> dict:
+        return {"participant": self.participant, "optimizer": self.optimizer, "seed": self.seed, "budget": self.budget}
+
+
+def _atomic_write(path: Path, write) -> None:
+    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
+def write_json_atomic(path: Path, data) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    _atomic_write(path, lambda p: p.write_text(json.dumps(data, indent=1, allow_nan=False)))
+
+
+class RunLog:
+    """The run log under `root` (created on first write)."""
+
+    def __init__(self, root):
+        self.root = Path(root)
+        self.evals_dir = self.root / "evals"
+        self.cells_dir = self.root / "cells"
+        self.locks_dir = self.root / "locks"
+
+    # writing
+
+    def append(self, key: RunKey, batch: int, start: int, x: np.ndarray, cost, failed, rmse: np.ndarray) -> Path:
+        """Log one batch: evaluations start … start + k − 1 of `key`, atomically, never twice.
+
+        x (k, 22) normalized materials; cost (k,); failed (k,); rmse (k, 12) in `RMSE_COLUMNS` order.
+        """
+        x = np.atleast_2d(np.asarray(x, dtype=np.float64))
+        k = len(x)
+        cost = np.asarray(cost, dtype=np.float64).reshape(k)
+        failed = np.asarray(failed, dtype=bool).reshape(k)
+        rmse = np.asarray(rmse, dtype=np.float64).reshape(k, len(RMSE_COLUMNS))
+        if x.shape[1] != len(X_COLUMNS):
+            raise ValueError(f"x must have {len(X_COLUMNS)} columns, but got {x.shape}")
+        self.evals_dir.mkdir(parents=True, exist_ok=True)
+        logged = self.logged_range(key)
+        if start != logged:
+            raise DuplicateEvaluationError(
+                f"{key.name}: batch {batch} starts at evaluation {start}, but {logged} evaluations are logged "
+                f"(evaluations must be logged once, in order)")
+        existing = list(self.evals_dir.glob(f"part-{key.name}-b{batch:05d}-*.parquet"))
+        if existing:
+            raise DuplicateEvaluationError(f"{key.name}: batch {batch} is already logged ({existing[0].name})")
+        now = time.time()
+        columns = {
+            "participant": [key.participant] * k, "optimizer": [key.optimizer] * k, "seed": [key.seed] * k,
+            "budget": [key.budget] * k, "eval": list(range(start, start + k)), "batch": [batch] * k,
+            "time": [now] * k,
+        }
+        columns.update({c: x[:, i] for i, c in enumerate(X_COLUMNS)})
+        columns["cost"] = cost
+        columns["failed"] = failed
+        columns.update({c: rmse[:, i] for i, c in enumerate(RMSE_COLUMNS)})
+        table = pa.Table.from_pydict(columns, schema=SCHEMA)
+        path = self.evals_dir / f"part-{key.name}-b{batch:05d}-e{start:06d}-{start + k:06d}.parquet"
+        _atomic_write(path, lambda p: pq.write_table(table, p))
+        return path
+
+    def compact(self, key: RunKey) -> Path | None:
+        """Merge a cell's batch files into one file (then remove them); the rows are unchanged."""
+        frame = self.read_cell(key)
+        if frame is None:
+            return None
+        path = self.evals_dir / f"cell-{key.name}-n{len(frame):06d}.parquet"
+        table = pa.Table.from_pandas(frame, schema=SCHEMA, preserve_index=False)
+        _atomic_write(path, lambda p: pq.write_table(table, p))
+        for p in self._files(key):
+            if p != path:
+                p.unlink(missing_ok=True)
+        return path
+
+    def write_summary(self, key: RunKey, summary: dict) -> Path:
+        path = self.cells_dir / f"{key.name}.json"
+        write_json_atomic(path, summary)
+        return path
+
+    @contextmanager
+    def lock(self, key: RunKey):
+        """Hold the cell's lock (an flock, released when the process dies) while running it."""
+        self.locks_dir.mkdir(parents=True, exist_ok=True)
+        with open(self.locks_dir / f"{key.name}.lock", "a+") as handle:
+            fcntl.flock(handle, fcntl.LOCK_EX)
+            try:
+                yield
+            finally:
+                fcntl.flock(handle, fcntl.LOCK_UN)
+
+    # reading
+
+    def _files(self, key: RunKey | None = None) -> list[Path]:
+        if not self.evals_dir.is_dir():
+            return []
+        pattern = "*.parquet" if key is None else f"*-{key.name}-*.parquet"
+        out = []
+        for p in sorted(self.evals_dir.glob(pattern)):
+            m = _PART.match(p.name) or _CELL.match(p.name)
+            if m and (key is None or m["cell"] == key.name):
+                out.append(p)
+        return out
+
+    def read(self, *, dedupe: bool = True):
+        """Every logged evaluation as a pandas DataFrame (sorted by run key and eval), duplicates dropped."""
+        import pandas as pd
+
+        files = self._files()
+        if not files:
+            return pd.DataFrame({f.name: pd.Series(dtype=f.type.to_pandas_dtype()) for f in SCHEMA})
+        frame = pa.concat_tables([pq.read_table(p, schema=SCHEMA) for p in files]).to_pandas()
+        if dedupe:
+            frame = frame.drop_duplicates(subset=list(KEY_FIELDS) + ["eval"], keep="first")
+        return frame.sort_values(list(KEY_FIELDS) + ["eval"], kind="stable").reset_index(drop=True)
+
+    def read_cell(self, key: RunKey):
+        """The cell's rows (DataFrame sorted by eval, duplicates dropped), or None if nothing is logged."""
+        files = self._files(key)
+        if not files:
+            return None
+        frame = pa.concat_tables([pq.read_table(p, schema=SCHEMA) for p in files]).to_pandas()
+        frame = frame[(frame.participant == key.participant) & (frame.optimizer == key.optimizer)
+                      & (frame.seed == key.seed) & (frame.budget == key.budget)]
+        frame = frame.drop_duplicates(subset=["eval"], keep="first").sort_values("eval", kind="stable")
+        frame = frame.reset_index(drop=True)
+        if not np.array_equal(frame["eval"].to_numpy(), np.arange(len(frame))):
+            raise RuntimeError(f"{key.name}: the logged evaluations are not 0 … n−1: {frame['eval'].tolist()}")
+        return frame
+
+    def logged_range(self, key: RunKey) -> int:
+        """How many evaluations of the cell are logged (from the file names; cheap)."""
+        return self.progress().get(key.name, 0)
+
+    def progress(self) -> dict[str, int]:
+        """{cell name: evaluations logged}, from the file names alone (for progress bars)."""
+        out: dict[str, int] = {}
+        if not self.evals_dir.is_dir():
+            return out
+        with os.scandir(self.evals_dir) as it:
+            for entry in it:
+                m = _PART.match(entry.name)
+                if m:
+                    out[m["cell"]] = max(out.get(m["cell"], 0), int(m["end"]))
+                    continue
+                m = _CELL.match(entry.name)
+                if m:
+                    out[m["cell"]] = max(out.get(m["cell"], 0), int(m["n"]))
+        return out
+
+    def summary(self, key: RunKey) -> dict | None:
+        path = self.cells_dir / f"{key.name}.json"
+        return json.loads(path.read_text()) if path.is_file() else None
+
+    def summaries(self) -> list[dict]:
+        """The summaries of every finished cell."""
+        if not self.cells_dir.is_dir():
+            return []
+        return [json.loads(p.read_text()) for p in sorted(self.cells_dir.glob("*.json"))]
