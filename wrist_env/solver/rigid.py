@@ -7,32 +7,6 @@ from numba import njit
 
 
 @njit(cache=True, error_model="numpy")
-def rotvec_to_matrix(w):
-    """Rotation matrix (3, 3) of a rotation vector (3,), radians (Rodrigues)."""
-    theta = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
-    R = np.eye(3)
-    if theta < 1e-14:
-        R[0, 1] = -w[2]
-        R[0, 2] = w[1]
-        R[1, 0] = w[2]
-        R[1, 2] = -w[0]
-        R[2, 0] = -w[1]
-        R[2, 1] = w[0]
-        return R
-    k = w / theta
-    c = np.cos(theta)
-    s = np.sin(theta)
-    K = np.zeros((3, 3))
-    K[0, 1] = -k[2]
-    K[0, 2] = k[1]
-    K[1, 0] = k[2]
-    K[1, 2] = -k[0]
-    K[2, 0] = -k[1]
-    K[2, 1] = k[0]
-    return R + s * K + (1.0 - c) * (K @ K)
-
-
-@njit(cache=True, error_model="numpy")
 def matrix_to_rotvec(R):
     """Rotation vector (3,), radians, of a rotation matrix (3, 3)."""
     c = (R[0, 0] + R[1, 1] + R[2, 2] - 1.0) * 0.5
