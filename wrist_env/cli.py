@@ -170,6 +170,26 @@ def _evaluate(args) -> int:
     return 1 if evaluation.failed else 0
 
 
+def _validate(args) -> int:
+    from wrist_env import validation
+    from wrist_env.errors import ParticipantError
+    from wrist_env.participants import registry
+
+    for folder in args.folder or []:
+        registry.add_folder(folder)
+    if args.participant not in registry.participants():
+        raise ParticipantError(f"unknown participant {args.participant!r}; known: {list(registry.participants())}")
+    report = validation.validate(args.participant)
+    out = Path(args.out) / f"validation_{report.participant}.png" if args.out else None
+    figure = validation.validation_figure(report, out)
+    if args.json:
+        print(json.dumps(dict(report.to_dict(), figure=str(figure)), indent=1, allow_nan=False))
+    else:
+        print(validation.format_table(report))
+        print(f"figure: {figure}")
+    return 0 if report.passed else 1
+
+
 def _figure(args) -> int:
     from wrist_env import figures
 
@@ -383,6 +403,19 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true", help="print the cost, per-DOF errors and timings as JSON")
     s.add_argument("--folder", action="append", help="register this participant folder first")
     s.set_defaults(run=_evaluate)
+
+    s = sub.add_parser(
+        "validate", help="check the model against published wrist measurements (exit 1 if any check fails)",
+        description="Simulate the population design (idealized +-40 deg sweep intact and with all three SLIL bundles "
+                    "torn, and the capitate held at neutral) and compare carpal kinematics, radiocarpal load share, "
+                    "SL gap after SLIL tear, radioscaphoid pressure and SLIL force with published bands (each row "
+                    "cites its source). Prints the table (or JSON) and writes a figure; exit status 1 if any check "
+                    "fails.")
+    s.add_argument("participant")
+    s.add_argument("--json", action="store_true", help="print the checks and series as JSON")
+    s.add_argument("--out", help=f"figure folder (default {FIGURES})")
+    s.add_argument("--folder", action="append", help="register this participant folder first")
+    s.set_defaults(run=_validate)
 
     s = sub.add_parser("figure", help="write a figure (PNG)",
                        description="model: bones, cartilage, ligaments; annotations: the template; pressure: "

@@ -1,0 +1,101 @@
+"""`wrist-bench validate`: the measures on known geometry, strict JSON, the CLI, and (xfail) the bands."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from wrist_env import design, validation
+from wrist_env.cli import main
+
+CHECK_IDS = ("scaphoid_slope", "lunate_slope", "scaphoid_above_lunate", "rs_rl_force_ratio", "sl_gap_growth_mm",
+             "rs_mean_pressure_mpa", "slil_force_30ext_n")
+
+
+def test_slope_recovers_a_known_line_and_ignores_nan():
+    x = np.linspace(40, -40, 17)
+    y = 0.72 * x + 3.0 + 0.01 * np.sin(np.arange(17))
+    assert validation.slope(x, y) == pytest.approx(0.72, abs=2e-3)
+    y[4] = np.nan
+    assert validation.slope(x, y) == pytest.approx(0.72, abs=2e-3)
+    assert math.isnan(validation.slope(np.ones(5), np.arange(5.0)))
+
+
+def _pose(translation=(0, 0, 0), angle_deg=0.0):
+    from scipy.spatial.transform import Rotation
+
+    T = np.eye(4)
+    T[:3, :3] = Rotation.from_euler("z", angle_deg, degrees=True).as_matrix()
+    T[:3, 3] = translation
+    return T
+
+
+def test_surface_gap_of_two_translated_boxes():
+    import trimesh
+
+    box = trimesh.creation.box(extents=(10.0, 10.0, 10.0))
+    mesh = (np.asarray(box.vertices), np.asarray(box.faces))
+    moved = (np.asarray(box.vertices) + [13.0, 0.0, 0.0], np.asarray(box.faces))
+    # the copy 13 mm along x: faces 3 mm apart; then both posed: the second moved 2 mm further, the first turned
+    a_poses = np.stack([_pose(), _pose(), _pose(angle_deg=90.0)])
+    b_poses = np.stack([_pose(), _pose((2.0, 0.0, 0.0)), _pose()])
+    gap = validation.surface_gap_mm(mesh, moved, a_poses, b_poses)
+    np.testing.assert_allclose(gap, [3.0, 5.0, 3.0], atol=1e-9)
+    a_poses[1, 0, 0] = np.nan
+    assert math.isnan(validation.surface_gap_mm(mesh, moved, a_poses, b_poses)[1])
+
+
+def test_with_tears_uses_the_injurable_names():
+    d = validation.with_tears(design.population(), validation.SLIL)
+    torn = {n for n, t in zip(design.LIGAMENT_NAMES, d.torn) if t}
+    assert torn == {"SLIL_v", "SLIL_p", "SLIL_d"}
+    assert not design.population().torn.any()
+
+
+def test_report_json_is_strict_and_round_trips():
+    inf, nan = float("inf"), float("nan")
+    rows = (validation.Check("a", "finite", 1.5, (1.0, 2.0), "mm", "src", True),
+            validation.Check("b", "failed run", nan, (3.0, inf), "mm", "src", False))
+    series = {"capitate_angle_deg": np.array([40.0, 0.0, -40.0]), "sl_gap_intact_mm": np.array([1.0, nan, 1.2]),
+              "intact_status": "ok"}
+    report = validation.Report("X", rows, series, 1.25)
+    text = json.dumps(report.to_dict(), allow_nan=False)
+    back = json.loads(text)
+    assert back["passed"] is False
+    assert back["checks"][0] == {"id": "a", "description": "finite", "value": 1.5, "band": [1.0, 2.0], "unit": "mm",
+                                 "source": "src", "passed": True}
+    assert back["checks"][1]["value"] is None and back["checks"][1]["band"] == [3.0, None]
+    assert back["series"]["sl_gap_intact_mm"] == [1.0, None, 1.2] and back["series"]["intact_status"] == "ok"
+    assert "FAIL" in validation.format_table(report)
+
+
+def test_cli_validate_json_has_the_seven_checks(capsys, built, tmp_path):
+    built("P1")
+    code = main(["validate", "P1", "--json", "--out", str(tmp_path)])
+    out = json.loads(capsys.readouterr().out)
+    assert tuple(c["id"] for c in out["checks"]) == CHECK_IDS
+    for c in out["checks"]:
+        assert len(c["band"]) == 2 and c["band"][0] is not None, c
+        assert c["source"] and c["unit"] and isinstance(c["passed"], bool), c
+        if c["value"] is not None:
+            low, high = c["band"]
+            assert c["passed"] == (low <= c["value"] <= (math.inf if high is None else high)), c
+    assert code == (0 if all(c["passed"] for c in out["checks"]) else 1)
+    assert out["participant"] == "P1" and len(out["series"]["capitate_angle_deg"]) == 17
+    figure = tmp_path / "validation_P1.png"
+    assert out["figure"] == str(figure) and figure.stat().st_size > 10_000
+
+
+def test_a_failed_run_fails_its_check_and_says_why():
+    row = validation._row("sl_gap_growth_mm", "SL gap growth", 5.0, (3.0, math.inf), "mm",
+                          "SLIL-torn sweep run failed: NaN in the state")
+    assert math.isnan(row.value) and not row.passed and "failed: NaN in the state" in row.description
+
+
+@pytest.mark.xfail(reason="model fidelity work in progress", strict=False, raises=AssertionError)
+@pytest.mark.parametrize("name", ["P1", "P2", "P3"])
+def test_builtins_pass_published_checks(name, built):
+    report = validation.validate(name, model=built(name))
+    failed = [(r.id, r.value, r.band) for r in report.rows if not r.passed]
+    assert not failed, failed
