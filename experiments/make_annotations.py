@@ -47,8 +47,8 @@ def patch_radius(bone: str, lig) -> float:
 
 
 def main() -> None:
-    bones = load_template().bones
-    V = {b: bones[b].vertices for b in bones}
+    template = load_template()
+    V = {b: template.parts[b].vertices for b in template.parts}  # rules read the bones one by one
     near = lambda a, b, gap: cKDTree(V[b]).query(V[a])[0] < gap  # noqa: E731
     s_sl, l_sl = near("scaphoid", "lunate", 3.0), near("lunate", "scaphoid", 3.0)
     distal_radius = V["radius"][:, 1] < 6.0
@@ -73,7 +73,8 @@ def main() -> None:
         "SRL": (("radius", extreme(V["radius"], (1, -0.2, 0), distal_radius & (V["radius"][:, 2] < -3) & (V["radius"][:, 2] > -10))),
                 ("lunate", extreme(V["lunate"], (1, 0.5, -0.3), V["lunate"][:, 1] > lun_c[1]))),
         # Nagao 2005, Mizuseki 1989: DRC from the dorsal rim of the radius (Lister's region)
-        # to the dorsal lunate (its fibres continue to the triquetrum, not modelled).
+        # to the dorsal lunate (with the distal row and triquetrum: on to the dorsal tubercle
+        # of the triquetrum, which moves with the lunate body; see `part` below).
         "DRC": (("radius", extreme(V["radius"], (-1, -0.2, 0), distal_radius & (np.abs(V["radius"][:, 2]) < 5))),
                 ("lunate", extreme(V["lunate"], (-1, 0, 0)))),
         # Ringler 2013: RCL from the tip of the radial styloid to the radial scaphoid waist.
@@ -93,6 +94,14 @@ def main() -> None:
             "origin": {"bone": ob, "centre_mm": np.round(oc, 3).tolist(), "radius_mm": patch_radius(ob, lig)},
             "insertion": {"bone": ib, "centre_mm": np.round(ic, 3).tolist(), "radius_mm": patch_radius(ib, lig)},
         }
+    # Mizuseki 1989: the DRC's main insertion is the dorsal tubercle of the triquetrum.
+    drc = ligaments["DRC"]["insertion"]
+    ligaments["DRC"]["insertion"] = {"bone": "lunate", "part": "triquetrum",
+                                     "centre_mm": np.round(extreme(V["triquetrum"], (-1, 0, 0)), 3).tolist(),
+                                     "radius_mm": drc["radius_mm"], "without_part": drc}
+    # Articulations are between rigid bodies: the scaphocapitate one includes the scaphoid's
+    # distal pole against the trapezium and trapezoid (the STT joint), the lunocapitate one the
+    # triquetrum against the hamate (Moritomo 2013: the helicoid triquetrohamate joint).
     cartilage = {
         "radioscaphoid": {"bones": ["radius", "scaphoid"], "max_gap_mm": 2.5},
         "radiolunate": {"bones": ["radius", "lunate"], "max_gap_mm": 2.5},

@@ -105,7 +105,7 @@ def make(name: str) -> dict:
         poses = np.transpose(result.poses, (1, 0, 2, 3)).copy()  # (bone, frame, 4, 4)
         for b in ("scaphoid", "lunate", "capitate"):
             i = BONES.index(b)
-            poses[i] = tracking_noise(poses[i], model.com[i], rng)
+            poses[i] = tracking_noise(poses[i], model.centroid[i], rng)
         t = Trial(trial, ROLE[trial], BONES, poses)
         write_trial_csv(t, folder / f"{trial}.csv")
         out[trial] = {"file": f"trials/{trial}.csv", "role": ROLE[trial], "task": info.task,

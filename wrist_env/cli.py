@@ -179,8 +179,14 @@ def _validate(args) -> int:
         registry.add_folder(folder)
     if args.participant not in registry.participants():
         raise ParticipantError(f"unknown participant {args.participant!r}; known: {list(registry.participants())}")
-    report = validation.validate(args.participant)
-    out = Path(args.out) / f"validation_{report.participant}.png" if args.out else None
+    from wrist_env.build.pipeline import BuildParams
+    from wrist_env.solver.simulate import IDEALIZED_LOAD_N
+
+    params = BuildParams(fossa_sweep_deg=tuple(args.fossa_sweep), distal_row=args.distal_row)
+    report = validation.validate(args.participant, params=params,
+                                 load_n=IDEALIZED_LOAD_N if args.load is None else args.load)
+    variant = "" if params == BuildParams() and args.load is None else "_variant"
+    out = Path(args.out or FIGURES) / f"validation_{report.participant}{variant}.png"
     figure = validation.validation_figure(report, out)
     if args.json:
         print(json.dumps(dict(report.to_dict(), figure=str(figure)), indent=1, allow_nan=False))
@@ -415,6 +421,12 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true", help="print the checks and series as JSON")
     s.add_argument("--out", help=f"figure folder (default {FIGURES})")
     s.add_argument("--folder", action="append", help="register this participant folder first")
+    s.add_argument("--distal-row", action="store_true",
+                   help="anatomy variant: triquetrum with the lunate, trapezium/trapezoid/hamate with the capitate")
+    s.add_argument("--fossa-sweep", nargs=2, type=float, default=(0.0, 0.0), metavar=("FLEXION", "DEVIATION"),
+                   help="anatomy variant: radius fossae as the envelope of the row swept +-these angles (deg); "
+                        "default 0 0 (moulded to the neutral row)")
+    s.add_argument("--load", type=float, help="compressive load on the capitate, N (default: the idealized driver's)")
     s.set_defaults(run=_validate)
 
     s = sub.add_parser("figure", help="write a figure (PNG)",

@@ -15,7 +15,20 @@ import numpy as np
 from wrist_env.io import load_dataclass, save_dataclass
 
 BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate")
+"""The five rigid bodies, each named after its principal bone."""
 RADIUS, ULNA, SCAPHOID, LUNATE, CAPITATE = range(5)
+BODY_PARTS = {
+    "radius": ("radius",),
+    "ulna": ("ulna",),
+    "scaphoid": ("scaphoid",),
+    "lunate": ("lunate", "triquetrum"),
+    "capitate": ("capitate", "trapezium", "trapezoid", "hamate"),
+}
+"""The bones of each rigid body, principal bone first: the triquetrum moves with the lunate
+(lunotriquetral motion is small beside scapholunate motion: Ruby 1988, Kobayashi 1997), the
+distal row with the capitate (within 3°: Akhbari 2019)."""
+PARTS = tuple(p for b in BONES for p in BODY_PARTS[b])
+"""All nine bones of the model: the five principal bones, then the triquetrum and the distal row."""
 PAIRS = ("radioscaphoid", "radiolunate", "scapholunate", "scaphocapitate", "lunocapitate")
 PAIR_BONES = np.array([[SCAPHOID, RADIUS], [LUNATE, RADIUS], [SCAPHOID, LUNATE], [CAPITATE, SCAPHOID], [CAPITATE, LUNATE]])
 """(sample bone, grid bone) of each contact pair: samples of the first are looked up in the second's grid."""
@@ -27,8 +40,11 @@ class Model:
 
     Bones (5, `BONES` order):
         vertices (V, 3) mm, vertex_offsets (6,); faces (F, 3) local indices, face_offsets (6,);
+        vertex_part (V,) index into `BODY_PARTS[body]` of the bone each vertex belongs to;
         thickness (V,) mm, cartilage thickness per vertex (0 off cartilage);
-        mass (5,) t; com (5, 3) mm; inertia (5, 3, 3) t·mm² about the com, RCS axes.
+        mass (5,) t; com (5, 3) mm; inertia (5, 3, 3) t·mm² about the com, RCS axes;
+        centroid (5, 3) mm, volume centroid of each body's principal bone alone (the point
+        whose motion the kinematic cost tracks; the lunate's without the triquetrum).
     Contact grids (one per bone; empty for the ulna):
         grid_origin (5, 3) mm; grid_spacing (5,) mm; grid_shape (5, 3);
         grid_values (G,) float32 mm, C-order per bone, grid_offsets (6,).
@@ -52,10 +68,12 @@ class Model:
     vertex_offsets: np.ndarray
     faces: np.ndarray
     face_offsets: np.ndarray
+    vertex_part: np.ndarray
     thickness: np.ndarray
     mass: np.ndarray
     com: np.ndarray
     inertia: np.ndarray
+    centroid: np.ndarray
     grid_origin: np.ndarray
     grid_spacing: np.ndarray
     grid_shape: np.ndarray
@@ -89,6 +107,16 @@ class Model:
         i = BONES.index(bone)
         return (self.vertices[self.vertex_offsets[i]:self.vertex_offsets[i + 1]],
                 self.faces[self.face_offsets[i]:self.face_offsets[i + 1]])
+
+    def part_mesh(self, part: str) -> tuple[np.ndarray, np.ndarray]:
+        """(vertices (n, 3) mm, faces (m, 3)) of one of the nine bones (`PARTS`), neutral pose."""
+        body = next(b for b in BONES if part in BODY_PARTS[b])
+        v, f = self.bone_mesh(body)
+        i = BONES.index(body)
+        keep = self.vertex_part[self.vertex_offsets[i]:self.vertex_offsets[i + 1]] == BODY_PARTS[body].index(part)
+        f = f[keep[f].all(axis=1)]
+        new = np.cumsum(keep) - 1
+        return v[keep], new[f]
 
     def bone_thickness(self, bone: str) -> np.ndarray:
         """Cartilage thickness (n,) mm on one bone's vertices."""

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from wrist_env.anatomy.myosim import BONES
+from wrist_env.model import BONES
 from wrist_env.errors import TrialError
 from wrist_env.frames import validate_poses
 

@@ -78,6 +78,8 @@ class Report:
     rows: tuple[Check, ...]
     series: dict = field(repr=False)
     wall_seconds: float = float("nan")
+    conditions: dict = field(default_factory=dict)
+    """The anatomy variant (build parameters) and the compressive load (N) of the runs."""
 
     @property
     def passed(self) -> bool:
@@ -88,7 +90,8 @@ class Report:
 
     def to_dict(self) -> dict:
         """Strict JSON: NaN and ±inf become None (a None band edge means unbounded)."""
-        return {"participant": self.participant, "design": "population", "passed": self.passed,
+        return {"participant": self.participant, "design": "population", "conditions": self.conditions,
+                "passed": self.passed,
                 "checks": [r.to_dict() for r in self.rows],
                 "series": {k: (v if isinstance(v, str) else _list(v)) for k, v in self.series.items()},
                 "wall_seconds": _num(round(self.wall_seconds, 3))}
@@ -146,7 +149,7 @@ def surface_gap_mm(a_mesh, b_mesh, a_poses, b_poses) -> np.ndarray:
 def sl_gap_mm(model, poses) -> np.ndarray:
     """Scapholunate gap (mm) per frame of a Result's poses (n_frames, 5, 4, 4): bone surface to bone surface."""
     s, l = BONES.index("scaphoid"), BONES.index("lunate")
-    return surface_gap_mm(model.bone_mesh("scaphoid"), model.bone_mesh("lunate"), poses[:, s], poses[:, l])
+    return surface_gap_mm(model.part_mesh("scaphoid"), model.part_mesh("lunate"), poses[:, s], poses[:, l])
 
 
 def with_tears(d: design_mod.Design, names) -> design_mod.Design:
@@ -182,19 +185,26 @@ def _failure(label, result) -> str | None:
     return None if result.ok else f"{label} run {result.message}"
 
 
-def validate(name: str, *, model=None, d: design_mod.Design | None = None, n_frames: int = 17) -> Report:
-    """Run the published-measurement checks on participant `name` (population design by default)."""
+def validate(name: str, *, model=None, d: design_mod.Design | None = None, n_frames: int = 17, params=None,
+             load_n: float = IDEALIZED_LOAD_N) -> Report:
+    """Run the published-measurement checks on participant `name` (population design by default).
+
+    params: build parameters (`BuildParams`; the anatomy variant), default the default build.
+    load_n: the compressive load (N) of the sweeps and of the neutral pose.
+    """
+    from wrist_env.build.pipeline import BuildParams
     from wrist_env.participants.registry import load_model
     from wrist_env.solver import simulate as sim
     from wrist_env.solver.outputs import cardan_deg
 
     start = time.perf_counter()
-    model = model if model is not None else load_model(name)
+    params = params or BuildParams()
+    model = model if model is not None else load_model(name, params)
     intact_design = d if d is not None else design_mod.population()
     torn_design = with_tears(intact_design, SLIL)
-    sweep = sim.idealized(model, n_frames=n_frames)
+    sweep = sim.idealized(model, n_frames=n_frames, load_n=load_n)
     intact, torn = sim.simulate_batch(model, [intact_design, torn_design], sweep)
-    neutral = sim.simulate(model, intact_design, sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N))
+    neutral = sim.simulate(model, intact_design, sim.loaded(model, [np.eye(3)], load_n=load_n))
 
     b = {bone: BONES.index(bone) for bone in ("capitate", "scaphoid", "lunate")}
     rs, rl = PAIRS.index("radioscaphoid"), PAIRS.index("radiolunate")
@@ -217,7 +227,7 @@ def validate(name: str, *, model=None, d: design_mod.Design | None = None, n_fra
         _row("scaphoid_above_lunate", "scaphoid slope minus lunate slope", s_slope - l_slope, (0.0, inf),
              "deg/deg", fail_i),
         _row("rs_rl_force_ratio", f"radioscaphoid / radiolunate contact force, capitate held at neutral under "
-             f"{NEUTRAL_LOAD_N:g} N", rs_rl, (1.1, 2.0), "ratio",
+             f"{load_n:g} N", rs_rl, (1.1, 2.0), "ratio",
              fail_n),
         _row("sl_gap_growth_mm", "SL gap at full extension (last frame), all three SLIL bundles torn minus intact",
              gap_torn[-1] - gap_intact[-1], (SL_DISSOCIATION_MM, inf), "mm", fail_i or fail_t),
@@ -230,7 +240,8 @@ def validate(name: str, *, model=None, d: design_mod.Design | None = None, n_fra
               "lunate_flexion_deg": lun, "sl_gap_intact_mm": gap_intact, "sl_gap_slil_torn_mm": gap_torn,
               "slil_force_intact_n": slil_total, "rs_mean_pressure_intact_mpa": intact.contact[:, rs, 0],
               "intact_status": intact.message, "slil_torn_status": torn.message, "neutral_status": neutral.message}
-    return Report(model.name, rows, series, time.perf_counter() - start)
+    conditions = {"fossa_sweep_deg": list(params.anatomy[0]), "distal_row": params.anatomy[1], "load_n": float(load_n)}
+    return Report(model.name, rows, series, time.perf_counter() - start, conditions)
 
 
 # -- output --------------------------------------------------------------------------------------------------
@@ -241,7 +252,10 @@ def _fmt(x: float) -> str:
 
 def format_table(report: Report) -> str:
     """The checks as a plain-text table: check, value, band, unit, pass/FAIL, source."""
-    lines = [f"{report.participant}, population design: the model against published measurements",
+    c = report.conditions
+    lines = [f"{report.participant}, population design: the model against published measurements"
+             + (f" (fossa sweep ±{c['fossa_sweep_deg']} deg, distal row {'on' if c['distal_row'] else 'off'}, "
+                f"load {c['load_n']:g} N)" if c else ""),
              f"{'check':<22} {'value':>8}  {'band':<13} {'unit':<8} {'result':<6}  source"]
     for r in report.rows:
         band = f"{_fmt(r.band[0])}-{_fmt(r.band[1])}" if math.isfinite(r.band[1]) else f"> {_fmt(r.band[0])}"

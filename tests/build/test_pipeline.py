@@ -85,3 +85,19 @@ def test_load_model_uses_the_cache(built, model_cache):
     assert any(f.startswith("P1-") and f.endswith(".npz") for f in files)
     again = load_model("P1")
     assert again.report["build_seconds"] == built("P1").report["build_seconds"]  # read back, not rebuilt
+
+
+@pytest.mark.parametrize("name", PARTICIPANTS)
+def test_tracked_centroid_is_the_principal_bones_and_parts_recover_it(built, name):
+    """With single-bone bodies (the default anatomy) the tracked centroid is the centre of mass, and
+    `part_mesh` returns each body's own mesh; the six other parts are absent."""
+    model = built(name)
+    np.testing.assert_allclose(model.centroid, model.com, atol=1e-9)
+    assert (model.vertex_part == 0).all()
+    for bone in BONES:
+        v, f = model.part_mesh(bone)
+        bv, bf = model.bone_mesh(bone)
+        np.testing.assert_array_equal(v, bv)
+        np.testing.assert_array_equal(f, bf)
+    v, f = model.part_mesh("hamate")
+    assert len(v) == 0 and len(f) == 0

@@ -20,6 +20,7 @@ import numpy as np
 
 from wrist_env.anatomy.template import load_template
 from wrist_env.design import LIGAMENT_NAMES
+from wrist_env.model import BODY_PARTS
 
 ARTICULATIONS = ("radioscaphoid", "radiolunate", "scapholunate", "scaphocapitate", "lunocapitate")
 
@@ -60,7 +61,12 @@ def facing_within(vertices, normals, partner_vertices, partner_faces, max_gap_mm
 
 
 def resolve(bones: dict, data: dict | None = None) -> Annotations:
-    """Resolve annotation data on `bones` (name -> BoneSurface in the template RCS)."""
+    """Resolve annotation data on `bones` (name -> BoneSurface in the template RCS).
+
+    A site lies on one bone of its body (its `part`, default the principal bone; e.g. the
+    DRC's insertion on the triquetrum); on bodies without that part (no distal row) its
+    `without_part` site is used instead.
+    """
     data = read_annotation_data() if data is None else data
     solids = {name: b.trimesh(solid_only=True) for name, b in bones.items() if b.solid.any()}
     coverage = {}
@@ -81,14 +87,22 @@ def resolve(bones: dict, data: dict | None = None) -> Annotations:
         pair = []
         for end in ("origin", "insertion"):
             spec = data["ligaments"][lig][end]
-            v = bones[spec["bone"]].vertices
-            mask = np.linalg.norm(v - np.asarray(spec["centre_mm"]), axis=1) <= spec["radius_mm"]
+            if "part" in spec and BODY_PARTS[spec["bone"]].index(spec["part"]) > bones[spec["bone"]].part.max():
+                spec = spec["without_part"]
+            body = bones[spec["bone"]]
+            own = body.part == BODY_PARTS[spec["bone"]].index(spec.get("part", spec["bone"]))
+            distance = np.where(own, np.linalg.norm(body.vertices - np.asarray(spec["centre_mm"]), axis=1), np.inf)
+            # a site off this variant's surface (a swept fossa's rim) moves to the nearest surface point
+            if distance.min() > 0.5 * spec["radius_mm"]:
+                nearest = body.vertices[np.argmin(distance)]
+                distance = np.where(own, np.linalg.norm(body.vertices - nearest, axis=1), np.inf)
+            mask = distance <= spec["radius_mm"]
             pair.append(Site(spec["bone"], mask))
         sites[lig] = tuple(pair)
     return Annotations(coverage=coverage, sites=sites)
 
 
-@functools.lru_cache(maxsize=1)
-def template_annotations() -> Annotations:
-    """Annotations resolved on the anatomy template."""
-    return resolve(load_template().bones)
+@functools.lru_cache(maxsize=4)
+def template_annotations(fossa_sweep_deg: tuple = (0.0, 0.0), distal_row: bool = False) -> Annotations:
+    """Annotations resolved on the anatomy template (variant as in `load_template`)."""
+    return resolve(load_template(tuple(fossa_sweep_deg), distal_row).bones)

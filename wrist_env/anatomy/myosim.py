@@ -19,7 +19,7 @@ import trimesh
 
 from wrist_env.errors import BuildError
 
-BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate")
+from wrist_env.model import PARTS as BONES  # the nine bones read from myo-sim
 CHAIN_XML = "models/arm/assets/myoarm_r_chain.xml"
 MESH_DIR = "models/meshes"
 

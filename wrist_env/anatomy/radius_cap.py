@@ -1,12 +1,19 @@
 """Rebuild the distal radius articular surface (scaphoid and lunate fossae).
 
 The myo-sim radius is coarse (~10 mm edges) and sits 3.4–4.3 mm from the
-proximal row. The articular surface is rebuilt as the offset envelope of the
-proximal row's proximally facing surface at the radiocarpal joint space
-(union of balls of radius `joint_space_mm` around the row's vertices, read
-from the proximal side), sampled on a regular grid and extruded into a
-watertight solid. Coordinates: an RCS-oriented frame (x volar, y proximal,
-z radial), mm.
+proximal row. The articular surface is rebuilt as the offset envelope, at the
+radiocarpal joint space, of the scaphoid and lunate swept through their
+radiocarpal range of motion: each bone turned about the centre of the sphere
+that best fits its proximal articular surface, through ± `sweep_deg` of
+flexion–extension and of radial–ulnar deviation (no sweep: the moulded fossa
+of builder version 1, still the default).
+A fossa moulded to the neutral pose alone locks the row (turning the lunate
+5° in place overlapped it by 0.18 mm); the swept envelope is the surface the
+row can roll and slide in, as the fossae are shaped to let it (the scaphoid
+turns ~0.7× and the lunate ~0.45× the capitate's ±40°: Rainbow 2013, so
+±20° / ±10° spans the row's radiocarpal arc). Sampled on a regular grid and
+extruded into a watertight solid. Coordinates: an RCS-oriented frame (x
+volar, y proximal, z radial), mm.
 """
 
 from __future__ import annotations
@@ -16,6 +23,8 @@ import trimesh
 from scipy.spatial import cKDTree
 
 from wrist_env.errors import BuildError
+
+SWEEP_STEPS = (9, 5)  # poses per axis of a swept range
 
 
 def fossa_points(row_meshes, radius_mesh, *, facing=0.3, reach_mm=8.0) -> np.ndarray:
@@ -35,13 +44,13 @@ def fossa_points(row_meshes, radius_mesh, *, facing=0.3, reach_mm=8.0) -> np.nda
     return points
 
 
-def offset_heightfield(footprint, row_vertices, *, joint_space_mm=1.5, spacing_mm=0.5):
+def offset_heightfield(footprint, row_points, *, joint_space_mm=1.5, spacing_mm=0.5):
     """Height y(x, z) of the envelope at `joint_space_mm` proximal to the row.
 
-    The envelope is taken over all `row_vertices` (so no vertex of the row
-    comes closer than the joint space), on the x–z footprint of `footprint`
-    points dilated by the joint space. Returns (xs, zs, height) with height of
-    shape (len(xs), len(zs)), NaN off the footprint.
+    The envelope is taken over all `row_points` (so no point comes closer than
+    the joint space), on the x–z footprint of `footprint` points dilated by the
+    joint space. Returns (xs, zs, height) with height of shape (len(xs), len(zs)),
+    NaN off the footprint.
     """
     g = joint_space_mm
     lo = footprint[:, [0, 2]].min(axis=0) - g
@@ -51,14 +60,39 @@ def offset_heightfield(footprint, row_vertices, *, joint_space_mm=1.5, spacing_m
     X, Z = np.meshgrid(xs, zs, indexing="ij")
     grid = np.column_stack([X.ravel(), Z.ravel()])
     on_footprint = cKDTree(footprint[:, [0, 2]]).query(grid)[0] < g
-    tree = cKDTree(row_vertices[:, [0, 2]])
-    height = np.full(len(grid), np.nan)
-    for i, neighbours in enumerate(tree.query_ball_point(grid, r=g * (1 - 1e-9))):
-        if neighbours and on_footprint[i]:
-            p = row_vertices[neighbours]
-            d2 = ((p[:, [0, 2]] - grid[i]) ** 2).sum(axis=1)
-            height[i] = np.max(p[:, 1] + np.sqrt(g * g - d2))
+    height = np.full(len(grid), -np.inf)
+    reach = int(np.ceil(g / spacing_mm + 0.5))
+    cell = np.rint((row_points[:, [0, 2]] - lo) / spacing_mm).astype(np.int64)
+    for di in range(-reach, reach + 1):  # every grid node within g of a point: the ball's top there
+        for dk in range(-reach, reach + 1):
+            i, k = cell[:, 0] + di, cell[:, 1] + dk
+            inside = (i >= 0) & (i < len(xs)) & (k >= 0) & (k < len(zs))
+            i, k, p = i[inside], k[inside], row_points[inside]
+            d2 = (xs[i] - p[:, 0]) ** 2 + (zs[k] - p[:, 2]) ** 2
+            near = d2 < g * g * (1 - 1e-9)
+            np.maximum.at(height, i[near] * len(zs) + k[near], p[near, 1] + np.sqrt(g * g - d2[near]))
+    height[~on_footprint | ~np.isfinite(height)] = np.nan
     return xs, zs, fill_creases(height.reshape(X.shape), sigma_cells=1.5)
+
+
+def sphere_centre(points) -> np.ndarray:
+    """Centre (3,) mm of the least-squares sphere through `points` (n, 3)."""
+    A = np.column_stack([2.0 * points, np.ones(len(points))])
+    b = (points ** 2).sum(axis=1)
+    return np.linalg.lstsq(A, b, rcond=None)[0][:3]
+
+
+def swept(points, centre, flexion_deg, deviation_deg, *, steps=SWEEP_STEPS):
+    """`points` (n, 3) turned about `centre` through a grid of flexion (z) and deviation (x)
+    angles (deg), stacked: array of shape (n × poses, 3)."""
+    from scipy.spatial.transform import Rotation
+
+    out = []
+    for f in np.linspace(-flexion_deg, flexion_deg, steps[0]):
+        for d in np.linspace(-deviation_deg, deviation_deg, steps[1]):
+            R = Rotation.from_euler("ZX", [f, d], degrees=True).as_matrix()
+            out.append((points - centre) @ R.T + centre)
+    return np.concatenate(out)
 
 
 def fill_creases(height, sigma_cells=1.5):
@@ -128,17 +162,28 @@ def extrude_heightfield(xs, zs, height, *, depth_mm=4.0) -> trimesh.Trimesh:
     return mesh
 
 
-def build_radius_cap(row_meshes, radius_mesh, *, joint_space_mm=1.5, spacing_mm=0.4, depth_mm=4.0, sample_mm=0.15):
+def build_radius_cap(row_meshes, radius_mesh, *, joint_space_mm=1.5, spacing_mm=0.4, depth_mm=4.0, sample_mm=0.15,
+                     sweep_deg=(0.0, 0.0)):
     """The rebuilt distal radius articular solid and its articular (top) vertex mask.
 
-    Returns (mesh, articular) where articular is a bool array over mesh vertices.
+    row_meshes: the scaphoid and lunate. sweep_deg: (flexion, deviation) half-ranges of the
+    swept envelope, deg; (0, 0) moulds the fossae to the neutral row. Returns (mesh, articular)
+    where articular is a bool array over mesh vertices.
     """
     footprint = fossa_points(row_meshes, radius_mesh)
-    # dense surface samples (not just vertices) so the envelope of balls is smooth
-    row_vertices = np.concatenate(
-        [trimesh.sample.sample_surface_even(m, int(m.area / (sample_mm * sample_mm)), seed=0)[0] for m in row_meshes]
-        + [m.vertices for m in row_meshes])
-    xs, zs, height = offset_heightfield(footprint, row_vertices, joint_space_mm=joint_space_mm, spacing_mm=spacing_mm)
+    row_points = []
+    for mesh in row_meshes:
+        # dense surface samples (not just vertices) so the envelope of balls is smooth
+        if tuple(sweep_deg) == (0.0, 0.0):
+            points = trimesh.sample.sample_surface_even(mesh, int(mesh.area / (sample_mm * sample_mm)), seed=0)[0]
+            row_points.append(points)
+            continue
+        points, face = trimesh.sample.sample_surface_even(mesh, int(mesh.area / (0.25 * 0.25)), seed=0)
+        facing = mesh.face_normals[face, 1] > 0.0  # the proximally facing surface
+        row_points.append(swept(points[facing], sphere_centre(fossa_points([mesh], radius_mesh)), *sweep_deg))
+    row_points += [m.vertices for m in row_meshes]
+    xs, zs, height = offset_heightfield(footprint, np.concatenate(row_points), joint_space_mm=joint_space_mm,
+                                        spacing_mm=spacing_mm)
     mesh = extrude_heightfield(xs, zs, height, depth_mm=depth_mm)
     articular = mesh.vertices[:, 1] < mesh.vertices[:, 1].max() - 1e-6
     return mesh, articular

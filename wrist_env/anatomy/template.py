@@ -25,10 +25,12 @@ from dataclasses import dataclass
 import numpy as np
 import trimesh
 
-from wrist_env.anatomy.myosim import BONES, load_myosim_anatomy
+from wrist_env.anatomy.myosim import load_myosim_anatomy
 from wrist_env.anatomy.radius_cap import build_radius_cap
+from wrist_env.model import BODY_PARTS, BONES, PARTS
 
 CARPALS = ("scaphoid", "lunate", "capitate")
+ROW = ("scaphoid", "lunate")  # the proximal row bones that articulate with the radius
 JOINT_SPACE_MM = 1.5  # radiocarpal bone-to-bone joint space of the rebuilt fossae
 SHAFT_LENGTH_MM = 20.0
 SHAFT_EDGE_MM = 1.5
@@ -42,12 +44,19 @@ class BoneSurface:
     solid: bool array of shape (n,): vertices of the watertight part that
         carries contact and mass (all True for carpal bones; the rebuilt
         articular solid for the radius; none for the ulna).
+    part: int array of shape (n,): index into `BODY_PARTS[name]` of the bone of each
+        vertex (all 0 for a single bone; see `compose`).
     """
 
     name: str
     vertices: np.ndarray
     faces: np.ndarray
     solid: np.ndarray
+    part: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.part is None:
+            object.__setattr__(self, "part", np.zeros(len(self.vertices), np.int64))
 
     def trimesh(self, solid_only: bool = False) -> trimesh.Trimesh:
         """The surface as a trimesh (optionally only its watertight part)."""
@@ -62,13 +71,33 @@ class BoneSurface:
 
 @dataclass(frozen=True)
 class Template:
-    """The five template bones in the RCS (mm), neutral pose.
+    """The template in the RCS (mm), neutral pose.
 
+    bones: the five rigid bodies (`BONES`); with the distal row, each composed of its
+        `BODY_PARTS`, otherwise the principal bones alone.
+    parts: the nine bones one by one (`PARTS`).
     rcs_from_myosim: 4x4 transform from the myo-sim radius body frame (mm) to the RCS.
     """
 
     bones: dict
+    parts: dict
     rcs_from_myosim: np.ndarray
+
+
+def compose(parts: dict, distal_row: bool = True) -> dict:
+    """The five rigid bodies from the bones (name -> BoneSurface): each body's parts
+    concatenated in `BODY_PARTS` order, with `part` labels (without the distal row:
+    the principal bones alone)."""
+    bodies = {}
+    for body in BONES:
+        members = [parts[p] for p in (BODY_PARTS[body] if distal_row else BODY_PARTS[body][:1])]
+        counts = np.cumsum([0] + [len(m.vertices) for m in members])
+        bodies[body] = BoneSurface(
+            body, np.vstack([m.vertices for m in members]),
+            np.vstack([m.faces + c for m, c in zip(members, counts)]).astype(np.int64),
+            np.concatenate([m.solid for m in members]),
+            np.concatenate([np.full(len(m.vertices), k, np.int64) for k, m in enumerate(members)]))
+    return bodies
 
 
 def rcs_rotation(radius: trimesh.Trimesh, carpus_centroid, flexor_sites, extensor_sites) -> np.ndarray:
@@ -99,21 +128,29 @@ def _transform(mesh: trimesh.Trimesh, T: np.ndarray) -> trimesh.Trimesh:
     return out
 
 
-@functools.lru_cache(maxsize=1)
-def load_template() -> Template:
-    """The anatomy template (built once per process, ~1 s)."""
+@functools.lru_cache(maxsize=4)
+def load_template(fossa_sweep_deg: tuple = (0.0, 0.0), distal_row: bool = False) -> Template:
+    """The anatomy template (built once per process and variant, ~1–5 s).
+
+    fossa_sweep_deg: (flexion, deviation) half-ranges (deg) of the row's sweep that shapes
+    the radius fossae ((0, 0): moulded to the neutral row). distal_row: the lunate body
+    carries the triquetrum and the capitate body the trapezium, trapezoid and hamate.
+    """
     anatomy = load_myosim_anatomy()
     meshes = anatomy.meshes
     carpus = np.mean([meshes[b].centroid for b in CARPALS], axis=0)
     R = rcs_rotation(meshes["radius"], carpus, anatomy.flexor_sites, anatomy.extensor_sites)
     oriented = np.eye(4)
     oriented[:3, :3] = R
-    m = {b: _transform(meshes[b], oriented) for b in BONES}
-    cap, articular = build_radius_cap([m["scaphoid"], m["lunate"]], m["radius"], joint_space_mm=JOINT_SPACE_MM)
-    top = cap.vertices[articular]
+    m = {b: _transform(meshes[b], oriented) for b in PARTS}
+    cap, articular = build_radius_cap([m[b] for b in ROW], m["radius"], joint_space_mm=JOINT_SPACE_MM)
+    top = cap.vertices[articular]  # the origin comes from the moulded surface, whatever the variant
     origin = top[np.argmin(np.linalg.norm(top[:, [0, 2]] - top[:, [0, 2]].mean(axis=0), axis=1))]
     to_rcs = np.eye(4)
     to_rcs[:3, 3] = -origin
+    if tuple(fossa_sweep_deg) != (0.0, 0.0):
+        cap, _ = build_radius_cap([m[b] for b in ROW], m["radius"], joint_space_mm=JOINT_SPACE_MM,
+                                  sweep_deg=tuple(float(a) for a in fossa_sweep_deg))
     rcs_from_myosim = to_rcs @ oriented
     m = {b: _transform(mesh, to_rcs) for b, mesh in m.items()}
     cap = _transform(cap, to_rcs)
@@ -128,10 +165,11 @@ def load_template() -> Template:
         "radius": BoneSurface("radius", radius_vertices, radius_faces.astype(np.int64), radius_solid),
         "ulna": BoneSurface("ulna", ulna.vertices.copy(), ulna.faces.astype(np.int64), np.zeros(len(ulna.vertices), bool)),
     }
-    for b in CARPALS:
+    for b in PARTS[2:]:
         bones[b] = BoneSurface(b, m[b].vertices.copy(), m[b].faces.astype(np.int64), np.ones(len(m[b].vertices), bool))
-    for bone in bones.values():
-        for arr in (bone.vertices, bone.faces, bone.solid):
+    bodies = compose(bones, distal_row)
+    for bone in list(bones.values()) + list(bodies.values()):
+        for arr in (bone.vertices, bone.faces, bone.solid, bone.part):
             arr.setflags(write=False)
     rcs_from_myosim.setflags(write=False)
-    return Template(bones=bones, rcs_from_myosim=rcs_from_myosim)
+    return Template(bones=bodies, parts=bones, rcs_from_myosim=rcs_from_myosim)

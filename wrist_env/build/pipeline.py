@@ -24,7 +24,7 @@ from wrist_env.design import LIGAMENTS, LIGAMENT_NAMES
 from wrist_env.errors import BuildError
 from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model, offsets
 
-BUILDER_VERSION = 1
+BUILDER_VERSION = 2  # 2: distal row and triquetrum as body parts, swept radius fossae
 GRID_BONES = ("radius", "scaphoid", "lunate", "capitate")
 MIN_SITE_VERTICES = 8
 
@@ -42,6 +42,17 @@ class BuildParams:
     membrane_along: int = 9
     membrane_across: int = 5
     seed: int = 0
+    fossa_sweep_deg: tuple = (0.0, 0.0)
+    """(flexion, deviation) half-ranges, deg, of the row's sweep that shapes the radius fossae
+    ((0, 0): moulded to the neutral row; see `anatomy.radius_cap`)."""
+    distal_row: bool = False
+    """The triquetrum moves with the lunate and the trapezium, trapezoid and hamate with the
+    capitate, bringing the STT and triquetrohamate contacts (`model.BODY_PARTS`)."""
+
+    @property
+    def anatomy(self) -> tuple:
+        """The template variant of these parameters: (fossa_sweep_deg, distal_row)."""
+        return (tuple(float(a) for a in self.fossa_sweep_deg), bool(self.distal_row))
 
 
 def source_hash(name: str, bones: dict, params: BuildParams) -> str:
@@ -54,6 +65,7 @@ def source_hash(name: str, bones: dict, params: BuildParams) -> str:
     for bone in BONES:
         h.update(np.ascontiguousarray(np.round(bones[bone].vertices, 6)).tobytes())
         h.update(np.ascontiguousarray(bones[bone].faces).tobytes())
+        h.update(np.ascontiguousarray(bones[bone].part).tobytes())
     return h.hexdigest()[:16]
 
 
@@ -62,9 +74,10 @@ def _morph_one(args):
     return morph.morph(tv, tf, pv, pf, seed=seed)
 
 
-def _morph_all(bones: dict, seed: int, workers: int) -> tuple[dict, dict]:
+def _morph_all(bones: dict, params: BuildParams, workers: int) -> tuple[dict, dict]:
     """Morph every template bone onto the participant's, largest first, on `workers` processes."""
-    template = load_template().bones
+    seed = params.seed
+    template = load_template(*params.anatomy).bones
     order = sorted(BONES, key=lambda b: -len(template[b].vertices))
     jobs = [(template[b].vertices, template[b].faces, bones[b].vertices, bones[b].faces, seed) for b in order]
     if workers > 1:
@@ -79,14 +92,14 @@ def _morph_all(bones: dict, seed: int, workers: int) -> tuple[dict, dict]:
     return results, report
 
 
-def _transfer(morphs: dict, bones: dict) -> tuple[dict, dict, list]:
+def _transfer(morphs: dict, bones: dict, params: BuildParams) -> tuple[dict, dict, list]:
     """Coverage and ligament site masks on the participant's bones, and the sites relocated.
 
     A site whose morphed patch finds too few participant vertices (a bone mesh
     cut shorter than the template's) is placed on the participant vertices
     nearest the morphed patch instead.
     """
-    ann = template_annotations()
+    ann = template_annotations(*params.anatomy)
     coverage = {}
     for art, (a, b, ma, mb) in ann.coverage.items():
         coverage[art] = (a, b,
@@ -208,9 +221,9 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None, *, wo
         timings[step] = round(now - clock, 3)
         clock = now
 
-    morphs, morph_report = _morph_all(bones, params.seed, workers)
+    morphs, morph_report = _morph_all(bones, params, workers)
     lap("morph")
-    coverage, sites, relocated = _transfer(morphs, bones)
+    coverage, sites, relocated = _transfer(morphs, bones, params)
     articulations = {(a, b): (ma, mb) for (a, b, ma, mb) in coverage.values()}
     verts = {b: bones[b].vertices for b in BONES}
     faces = {b: bones[b].faces for b in BONES}
@@ -230,6 +243,7 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None, *, wo
     s_pts, seated = _seat_samples(s_pts, s_nrm, s_off, grids)
     lap("grids")
     masses = [mass.mass_properties(*_solid(bones[b])) if bones[b].solid.any() else (0.0, np.zeros(3), np.zeros((3, 3))) for b in BONES]
+    centroids = [mass.mass_properties(*_solid(bones[b], part=0))[1] if bones[b].solid.any() else np.zeros(3) for b in BONES]
     lap("mass")
 
     empty = np.zeros((0, 0, 0), np.float32)
@@ -263,10 +277,12 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None, *, wo
         vertex_offsets=offsets([len(bones[b].vertices) for b in BONES]),
         faces=np.vstack([bones[b].faces for b in BONES]).astype(np.int64),
         face_offsets=offsets([len(bones[b].faces) for b in BONES]),
+        vertex_part=np.concatenate([bones[b].part for b in BONES]).astype(np.int64),
         thickness=np.concatenate([thickness[b] for b in BONES]),
         mass=np.array([m[0] for m in masses]),
         com=np.array([m[1] for m in masses]),
         inertia=np.array([m[2] for m in masses]),
+        centroid=np.array(centroids),
         grid_origin=np.array([g.origin if g else np.zeros(3) for g in grid_list]),
         grid_spacing=np.array([g.spacing_mm if g else 0.0 for g in grid_list]),
         grid_shape=np.array([g.values.shape if g else (0, 0, 0) for g in grid_list], dtype=np.int64),
@@ -305,6 +321,8 @@ def _articulation_summary(articulations: dict) -> dict:
     return {"cartilage_thickness_mm": thickness, "joint_space_mm": space, "overclosure_mm": overclosure}
 
 
-def _solid(bone):
-    f = bone.faces[bone.solid[bone.faces].all(axis=1)]
+def _solid(bone, part: int | None = None):
+    """(vertices, faces) of the bone's closed surface (of one of its parts, if given)."""
+    keep = bone.solid if part is None else bone.solid & (bone.part == part)
+    f = bone.faces[keep[bone.faces].all(axis=1)]
     return bone.vertices, f

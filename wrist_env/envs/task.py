@@ -48,7 +48,7 @@ class Task:
         self.settings, self.weights = settings, weights
         self.model: Model = registry.load_model(participant)
         self.driver, self.reference = self._driver_and_reference()
-        self.reference_points = self.model.com[[BONES.index(b) for b in COST_BONES]]
+        self.reference_points = self.model.centroid[[BONES.index(b) for b in COST_BONES]]
 
     def _driver_and_reference(self) -> tuple[Driver, np.ndarray | None]:
         if self.motion == "idealized":

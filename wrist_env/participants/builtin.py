@@ -66,13 +66,14 @@ def trials(name: str) -> dict:
             for t, entry in meta["trials"].items()}
 
 
-@functools.lru_cache(maxsize=len(BUILTIN))
-def bones(name: str) -> dict:
-    """The participant's bones: the template under its warp (name -> BoneSurface, RCS mm)."""
+@functools.lru_cache(maxsize=4 * len(BUILTIN))
+def bones(name: str, fossa_sweep_deg: tuple = (0.0, 0.0), distal_row: bool = False) -> dict:
+    """The participant's bones: the template (variant as in `load_template`) under its warp
+    (name -> BoneSurface, RCS mm)."""
     warp = Warp.from_dict(info(name).warp)
     out = {}
-    for bone, surface in load_template().bones.items():
+    for bone, surface in load_template(tuple(fossa_sweep_deg), distal_row).bones.items():
         v = warp.apply(surface.vertices)
         v.setflags(write=False)
-        out[bone] = BoneSurface(bone, v, surface.faces, surface.solid)
+        out[bone] = BoneSurface(bone, v, surface.faces, surface.solid, surface.part)
     return out

@@ -42,15 +42,20 @@ def add_folder(folder) -> str:
     return source.name
 
 
-def bones(name: str) -> dict:
-    """The participant's bones (name -> BoneSurface, RCS mm, neutral pose)."""
+def bones(name: str, params: BuildParams | None = None) -> dict:
+    """The participant's bones (name -> BoneSurface, RCS mm, neutral pose) for the anatomy
+    variant of `params` (default: `BuildParams()`)."""
+    params = params or BuildParams()
     if name in builtin.BUILTIN:
-        return builtin.bones(name)
+        return builtin.bones(name, *params.anatomy)
     if name not in _FOLDERS:
         raise ParticipantError(f"unknown participant {name!r}; known: {list(participants())}")
     from wrist_env.participants.folder import load_participant_folder
 
     source = load_participant_folder(_FOLDERS[name])
+    if params.distal_row:
+        raise ParticipantError(f"participant {name!r}: the distal-row anatomy needs triquetrum, trapezium, trapezoid "
+                               "and hamate meshes, which participant folders do not take yet")
     return {b: BoneSurface(b, v, f, np.ones(len(v), bool)) for b, (v, f) in source.bones.items()}
 
 
@@ -77,7 +82,7 @@ def trial(name: str, role: str):
 def load_model(name: str, params: BuildParams | None = None, *, cache: bool = True) -> Model:
     """The participant's model, built on first use and cached by the hash of its inputs."""
     params = params or BuildParams()
-    b = bones(name)
+    b = bones(name, params)
     path = cache_dir() / f"{name}-{source_hash(name, b, params)}"
     if cache and path.with_suffix(".json").exists() and path.with_suffix(".npz").exists():
         return Model.load(path)

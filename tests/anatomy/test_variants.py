@@ -1,0 +1,79 @@
+"""Anatomy variants: the distal row and triquetrum as body parts, and the swept radius fossae."""
+
+import igl
+import numpy as np
+import pytest
+
+from wrist_env.anatomy.annotations import read_annotation_data, template_annotations
+from wrist_env.anatomy.template import JOINT_SPACE_MM, load_template
+from wrist_env.model import BODY_PARTS, BONES, PARTS
+
+SWEEP = (20.0, 10.0)
+
+
+@pytest.fixture(scope="module")
+def default():
+    return load_template()
+
+
+@pytest.fixture(scope="module")
+def wrist():
+    return load_template(SWEEP, True)
+
+
+def test_default_bodies_are_the_principal_bones(default):
+    for body in BONES:
+        assert (default.bones[body].part == 0).all()
+        np.testing.assert_array_equal(default.bones[body].vertices, default.parts[body].vertices)
+    assert sorted(default.parts) == sorted(PARTS)
+
+
+def test_distal_row_bodies_are_their_parts_in_order(wrist):
+    for body in BONES:
+        surface = wrist.bones[body]
+        assert surface.part.max() == len(BODY_PARTS[body]) - 1
+        for k, part in enumerate(BODY_PARTS[body]):
+            np.testing.assert_array_equal(surface.vertices[surface.part == k], wrist.parts[part].vertices)
+        assert surface.trimesh(solid_only=True).is_watertight or not surface.solid.any()  # closed parts, closed body
+
+
+@pytest.mark.parametrize("bone, partner, most_mm", [
+    ("scaphoid", "trapezoid", 2.0),  # the STT joint: the scaphoid's distal pole against the trapezoid
+    ("scaphoid", "trapezium", 3.0),  # ... and the trapezium
+    ("triquetrum", "hamate", 1.5),  # the triquetrohamate joint
+    ("lunate", "triquetrum", 1.0),  # the lunotriquetral joint
+])
+def test_new_bones_articulate_where_anatomy_puts_them(wrist, bone, partner, most_mm):
+    """Each new joint is open (no overlap) and within a joint space of its partner."""
+    a, b = wrist.parts[bone], wrist.parts[partner]
+    d2 = igl.point_mesh_squared_distance(a.vertices, b.vertices, b.faces)[0]
+    inside = igl.winding_number(b.vertices, b.faces, a.vertices) > 0.5
+    assert not inside.any()
+    assert 0.2 < np.sqrt(d2.min()) < most_mm
+
+
+def test_drc_inserts_on_the_triquetrum_with_the_distal_row(default, wrist):
+    spec = read_annotation_data()["ligaments"]["DRC"]["insertion"]
+    assert spec["part"] == "triquetrum"
+    on_wrist = template_annotations(SWEEP, True).sites["DRC"][1]
+    assert on_wrist.bone == "lunate"
+    assert (wrist.bones["lunate"].part[on_wrist.mask] == BODY_PARTS["lunate"].index("triquetrum")).all()
+    on_default = template_annotations().sites["DRC"][1]
+    assert on_default.mask.sum() > 8 and (default.bones["lunate"].part[on_default.mask] == 0).all()
+
+
+def test_swept_fossae_keep_the_joint_space_and_open_only_where_the_row_turns(default, wrist):
+    """The swept envelope lies proximal of the moulded one (never closer to the neutral row), keeps
+    the joint space's minimum, and opens away from the neutral mould (it lets the row turn)."""
+    moulded = default.bones["radius"].trimesh(solid_only=True)
+    swept = wrist.bones["radius"].trimesh(solid_only=True)
+    assert swept.is_watertight
+    np.testing.assert_allclose(default.rcs_from_myosim, wrist.rcs_from_myosim)  # the RCS does not move
+    for bone in ("scaphoid", "lunate"):
+        v = default.parts[bone].vertices
+        d_m = np.sqrt(igl.point_mesh_squared_distance(v, moulded.vertices, moulded.faces.astype(np.int64))[0])
+        d_s = np.sqrt(igl.point_mesh_squared_distance(v, swept.vertices, swept.faces.astype(np.int64))[0])
+        assert d_s.min() >= JOINT_SPACE_MM - 0.05
+        near = d_m < JOINT_SPACE_MM + 0.5  # the articular part of the row
+        assert np.all(d_s[near] >= d_m[near] - 0.05)
+        assert np.median(d_s[near] - d_m[near]) > 0.05
