@@ -118,8 +118,9 @@ def model(*, mass, com, inertia, law, grids: dict | None = None, patches: dict |
     return Model(
         name=name, source_hash="synthetic",
         vertices=np.zeros((0, 3)), vertex_offsets=zero_bones, faces=np.zeros((0, 3), np.int64), face_offsets=zero_bones,
-        thickness=np.zeros(0),
+        vertex_part=np.zeros(0, np.int64), thickness=np.zeros(0),
         mass=np.asarray(mass, float), com=np.asarray(com, float), inertia=np.asarray(inertia, float),
+        centroid=np.asarray(com, float),
         grid_origin=np.array([x.origin for x in g], float), grid_spacing=np.array([x.spacing for x in g], float),
         grid_shape=np.array([x.values.shape for x in g], np.int64),
         grid_values=np.concatenate([x.values.ravel() for x in g]).astype(np.float32),
@@ -188,6 +189,7 @@ def transformed(model: Model, Q, t) -> Model:
         name=f"{model.name}-moved",
         vertices=points(model.vertices),
         com=points(model.com),
+        centroid=points(model.centroid),
         inertia=np.einsum("ij,bjk,lk->bil", Q, model.inertia, Q),
         grid_origin=np.array(origin, float),
         grid_shape=np.array(shape, np.int64).reshape(-1, 3),
