@@ -12,13 +12,13 @@ Prints, for P1 (or the participant named on the command line):
   pose, plus the amortized active-set rebuild), over the time of a full step;
 - the ratio to the preprint's 45 s per Abaqus simulation.
 
-Run: `python experiments/bench_solver.py [P1]`. Timings are medians of
-repeated runs on a shared machine; expect ±10 %.
+Run: `python experiments/bench_solver.py [P1] [--distal-row] [--fossa-sweep F D] [--load N]`
+(the flags pick an anatomy variant and the idealized load, as for `wrist-bench validate`).
+Timings are medians of repeated runs on a shared machine; expect ±10 %.
 """
 
 from __future__ import annotations
 
-import sys
 import time
 
 import numpy as np
@@ -92,14 +92,18 @@ def efficiency(model, steps_per_sim: float, seconds_per_sim: float) -> tuple[flo
     return per_step * 1e6, seconds_per_sim / steps_per_sim * 1e6, int(n_active.sum())
 
 
-def main(name: str) -> None:
-    model = load_model(name)
+def main(name: str, params=None, load_n=None) -> None:
+    model = load_model(name, params)
     pop = design.population()
-    sweep, trial = idealized(model), trial_driver(name, model)
+    sweep = idealized(model) if load_n is None else idealized(model, load_n=load_n)
+    trial = trial_driver(name, model)
     rows = []
     for label, driver in (("idealized sweep, 17 frames", sweep), ("15-frame trial", trial)):
         seconds = median_seconds(lambda: simulate(model, pop, driver))
-        steps = int(simulate(model, pop, driver).steps.sum())
+        result = simulate(model, pop, driver)
+        steps = int(result.steps.sum())
+        if not result.ok:
+            raise SystemExit(f"{name}: the population design's {label} failed ({result.message}); nothing to time")
         rows.append((label, seconds, steps))
         print(f"{label:<28} {seconds * 1e3:7.1f} ms on one core  ({steps} steps, {seconds / steps * 1e6:.1f} µs/step, "
               f"{PREPRINT_SECONDS / seconds:,.0f}× faster than 45 s)")
@@ -127,4 +131,14 @@ def main(name: str) -> None:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else "P1")
+    import argparse
+
+    from wrist_env.build.pipeline import BuildParams
+
+    cli = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    cli.add_argument("participant", nargs="?", default="P1")
+    cli.add_argument("--distal-row", action="store_true")
+    cli.add_argument("--fossa-sweep", nargs=2, type=float, default=(0.0, 0.0))
+    cli.add_argument("--load", type=float)
+    args = cli.parse_args()
+    main(args.participant, BuildParams(fossa_sweep_deg=tuple(args.fossa_sweep), distal_row=args.distal_row), args.load)

@@ -172,16 +172,15 @@ def _evaluate(args) -> int:
 
 def _validate(args) -> int:
     from wrist_env import validation
+    from wrist_env.build.pipeline import BuildParams
     from wrist_env.errors import ParticipantError
     from wrist_env.participants import registry
+    from wrist_env.solver.simulate import IDEALIZED_LOAD_N
 
     for folder in args.folder or []:
         registry.add_folder(folder)
     if args.participant not in registry.participants():
         raise ParticipantError(f"unknown participant {args.participant!r}; known: {list(registry.participants())}")
-    from wrist_env.build.pipeline import BuildParams
-    from wrist_env.solver.simulate import IDEALIZED_LOAD_N
-
     params = BuildParams(fossa_sweep_deg=tuple(args.fossa_sweep), distal_row=args.distal_row)
     report = validation.validate(args.participant, params=params,
                                  load_n=IDEALIZED_LOAD_N if args.load is None else args.load)

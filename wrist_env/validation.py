@@ -26,7 +26,6 @@ from wrist_env.solver.simulate import IDEALIZED_LOAD_N
 FIGURES = Path("experiments") / "figures"
 
 SLIL = ("SLIL_v", "SLIL_p", "SLIL_d")
-NEUTRAL_LOAD_N = IDEALIZED_LOAD_N  # capitate held at neutral under the idealized sweep's compressive load (N)
 EXTENSION_30_DEG = -30.0  # flexion + / extension −, as the idealized driver's angle_deg
 SL_DISSOCIATION_MM = 3.0  # clinical scapholunate dissociation: gap > 3 mm
 RAINBOW_SCAPHOID = 0.72  # Rainbow 2013: scaphoid 70 % (flexion), 74 % (extension) of the capitate
@@ -335,5 +334,5 @@ def validation_figure(report: Report, out: Path | None = None) -> Path:
     return out
 
 
-__all__ = ["Check", "Report", "NEUTRAL_LOAD_N", "format_table", "sl_gap_mm", "slope", "surface_gap_mm",
+__all__ = ["Check", "Report", "format_table", "sl_gap_mm", "slope", "surface_gap_mm",
            "validate", "validation_figure", "with_tears"]

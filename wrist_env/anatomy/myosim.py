@@ -18,8 +18,8 @@ import numpy as np
 import trimesh
 
 from wrist_env.errors import BuildError
+from wrist_env.model import PARTS
 
-from wrist_env.model import PARTS as BONES  # the nine bones read from myo-sim
 CHAIN_XML = "models/arm/assets/myoarm_r_chain.xml"
 MESH_DIR = "models/meshes"
 
@@ -66,7 +66,7 @@ def _chain_transforms(root: ET.Element) -> tuple[dict, dict]:
     for b in root.iter("body"):
         for child in b.findall("body"):
             parent[child.get("name")] = b.get("name")
-    missing = [n for n in BONES if f"{n}_r" not in bodies]
+    missing = [n for n in PARTS if f"{n}_r" not in bodies]
     if missing:
         raise BuildError(f"myo-sim chain {CHAIN_XML} lacks bodies {missing}")
 
@@ -78,7 +78,7 @@ def _chain_transforms(root: ET.Element) -> tuple[dict, dict]:
         return T
 
     radius_inv = np.linalg.inv(to_world("radius_r"))
-    return {n: radius_inv @ to_world(f"{n}_r") for n in BONES}, bodies
+    return {n: radius_inv @ to_world(f"{n}_r") for n in PARTS}, bodies
 
 
 def _sites(bodies: dict, body_T: dict, prefixes: tuple[str, ...]) -> np.ndarray:
@@ -93,12 +93,12 @@ def _sites(bodies: dict, body_T: dict, prefixes: tuple[str, ...]) -> np.ndarray:
 
 
 def load_myosim_anatomy() -> MyoSimAnatomy:
-    """The five bones assembled in their neutral pose, in mm, myo-sim radius frame."""
+    """The nine bones (`model.PARTS`) assembled in their neutral pose, in mm, myo-sim radius frame."""
     pkg = importlib.resources.files("myo_sim")
     root = ET.parse(str(pkg / CHAIN_XML)).getroot()
     body_T, bodies = _chain_transforms(root)
     meshes = {}
-    for bone in BONES:
+    for bone in PARTS:
         path = pkg / MESH_DIR / f"{bone}.stl"
         mesh = trimesh.load(str(path), force="mesh", process=True)
         mesh.apply_transform(body_T[bone])

@@ -163,11 +163,12 @@ def extrude_heightfield(xs, zs, height, *, depth_mm=4.0) -> trimesh.Trimesh:
 
 
 def build_radius_cap(row_meshes, radius_mesh, *, joint_space_mm=1.5, spacing_mm=0.4, depth_mm=4.0, sample_mm=0.15,
-                     sweep_deg=(0.0, 0.0)):
+                     sweep_deg=(0.0, 0.0), swept_sample_mm=0.25):
     """The rebuilt distal radius articular solid and its articular (top) vertex mask.
 
     row_meshes: the scaphoid and lunate. sweep_deg: (flexion, deviation) half-ranges of the
-    swept envelope, deg; (0, 0) moulds the fossae to the neutral row. Returns (mesh, articular)
+    swept envelope, deg; (0, 0) moulds the fossae to the neutral row. sample_mm, swept_sample_mm:
+    surface sampling of the row, mm (coarser when swept: every sample is repeated per pose). Returns (mesh, articular)
     where articular is a bool array over mesh vertices.
     """
     footprint = fossa_points(row_meshes, radius_mesh)
@@ -178,7 +179,7 @@ def build_radius_cap(row_meshes, radius_mesh, *, joint_space_mm=1.5, spacing_mm=
             points = trimesh.sample.sample_surface_even(mesh, int(mesh.area / (sample_mm * sample_mm)), seed=0)[0]
             row_points.append(points)
             continue
-        points, face = trimesh.sample.sample_surface_even(mesh, int(mesh.area / (0.25 * 0.25)), seed=0)
+        points, face = trimesh.sample.sample_surface_even(mesh, int(mesh.area / swept_sample_mm ** 2), seed=0)
         facing = mesh.face_normals[face, 1] > 0.0  # the proximally facing surface
         row_points.append(swept(points[facing], sphere_centre(fossa_points([mesh], radius_mesh)), *sweep_deg))
     row_points += [m.vertices for m in row_meshes]

@@ -243,7 +243,8 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None, *, wo
     s_pts, seated = _seat_samples(s_pts, s_nrm, s_off, grids)
     lap("grids")
     masses = [mass.mass_properties(*_solid(bones[b])) if bones[b].solid.any() else (0.0, np.zeros(3), np.zeros((3, 3))) for b in BONES]
-    centroids = [mass.mass_properties(*_solid(bones[b], part=0))[1] if bones[b].solid.any() else np.zeros(3) for b in BONES]
+    centroids = [mass.mass_properties(*_solid(bones[b], part=0))[1] if bones[b].part.any() else m[1]
+                 for b, m in zip(BONES, masses)]  # a body of one bone: its centre of mass
     lap("mass")
 
     empty = np.zeros((0, 0, 0), np.float32)
