@@ -133,12 +133,11 @@ def main(name: str, params=None, load_n=None) -> None:
 if __name__ == "__main__":
     import argparse
 
-    from wrist_env.build.pipeline import BuildParams
+    from wrist_env.build.pipeline import add_anatomy_arguments, anatomy_params
 
     cli = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     cli.add_argument("participant", nargs="?", default="P1")
-    cli.add_argument("--distal-row", action="store_true")
-    cli.add_argument("--fossa-sweep", nargs=2, type=float, default=(0.0, 0.0))
+    add_anatomy_arguments(cli)
     cli.add_argument("--load", type=float)
     args = cli.parse_args()
-    main(args.participant, BuildParams(fossa_sweep_deg=tuple(args.fossa_sweep), distal_row=args.distal_row), args.load)
+    main(args.participant, anatomy_params(args), args.load)

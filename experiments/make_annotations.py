@@ -4,7 +4,7 @@ Each ligament site is placed on the template bones (RCS: x volar, y proximal,
 z radial) by an anatomical rule quoted from the descriptions the preprint
 cites (Table 2): Berger 2001 (SLIL regions, RSC, LRL), Nagao 2005 (SRL, DRC,
 UL), Mizuseki 1989 (DRC), Ringler 2013 (RCL), Apergis 2013 (SCL), Moritomo
-2013 (UCL). A rule picks the extreme vertex of a bone region along an
+2013 (UCL); Berger 2001 and Garcia-Elias 2017 for the fixed TC and TH. A rule picks the extreme vertex of a bone region along an
 anatomical direction; the patch is the bone surface within `radius_mm` of it.
 Cartilage coverage is the part of each bone facing its partner within a gap.
 
@@ -99,6 +99,18 @@ def main() -> None:
     ligaments["DRC"]["insertion"] = {"bone": "lunate", "part": "triquetrum",
                                      "centre_mm": np.round(extreme(V["triquetrum"], (-1, 0, 0)), 3).tolist(),
                                      "radius_mm": drc["radius_mm"], "without_part": drc}
+    # Berger 2001, Garcia-Elias 2017: the ulnar arm of the palmar arcuate ligament, from the
+    # palmar-distal triquetrum to the palmar capitate neck (TC, beside the UCL's insertion) and
+    # to the palmar hamate body proximal to its hook (TH). Fixed ligaments of the distal row.
+    tri = {"bone": "lunate", "part": "triquetrum", "radius_mm": 2.0,
+           "centre_mm": np.round(extreme(V["triquetrum"], (1, -0.6, 0.4)), 3).tolist()}
+    hamate_body = V["hamate"][:, 1] > V["hamate"][:, 1].mean()
+    ligaments["TC"] = {"origin": tri, "insertion": {
+        "bone": "capitate", "radius_mm": 2.0,
+        "centre_mm": np.round(extreme(V["capitate"], (1, 0, -0.5), cap_waist), 3).tolist()}}
+    ligaments["TH"] = {"origin": tri, "insertion": {
+        "bone": "capitate", "part": "hamate", "radius_mm": 2.0,
+        "centre_mm": np.round(extreme(V["hamate"], (1, 0.3, 0.3), hamate_body), 3).tolist()}}
     # Articulations are between rigid bodies: the scaphocapitate one includes the scaphoid's
     # distal pole against the trapezium and trapezoid (the STT joint), the lunocapitate one the
     # triquetrum against the hamate (Moritomo 2013: the helicoid triquetrohamate joint).

@@ -101,12 +101,13 @@ def test_builtins_pass_published_checks(name, built):
     assert not failed, failed
 
 
-def test_distal_row_and_swept_fossae_make_the_row_follow_the_capitate(model_cache):
-    """The anatomy variant under study (README, "Anatomy variants"): on P1 at the default load the
-    scaphoid and lunate turn with the capitate within Rainbow 2013's bands, the scaphoid more."""
-    from wrist_env.build.pipeline import BuildParams
-
-    report = validation.validate("P1", params=BuildParams(fossa_sweep_deg=(20.0, 10.0), distal_row=True))
-    assert report.conditions == {"fossa_sweep_deg": [20.0, 10.0], "distal_row": True, "load_n": 10.0}
-    for check in ("scaphoid_slope", "lunate_slope", "scaphoid_above_lunate"):
+@pytest.mark.parametrize("name", ["P1", "P2", "P3"])
+def test_builtins_move_like_a_wrist(name, built):
+    """The default anatomy (distal row, swept fossae, TC/TH): the scaphoid and lunate turn with the
+    capitate within Rainbow 2013's bands, the scaphoid more, at cadaveric radioscaphoid pressures.
+    Still failing on some participants, held by the strict xfail below: the radiocarpal load share
+    (RS/RL ~0.3 on all three), the SL gap after SLIL transection (P2, P3) and SLIL force (P2, 42 N)."""
+    report = validation.validate(name, model=built(name))
+    for check in ("scaphoid_slope", "lunate_slope", "scaphoid_above_lunate", "rs_mean_pressure_mpa"):
         assert report.row(check).passed, report.row(check)
+    assert report.row("rs_rl_force_ratio").value < 1.1  # the open item of issue 10: update when it passes

@@ -172,7 +172,7 @@ def _evaluate(args) -> int:
 
 def _validate(args) -> int:
     from wrist_env import validation
-    from wrist_env.build.pipeline import BuildParams
+    from wrist_env.build.pipeline import BuildParams, anatomy_params
     from wrist_env.errors import ParticipantError
     from wrist_env.participants import registry
     from wrist_env.solver.simulate import IDEALIZED_LOAD_N
@@ -181,7 +181,7 @@ def _validate(args) -> int:
         registry.add_folder(folder)
     if args.participant not in registry.participants():
         raise ParticipantError(f"unknown participant {args.participant!r}; known: {list(registry.participants())}")
-    params = BuildParams(fossa_sweep_deg=tuple(args.fossa_sweep), distal_row=args.distal_row)
+    params = anatomy_params(args)
     report = validation.validate(args.participant, params=params,
                                  load_n=IDEALIZED_LOAD_N if args.load is None else args.load)
     variant = "" if params == BuildParams() and args.load is None else "_variant"
@@ -354,6 +354,8 @@ def _montecarlo_report(args) -> int:
 
 
 def parser() -> argparse.ArgumentParser:
+    from wrist_env.build.pipeline import add_anatomy_arguments
+
     p = argparse.ArgumentParser(prog="wrist-bench", description=__doc__)
     sub = p.add_subparsers(dest="command", required=True)
 
@@ -420,12 +422,9 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true", help="print the checks and series as JSON")
     s.add_argument("--out", help=f"figure folder (default {FIGURES})")
     s.add_argument("--folder", action="append", help="register this participant folder first")
-    s.add_argument("--distal-row", action="store_true",
-                   help="anatomy variant: triquetrum with the lunate, trapezium/trapezoid/hamate with the capitate")
-    s.add_argument("--fossa-sweep", nargs=2, type=float, default=(0.0, 0.0), metavar=("FLEXION", "DEVIATION"),
-                   help="anatomy variant: radius fossae as the envelope of the row swept +-these angles (deg); "
-                        "default 0 0 (moulded to the neutral row)")
-    s.add_argument("--load", type=float, help="compressive load on the capitate, N (default: the idealized driver's)")
+    add_anatomy_arguments(s)
+    s.add_argument("--load", type=float, help="compressive load on the capitate in the sweeps, N (default: the idealized "
+                                              "driver's; the load-share check always takes 100 N)")
     s.set_defaults(run=_validate)
 
     s = sub.add_parser("figure", help="write a figure (PNG)",

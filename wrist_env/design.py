@@ -45,6 +45,23 @@ LIGAMENTS = (
     Ligament("UL", "ulnolunate ligament", 3, 40.0, 12.0, False, "Nagao 2005"),
 )
 LIGAMENT_NAMES = tuple(lig.name for lig in LIGAMENTS)
+FIXED_LIGAMENTS = (
+    Ligament("TC", "palmar triquetrocapitate ligament", 3, 20.0, 6.0, False, "Garcia-Elias 2017; Weaver 1994"),
+    Ligament("TH", "palmar triquetrohamate ligament", 3, 20.0, 6.0, False, "Garcia-Elias 2017; Weaver 1994"),
+)
+"""Ligaments outside the design, built with the distal row: the two insertions (capitate,
+hamate) of the triquetrum–hamate–capitate ligament, the ulnar arm of the palmar arcuate
+(midcarpal) ligament and the main passive stabilizer of the midcarpal joint in neutral
+(Garcia-Elias 2017, Hand Clin 33:511; Weaver, Tencer & Trumble 1994, J Hand Surg Am 19:464;
+its laxity is midcarpal instability: Lichtman 1981). No stiffness of it is published: the
+ligament takes the mean of Table 2's radial palmar midcarpal ligament, the SCL (40 N/mm,
+Apergis 2013), split equally between its two insertions, and `FIXED_REFERENCE_STRAIN`."""
+FIXED_REFERENCE_STRAIN = 1.0
+"""Reference strain of the fixed ligaments: just taut at neutral (the palmar ligaments are in
+tension in the unloaded neutral wrist: Weaver 1994)."""
+ALL_LIGAMENTS = LIGAMENTS + FIXED_LIGAMENTS
+ALL_LIGAMENT_NAMES = tuple(lig.name for lig in ALL_LIGAMENTS)
+"""The design's eleven ligaments, then the fixed ones: the order of every per-bundle output."""
 INJURABLE = tuple(lig.name for lig in LIGAMENTS if lig.injurable)
 N_LIGAMENTS = len(LIGAMENTS)
 N_MATERIAL = 2 * N_LIGAMENTS
@@ -159,6 +176,15 @@ def to_action(design: Design) -> np.ndarray:
 def population() -> Design:
     """Table 2 means, all ligaments intact."""
     return Design.from_vector(MEAN)
+
+
+def ligament_arrays(design: Design) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(stiffness N/mm, reference strain, torn) of every ligament in `ALL_LIGAMENT_NAMES` order:
+    the design's, then the fixed ligaments' (never torn)."""
+    n = len(FIXED_LIGAMENTS)
+    return (np.concatenate([design.stiffness, [lig.stiffness_mean for lig in FIXED_LIGAMENTS]]),
+            np.concatenate([design.reference_strain, np.full(n, FIXED_REFERENCE_STRAIN)]),
+            np.concatenate([design.torn, np.zeros(n, bool)]))
 
 
 def z_scores(design: Design) -> np.ndarray:

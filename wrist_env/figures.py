@@ -11,12 +11,12 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection  # noqa: E402
 
-from wrist_env.design import LIGAMENT_NAMES  # noqa: E402
+from wrist_env.design import ALL_LIGAMENT_NAMES  # noqa: E402
 
 FIGURES = Path("experiments") / "figures"
 BONE_COLOUR = {"radius": "#d9cfc1", "ulna": "#d9cfc1", "scaphoid": "#e8dcc8", "lunate": "#e3d5bd", "capitate": "#eadfcf"}
 VIEWS = (("volar view", 0, 0), ("radial view", 0, 90), ("oblique", 25, 40))
-LIGAMENT_COLOURS = dict(zip(LIGAMENT_NAMES, plt.get_cmap("tab10").colors + ("#000000",)))
+LIGAMENT_COLOURS = dict(zip(ALL_LIGAMENT_NAMES, plt.get_cmap("tab10").colors + ("#000000", "#7a5195", "#ef5675")))
 
 
 def _to_plot(p):
@@ -86,7 +86,7 @@ def model_figure(name: str, out: Path | None = None) -> Path:
         colours.append(c)
     tris, colours = np.concatenate(tris), np.concatenate(colours)
     fibres = np.stack([model.fibre_origin, model.fibre_insertion], axis=1)
-    fibre_colours = [LIGAMENT_COLOURS[LIGAMENT_NAMES[i]] for i in model.fibre_ligament]
+    fibre_colours = [LIGAMENT_COLOURS[ALL_LIGAMENT_NAMES[i]] for i in model.fibre_ligament]
     nodes = model.membrane_nodes
     membrane = np.stack([nodes[model.membrane_connectors[:, 0]], nodes[model.membrane_connectors[:, 1]]], axis=1)
     fig = plt.figure(figsize=(17, 6.5))
@@ -100,8 +100,8 @@ def model_figure(name: str, out: Path | None = None) -> Path:
         ax.view_init(elev=elev, azim=azim - 90)
         _frame(ax, tris.reshape(-1, 3), title)
     handles = [plt.Line2D([], [], color=LIGAMENT_COLOURS[n], lw=2, label=n + (" (membrane)" if n == "RSC" else ""))
-               for n in LIGAMENT_NAMES]
-    fig.legend(handles=handles, loc="lower center", ncol=11, frameon=False)
+               for n in ALL_LIGAMENT_NAMES]
+    fig.legend(handles=handles, loc="lower center", ncol=13, frameon=False)
     sm = plt.cm.ScalarMappable(norm=norm, cmap=cmap)
     fig.colorbar(sm, ax=fig.axes, shrink=0.45, label="cartilage thickness (mm)", location="right")
     fig.suptitle(f"{name}: bones, cartilage coloured by thickness, ligament fibres (drawn on top) "
@@ -125,9 +125,11 @@ def annotations_figure(out: Path | None = None) -> Path:
     """The template with its cartilage coverage and ligament attachment sites, for review."""
     from wrist_env.anatomy.annotations import ARTICULATIONS, template_annotations
     from wrist_env.anatomy.template import load_template
+    from wrist_env.build.pipeline import BuildParams
 
-    bones = load_template().bones
-    ann = template_annotations()
+    anatomy = BuildParams().anatomy  # the default build's template: swept fossae, distal row
+    bones = load_template(*anatomy).bones
+    ann = template_annotations(*anatomy)
     out = out or FIGURES / "template_annotations.png"
     art_colours = dict(zip(ARTICULATIONS, ("#f4a6a0", "#9fc3e0", "#b9e3ae", "#d3bde0", "#fdd49e")))
     fig = plt.figure(figsize=(18, 5.6))
@@ -152,7 +154,7 @@ def annotations_figure(out: Path | None = None) -> Path:
         ax.view_init(elev=elev, azim=azim - 90)
         _frame(ax, np.vstack([bones[b].vertices[bones[b].vertices[:, 1] < 14.0] for b in shown]), title)
     handles = [plt.Line2D([], [], color=c, lw=6, label=a) for a, c in art_colours.items()]
-    handles += [plt.Line2D([], [], color=LIGAMENT_COLOURS[n], marker="o", lw=0, label=n) for n in LIGAMENT_NAMES]
+    handles += [plt.Line2D([], [], color=LIGAMENT_COLOURS[n], marker="o", lw=0, label=n) for n in ALL_LIGAMENT_NAMES]
     fig.legend(handles=handles, loc="lower center", ncol=8, frameon=False)
     fig.suptitle("Template annotations: cartilage coverage per articulation (patches) and ligament sites (dots), RCS")
     out.parent.mkdir(parents=True, exist_ok=True)

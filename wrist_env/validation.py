@@ -30,6 +30,7 @@ EXTENSION_30_DEG = -30.0  # flexion + / extension −, as the idealized driver's
 SL_DISSOCIATION_MM = 3.0  # clinical scapholunate dissociation: gap > 3 mm
 RAINBOW_SCAPHOID = 0.72  # Rainbow 2013: scaphoid 70 % (flexion), 74 % (extension) of the capitate
 RAINBOW_LUNATE = 0.44  # Rainbow 2013: lunate 46 % (flexion), 42 % (extension)
+NEUTRAL_LOAD_N = 100.0  # axial load of the load-share check: Hara 1992 loaded neutral wrists with up to 12 kg
 
 RAINBOW = ("Rainbow et al. 2013, J Hand Surg Am 38:278-288 (in vivo CT, 12 wrists, extreme loaded flexion and "
            "extension: {} of the capitate's flexion / extension)")
@@ -189,7 +190,7 @@ def validate(name: str, *, model=None, d: design_mod.Design | None = None, n_fra
     """Run the published-measurement checks on participant `name` (population design by default).
 
     params: build parameters (`BuildParams`; the anatomy variant), default the default build.
-    load_n: the compressive load (N) of the sweeps and of the neutral pose.
+    load_n: the compressive load (N) of the sweeps; the neutral pose takes `NEUTRAL_LOAD_N`.
     """
     from wrist_env.build.pipeline import BuildParams
     from wrist_env.participants.registry import load_model
@@ -203,7 +204,7 @@ def validate(name: str, *, model=None, d: design_mod.Design | None = None, n_fra
     torn_design = with_tears(intact_design, SLIL)
     sweep = sim.idealized(model, n_frames=n_frames, load_n=load_n)
     intact, torn = sim.simulate_batch(model, [intact_design, torn_design], sweep)
-    neutral = sim.simulate(model, intact_design, sim.loaded(model, [np.eye(3)], load_n=load_n))
+    neutral = sim.simulate(model, intact_design, sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N))
 
     b = {bone: BONES.index(bone) for bone in ("capitate", "scaphoid", "lunate")}
     rs, rl = PAIRS.index("radioscaphoid"), PAIRS.index("radiolunate")
@@ -226,7 +227,7 @@ def validate(name: str, *, model=None, d: design_mod.Design | None = None, n_fra
         _row("scaphoid_above_lunate", "scaphoid slope minus lunate slope", s_slope - l_slope, (0.0, inf),
              "deg/deg", fail_i),
         _row("rs_rl_force_ratio", f"radioscaphoid / radiolunate contact force, capitate held at neutral under "
-             f"{load_n:g} N", rs_rl, (1.1, 2.0), "ratio",
+             f"{NEUTRAL_LOAD_N:g} N", rs_rl, (1.1, 2.0), "ratio",
              fail_n),
         _row("sl_gap_growth_mm", "SL gap at full extension (last frame), all three SLIL bundles torn minus intact",
              gap_torn[-1] - gap_intact[-1], (SL_DISSOCIATION_MM, inf), "mm", fail_i or fail_t),
@@ -239,7 +240,8 @@ def validate(name: str, *, model=None, d: design_mod.Design | None = None, n_fra
               "lunate_flexion_deg": lun, "sl_gap_intact_mm": gap_intact, "sl_gap_slil_torn_mm": gap_torn,
               "slil_force_intact_n": slil_total, "rs_mean_pressure_intact_mpa": intact.contact[:, rs, 0],
               "intact_status": intact.message, "slil_torn_status": torn.message, "neutral_status": neutral.message}
-    conditions = {"fossa_sweep_deg": list(params.anatomy[0]), "distal_row": params.anatomy[1], "load_n": float(load_n)}
+    conditions = {"fossa_sweep_deg": list(params.anatomy[0]), "distal_row": params.anatomy[1],
+                  "fixed_ligaments": bool(params.fixed_ligaments and params.distal_row), "load_n": float(load_n)}
     return Report(model.name, rows, series, time.perf_counter() - start, conditions)
 
 
@@ -254,7 +256,7 @@ def format_table(report: Report) -> str:
     c = report.conditions
     lines = [f"{report.participant}, population design: the model against published measurements"
              + (f" (fossa sweep ±{c['fossa_sweep_deg']} deg, distal row {'on' if c['distal_row'] else 'off'}, "
-                f"load {c['load_n']:g} N)" if c else ""),
+                f"TC/TH {'on' if c.get('fixed_ligaments') else 'off'}, sweep load {c['load_n']:g} N)" if c else ""),
              f"{'check':<22} {'value':>8}  {'band':<13} {'unit':<8} {'result':<6}  source"]
     for r in report.rows:
         band = f"{_fmt(r.band[0])}-{_fmt(r.band[1])}" if math.isfinite(r.band[1]) else f"> {_fmt(r.band[0])}"

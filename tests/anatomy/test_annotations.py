@@ -35,3 +35,26 @@ def test_site_bones_follow_the_anatomy():
     assert c["SLIL_v"][0] > c["SLIL_p"][0] > c["SLIL_d"][0]
     assert c["SLIL_p"][1] > max(c["SLIL_v"][1], c["SLIL_d"][1])
     assert c["DRC"][0] < 0 < c["LRL"][0]  # dorsal vs volar radiocarpal ligaments
+
+
+def test_fixed_midcarpal_ligaments_join_the_triquetrum_to_the_distal_row():
+    """TC and TH (design.FIXED_LIGAMENTS) run palmar, from the triquetrum to the capitate neck and the
+    hamate body; they are resolved only on bodies that carry those bones (the distal row)."""
+    from wrist_env.anatomy.annotations import template_annotations
+    from wrist_env.design import FIXED_LIGAMENTS
+    from wrist_env.model import BODY_PARTS
+
+    data = read_annotation_data()["ligaments"]
+    with_row, without = template_annotations((20.0, 10.0), True), template_annotations()
+    for lig in FIXED_LIGAMENTS:
+        spec = data[lig.name]
+        assert spec["origin"]["part"] == "triquetrum" and spec["insertion"]["bone"] == "capitate"
+        assert spec["origin"]["centre_mm"][0] > 5.0 and spec["insertion"]["centre_mm"][0] > 5.0  # palmar (x volar)
+        assert lig.name not in without.sites
+        origin, insertion = with_row.sites[lig.name]
+        assert origin.mask.sum() >= lig.fibres and insertion.mask.sum() >= lig.fibres
+        part = spec["insertion"].get("part", "capitate")
+        from wrist_env.anatomy.template import load_template
+
+        body = load_template((20.0, 10.0), True).bones["capitate"]
+        assert (body.part[insertion.mask] == BODY_PARTS["capitate"].index(part)).all(), lig.name

@@ -95,14 +95,14 @@ def test_killed_study_resumes_with_no_run_lost_or_repeated(reference, tmp_path):
 
 
 def test_excluded_runs_are_flagged_counted_and_replaced(built, tmp_path):
-    config = StudyConfig(("P1",), n=8, seed=3, exclude_above_mpa=1.5)
+    config = StudyConfig(("P1",), n=8, seed=3, exclude_above_mpa=3.0)
     summary = run_study(config, tmp_path, batch=4)
     log = read_runs(tmp_path).to_pandas()
     c = summary.counts["P1"]
     assert c.succeeded == 8 and c.excluded > 0 and c.attempts == len(log) == 8 + c.excluded + c.failed
     assert ((log["ok"]) & (~log["excluded"])).sum() == 8
     peak = log["rs_mean_mpa"].map(lambda x: -1.0 if x is None else np.max(x))
-    assert (log["excluded"] == (log["ok"] & (peak > 1.5))).all()
+    assert (log["excluded"] == (log["ok"] & (peak > 3.0))).all()
     assert log["block"].max() == c.blocks - 1 >= 1
     assert summary.excluded == c.excluded and "excluded" in summary.line()
 

@@ -6,7 +6,7 @@ import trimesh
 
 from wrist_env.anatomy.template import load_template
 from wrist_env.build.warp import random_warp
-from wrist_env.design import LIGAMENTS
+from wrist_env.design import ALL_LIGAMENTS
 from wrist_env.errors import ParticipantError
 from wrist_env.participants import registry
 from wrist_env.participants.folder import ParticipantSource, write_participant_folder
@@ -38,10 +38,10 @@ def test_a_registered_folder_builds_a_model(tmp_path):
     name = registry.add_folder(folder)
     assert name == "U1" and "U1" in registry.participants()
     model = registry.load_model("U1")
-    counts = np.bincount(model.fibre_ligament, minlength=len(LIGAMENTS))
-    assert [int(c) for c in counts] == [lig.fibres for lig in LIGAMENTS]
+    counts = np.bincount(model.fibre_ligament, minlength=len(ALL_LIGAMENTS))
+    assert [int(c) for c in counts] == [lig.fibres for lig in ALL_LIGAMENTS]  # the distal row carried from the template
     for art, gap in model.report["joint_space_mm"].items():
-        assert 0.5 <= gap <= 2.5, art
+        assert 0.5 <= gap <= 3.0, art
     assert model.report["morph_error_mm"]["scaphoid"]["mean"] < 0.1
 
 

@@ -105,7 +105,7 @@ def test_result_to_dict_is_strict_json_with_every_output(p1, sweep):
     rs = frame["contact"]["radioscaphoid"]
     assert rs == pytest.approx(dict(zip(("mean_pressure_mpa", "peak_pressure_mpa", "area_mm2", "force_n"),
                                         sweep.contact[4, RS])))
-    assert set(frame["ligament_force_n"]) == set(design.LIGAMENT_NAMES)
+    assert set(frame["ligament_force_n"]) == set(design.ALL_LIGAMENT_NAMES)
     for key in ("kinetic_energy_nmm", "internal_energy_nmm"):
         assert np.isfinite(frame[key])
     assert set(frame["residual"]) == {"force_n", "moment_nmm"} and frame["steps"] > 0

@@ -19,7 +19,7 @@ import igl
 import numpy as np
 
 from wrist_env.anatomy.template import load_template
-from wrist_env.design import LIGAMENT_NAMES
+from wrist_env.design import ALL_LIGAMENT_NAMES, LIGAMENT_NAMES
 from wrist_env.model import BODY_PARTS
 
 ARTICULATIONS = ("radioscaphoid", "radiolunate", "scapholunate", "scaphocapitate", "lunocapitate")
@@ -60,12 +60,21 @@ def facing_within(vertices, normals, partner_vertices, partner_faces, max_gap_mm
     return (np.sqrt(d2) < max_gap_mm) & (towards > 0)
 
 
+ENDS = ("origin", "insertion")
+
+
+def _has_part(bones: dict, spec: dict) -> bool:
+    """Whether the body of a site spec carries the bone (`part`) the site lies on."""
+    return "part" not in spec or BODY_PARTS[spec["bone"]].index(spec["part"]) <= bones[spec["bone"]].part.max()
+
+
 def resolve(bones: dict, data: dict | None = None) -> Annotations:
     """Resolve annotation data on `bones` (name -> BoneSurface in the template RCS).
 
     A site lies on one bone of its body (its `part`, default the principal bone; e.g. the
     DRC's insertion on the triquetrum); on bodies without that part (no distal row) its
-    `without_part` site is used instead.
+    `without_part` site is used instead, and a fixed ligament (`design.FIXED_LIGAMENTS`)
+    without one is not built.
     """
     data = read_annotation_data() if data is None else data
     solids = {name: b.trimesh(solid_only=True) for name, b in bones.items() if b.solid.any()}
@@ -83,11 +92,13 @@ def resolve(bones: dict, data: dict | None = None) -> Annotations:
             masks.append(mask & bones[me].solid)
         coverage[art] = (a, b, masks[0], masks[1])
     sites = {}
-    for lig in LIGAMENT_NAMES:
+    for lig in ALL_LIGAMENT_NAMES:
+        if lig not in LIGAMENT_NAMES and not all(_has_part(bones, data["ligaments"][lig][end]) for end in ENDS):
+            continue  # a fixed ligament of a bone this variant lacks (the distal row's)
         pair = []
-        for end in ("origin", "insertion"):
+        for end in ENDS:
             spec = data["ligaments"][lig][end]
-            if "part" in spec and BODY_PARTS[spec["bone"]].index(spec["part"]) > bones[spec["bone"]].part.max():
+            if not _has_part(bones, spec):
                 spec = spec["without_part"]
             body = bones[spec["bone"]]
             own = body.part == BODY_PARTS[spec["bone"]].index(spec.get("part", spec["bone"]))

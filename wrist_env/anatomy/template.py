@@ -100,6 +100,25 @@ def compose(parts: dict, distal_row: bool = True) -> dict:
     return bodies
 
 
+def carry_parts(bodies: dict, template: "Template") -> dict:
+    """Bodies with the distal row for a participant who supplies the five principal bones only
+    (name -> BoneSurface, RCS mm): each other bone of a body (`BODY_PARTS`) is the template's,
+    carried by the similarity (rotation, translation, isotropic scale) that registers the
+    template's principal bone onto the participant's (ICP from the shared RCS)."""
+    parts = {b: bodies[b] for b in BONES}
+    for body in BONES:
+        if len(BODY_PARTS[body]) == 1:
+            continue
+        principal = template.parts[body]
+        target = trimesh.Trimesh(bodies[body].vertices, bodies[body].faces, process=False)
+        T, _, _ = trimesh.registration.icp(principal.vertices, target, initial=np.eye(4), threshold=1e-6,
+                                           max_iterations=60, reflection=False, scale=True)
+        for p in BODY_PARTS[body][1:]:
+            src = template.parts[p]
+            parts[p] = BoneSurface(p, src.vertices @ T[:3, :3].T + T[:3, 3], src.faces.copy(), src.solid.copy())
+    return compose(parts, True)
+
+
 def rcs_rotation(radius: trimesh.Trimesh, carpus_centroid, flexor_sites, extensor_sites) -> np.ndarray:
     """Rows x (volar), y (proximal), z (radial) of the RCS in the myo-sim frame."""
     centred = radius.vertices - radius.vertices.mean(axis=0)

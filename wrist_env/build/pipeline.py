@@ -20,11 +20,11 @@ from scipy.spatial import cKDTree
 from wrist_env.anatomy.annotations import ARTICULATIONS, template_annotations
 from wrist_env.anatomy.template import load_template
 from wrist_env.build import cartilage, contact_law, fibres, mass, morph, sdf
-from wrist_env.design import LIGAMENTS, LIGAMENT_NAMES
+from wrist_env.design import ALL_LIGAMENTS, LIGAMENTS, LIGAMENT_NAMES
 from wrist_env.errors import BuildError
 from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model, offsets
 
-BUILDER_VERSION = 2  # 2: distal row and triquetrum as body parts, swept radius fossae
+BUILDER_VERSION = 3  # 2: distal row and triquetrum as body parts, swept fossae; 3: both by default, TC and TH
 GRID_BONES = ("radius", "scaphoid", "lunate", "capitate")
 MIN_SITE_VERTICES = 8
 
@@ -42,17 +42,42 @@ class BuildParams:
     membrane_along: int = 9
     membrane_across: int = 5
     seed: int = 0
-    fossa_sweep_deg: tuple = (0.0, 0.0)
+    fossa_sweep_deg: tuple = (20.0, 10.0)
     """(flexion, deviation) half-ranges, deg, of the row's sweep that shapes the radius fossae
     ((0, 0): moulded to the neutral row; see `anatomy.radius_cap`)."""
-    distal_row: bool = False
+    distal_row: bool = True
     """The triquetrum moves with the lunate and the trapezium, trapezoid and hamate with the
-    capitate, bringing the STT and triquetrohamate contacts (`model.BODY_PARTS`)."""
+    capitate, bringing the STT and triquetrohamate contacts (`model.BODY_PARTS`) and the fixed
+    TC and TH ligaments (`design.FIXED_LIGAMENTS`); participant folders get these bones from
+    the template (`anatomy.template.carry_parts`)."""
+    fixed_ligaments: bool = True
+    """Build the fixed TC and TH with the distal row (False: the lunate body is tied to the
+    distal row by contact alone; for studying what they do)."""
 
     @property
     def anatomy(self) -> tuple:
         """The template variant of these parameters: (fossa_sweep_deg, distal_row)."""
         return (tuple(float(a) for a in self.fossa_sweep_deg), bool(self.distal_row))
+
+
+def add_anatomy_arguments(parser) -> None:
+    """Add the anatomy-variant options (`--fossa-sweep`, `--no-distal-row`) to an argparse parser."""
+    d = BuildParams()
+    parser.add_argument("--fossa-sweep", nargs=2, type=float, default=d.fossa_sweep_deg, metavar=("FLEXION", "DEVIATION"),
+                        help="anatomy variant: radius fossae as the envelope of the row swept +-these angles (deg); "
+                             f"0 0 moulds them to the neutral row (default {d.fossa_sweep_deg[0]:g} "
+                             f"{d.fossa_sweep_deg[1]:g})")
+    parser.add_argument("--no-distal-row", dest="distal_row", action="store_false",
+                        help="anatomy variant: the five principal bones alone (no triquetrum, trapezium, trapezoid, "
+                             "hamate; no TC/TH ligaments)")
+    parser.add_argument("--no-fixed-ligaments", dest="fixed_ligaments", action="store_false",
+                        help="anatomy variant: the distal row without the TC and TH ligaments")
+
+
+def anatomy_params(args) -> BuildParams:
+    """The `BuildParams` of parsed `add_anatomy_arguments` options."""
+    return BuildParams(fossa_sweep_deg=tuple(float(a) for a in args.fossa_sweep), distal_row=bool(args.distal_row),
+                       fixed_ligaments=bool(args.fixed_ligaments))
 
 
 def source_hash(name: str, bones: dict, params: BuildParams) -> str:
@@ -124,7 +149,9 @@ def _transfer(morphs: dict, bones: dict, params: BuildParams) -> tuple[dict, dic
 
 def _ligaments(bones: dict, sites: dict, params: BuildParams):
     bundles, membrane = [], None
-    for k, lig in enumerate(LIGAMENTS):
+    for k, lig in enumerate(ALL_LIGAMENTS):
+        if lig.name not in sites or (lig not in LIGAMENTS and not params.fixed_ligaments):
+            continue  # a fixed ligament of the distal row, in a model without it or without them
         (ob, om), (ib, im) = sites[lig.name]
         if lig.fibres == 0:
             scaphoid = trimesh.Trimesh(bones["scaphoid"].vertices, bones["scaphoid"].faces, process=False)
@@ -262,7 +289,7 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None, *, wo
         "build_seconds": round(sum(timings.values()), 2),
         "timings_s": timings,
         "morph_error_mm": morph_report,
-        "fibres": {LIGAMENTS[k].name: int(len(bd.origin)) for k, _, _, bd in bundles} | {"RSC": int(len(membrane.connectors))},
+        "fibres": {ALL_LIGAMENTS[k].name: int(len(bd.origin)) for k, _, _, bd in bundles} | {"RSC": int(len(membrane.connectors))},
         "reference_length_mm": {n: round(float(x), 3) for n, x in zip(LIGAMENT_NAMES, ref_len)},
         "contact_law_r2": round(float(law.r2), 5),
         "sites_relocated": relocated,

@@ -14,7 +14,7 @@ import numpy as np
 
 from wrist_env import design as design_vars
 from wrist_env.cost import COST_BONES, CostWeights, kinematic_cost
-from wrist_env.design import LIGAMENT_NAMES, Design
+from wrist_env.design import ALL_LIGAMENT_NAMES, Design
 from wrist_env.model import BONES, PAIRS, Model
 from wrist_env.participants import builtin, registry
 from wrist_env.solver.arrays import SolverSettings
@@ -100,7 +100,7 @@ def outputs(result: Result, report=None) -> dict:
         "poses": clean(result.poses),
         "contact": {pair: {field: clean(result.contact[:, p, k]) for k, field in enumerate(CONTACT_FIELDS)}
                     for p, pair in enumerate(PAIRS)},
-        "bundle_force_n": {lig: clean(result.bundle_force[:, i]) for i, lig in enumerate(LIGAMENT_NAMES)},
+        "bundle_force_n": {lig: clean(result.bundle_force[:, i]) for i, lig in enumerate(ALL_LIGAMENT_NAMES)},
         "kinetic_energy_nmm": clean(result.energy[:, 0]),
         "internal_energy_nmm": clean(result.energy[:, 1]),
         "steps": np.asarray(result.steps, dtype=np.int64),

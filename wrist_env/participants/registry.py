@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from wrist_env.anatomy.template import BoneSurface
+from wrist_env.anatomy.template import BoneSurface, carry_parts, load_template
 from wrist_env.build.pipeline import BuildParams, build_model, source_hash
 from wrist_env.errors import ParticipantError
 from wrist_env.model import BONES, Model
@@ -53,10 +53,8 @@ def bones(name: str, params: BuildParams | None = None) -> dict:
     from wrist_env.participants.folder import load_participant_folder
 
     source = load_participant_folder(_FOLDERS[name])
-    if params.distal_row:
-        raise ParticipantError(f"participant {name!r}: the distal-row anatomy needs triquetrum, trapezium, trapezoid "
-                               "and hamate meshes, which participant folders do not take yet")
-    return {b: BoneSurface(b, v, f, np.ones(len(v), bool)) for b, (v, f) in source.bones.items()}
+    principal = {b: BoneSurface(b, v, f, np.ones(len(v), bool)) for b, (v, f) in source.bones.items()}
+    return carry_parts(principal, load_template()) if params.distal_row else principal
 
 
 def trials(name: str) -> dict:

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wrist_env.design import LIGAMENT_NAMES, Design
+from wrist_env.design import LIGAMENT_NAMES, Design, ligament_arrays
 from wrist_env.model import BONES, PAIR_BONES, Model
 
 Bodies = namedtuple("Bodies", "com0 inv_mass inv_inertia mass inertia")
@@ -125,9 +125,7 @@ def design_arrays(model: Model, fib: Fibres, mem: Membrane, design: Design):
     its length: its n_across longitudinal chains of (n_along − 1) connectors in
     parallel; across connectors take a quarter of the along connectors' stiffness.
     """
-    k = design.stiffness
-    r = design.reference_strain
-    torn = design.torn
+    k, r, torn = ligament_arrays(design)
     lig = fib.ligament
     counts = np.bincount(lig, minlength=len(k)).astype(float)
     f_l0 = fib.rest_length / r[lig]

@@ -193,7 +193,7 @@ def fibre_forces(R, x, v, w, com0, fibres, l0, K, damping_s, F, T, bundle_force)
     """Blankevoort fibre forces; returns strain energy (N·mm).
 
     l0, K: per-fibre zero-load length (mm) and scale (N per unit strain), K = 0 if torn.
-    bundle_force (11,) receives the summed tension of each bundle (N).
+    bundle_force (n_ligaments,) receives the summed tension of each bundle (N).
     """
     energy = 0.0
     o, ins = fibres.origin, fibres.insertion

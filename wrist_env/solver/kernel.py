@@ -12,12 +12,14 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from wrist_env.design import ALL_LIGAMENT_NAMES
 from wrist_env.solver.forces import C_AREA, C_FORCE, C_PEAK, contact_forces, fibre_forces, membrane_forces, place_nodes, rebuild_active
 from wrist_env.solver.rigid import interpolate_pose, matrix_to_rotvec, orthonormalize, rotate_in_place, smoothstep
 
 SCAPHOID, LUNATE, CAPITATE = 2, 3, 4
-N_BONES, N_PAIRS, N_LIGAMENTS = 5, 5, 11
-RSC = 3  # Table 2 index of the radioscaphocapitate ligament
+N_BONES, N_PAIRS = 5, 5
+N_LIGAMENTS = len(ALL_LIGAMENT_NAMES)
+RSC = ALL_LIGAMENT_NAMES.index("RSC")
 OK, FAILED_NAN, FAILED_DIVERGED = 0, 1, 2
 
 
@@ -196,7 +198,7 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x, f
     free and frame_x is only the start); frame_load (n_frames,) compressive
     load on the capitate (N, along +y; loaded driver only). Outputs: poses (n_frames, 5, 4, 4);
     contact (n_frames, 5, 4) mean pressure (MPa), peak pressure (MPa), area
-    (mm²), force (N); bundle_out (n_frames, 11) N; energy_out (n_frames, 2)
+    (mm²), force (N); bundle_out (n_frames, len(ALL_LIGAMENT_NAMES)) N; energy_out (n_frames, 2)
     kinetic, internal (N·mm); residual_out (n_frames, 2) largest net force (N)
     and moment (N·mm) on the free bones; steps_out (n_frames,) steps
     taken since the previous frame (frame 0: settling and the move included).

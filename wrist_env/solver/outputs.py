@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from wrist_env.design import LIGAMENT_NAMES
+from wrist_env.design import ALL_LIGAMENT_NAMES
 from wrist_env.model import BONES, PAIRS, Model
 from wrist_env.solver import arrays, forces
 
@@ -94,7 +94,7 @@ def result_to_dict(result, model: Model) -> dict:
             "contact": {p: {"mean_pressure_mpa": _num(c[0]), "peak_pressure_mpa": _num(c[1]),
                             "area_mm2": _num(c[2]), "force_n": _num(c[3])}
                         for p, c in zip(PAIRS, result.contact[f])},
-            "ligament_force_n": {name: _num(v) for name, v in zip(LIGAMENT_NAMES, result.bundle_force[f])},
+            "ligament_force_n": {name: _num(v) for name, v in zip(ALL_LIGAMENT_NAMES, result.bundle_force[f])},
             "kinetic_energy_nmm": _num(result.energy[f, 0]),
             "internal_energy_nmm": _num(result.energy[f, 1]),
             "residual": {"force_n": _num(result.residual[f, 0]), "moment_nmm": _num(result.residual[f, 1])},
@@ -107,6 +107,6 @@ def result_to_dict(result, model: Model) -> dict:
         "n_frames": n,
         "bones": list(BONES),
         "pairs": list(PAIRS),
-        "ligaments": list(LIGAMENT_NAMES),
+        "ligaments": list(ALL_LIGAMENT_NAMES),
         "frames": frames,
     }

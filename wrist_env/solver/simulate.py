@@ -16,7 +16,7 @@ import numpy as np
 
 from scipy.spatial.transform import Rotation
 
-from wrist_env.design import Design
+from wrist_env.design import ALL_LIGAMENT_NAMES, Design
 from wrist_env.model import BONES, Model
 from wrist_env.solver import arrays, kernel
 
@@ -82,7 +82,7 @@ class Result:
     poses (n_frames, 5, 4, 4): neutral → frame transforms of `BONES`, RCS mm.
     contact (n_frames, 5, 4): per pair (`model.PAIRS`) mean pressure over the
         contacting area (MPa), peak pressure (MPa), contact area (mm²), force (N).
-    bundle_force (n_frames, 11): tension of each Table 2 ligament (N).
+    bundle_force (n_frames, 13): tension of each ligament, `design.ALL_LIGAMENT_NAMES` order (N).
     energy (n_frames, 2): kinetic and internal energy (N·mm).
     residual (n_frames, 2): largest net force (N) and moment (N·mm) on the free bones.
     steps (n_frames,): explicit steps since the previous frame (ramp + hold to equilibrium;
@@ -108,7 +108,7 @@ class Result:
 def _outputs(n: int, n_frames: int):
     shape = (n,) if n else ()
     return (np.full(shape + (n_frames, 5, 4, 4), np.nan), np.full(shape + (n_frames, 5, 4), np.nan),
-            np.full(shape + (n_frames, 11), np.nan), np.full(shape + (n_frames, 2), np.nan),
+            np.full(shape + (n_frames, len(ALL_LIGAMENT_NAMES)), np.nan), np.full(shape + (n_frames, 2), np.nan),
             np.full(shape + (n_frames, 2), np.nan), np.zeros(shape + (n_frames,), np.int64), np.zeros(shape + (1,), np.int64))
 
 
