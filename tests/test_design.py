@@ -39,6 +39,8 @@ def test_population_is_the_table_2_mean_and_intact():
     (np.zeros(26), r"shape \(27,\)"),
     (np.r_[np.zeros(26), 1.5], r"LRL.injury=1.5"),
     (np.r_[np.nan, np.zeros(26)], r"SLIL_v.stiffness=nan"),
+    (np.zeros(27) + 0.5j, r"real numbers, but got dtype complex128"),
+    (np.array(["0.1"] * 27), r"real numbers, but got dtype <U3"),
 ])
 def test_bad_actions_name_the_value(bad, match):
     with pytest.raises(DesignError, match=match):

@@ -146,7 +146,10 @@ class Design:
 
 def check_action(action) -> np.ndarray:
     """The action as float64 of shape (27,) in [-1, 1], or a DesignError naming the offending entries."""
-    a = np.asarray(action, dtype=np.float64)
+    raw = np.asarray(action)
+    if not (np.issubdtype(raw.dtype, np.floating) or np.issubdtype(raw.dtype, np.integer)):
+        raise DesignError(f"an action must be real numbers, but got dtype {raw.dtype}.")
+    a = raw.astype(np.float64)
     if a.shape != (N_DESIGN,):
         raise DesignError(f"an action must have shape ({N_DESIGN},), but got {a.shape}.")
     bad = ~np.isfinite(a) | (np.abs(a) > 1.0 + 1e-9)

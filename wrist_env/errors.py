@@ -31,3 +31,7 @@ class DesignError(InputError):
 
 class BuildError(WristEnvError, RuntimeError):
     """The participant build could not produce a valid model."""
+
+
+class StoreError(InputError):
+    """A saved file (a cached model, a run log) that is damaged, tampered with or not what it claims."""

@@ -1,16 +1,24 @@
 """Save and load frozen dataclasses of arrays as `.npz` + `.json` (never pickle).
 
 Array fields (and tuples of arrays) go to the `.npz`; everything else must be
-JSON-able and goes to the `.json`, with the class name and a format version.
+JSON-able and goes to the `.json`, with the class name, a format version and
+the SHA-256 of the `.npz`. Both are written to a temporary name and moved into
+place, the `.npz` first, so a reader sees a whole pair or no `.json`; a load
+checks the hash and the fields and raises `StoreError` naming the file.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import json
+import os
+import zipfile
 from pathlib import Path
 
 import numpy as np
+
+from wrist_env.errors import StoreError
 
 FORMAT_VERSION = 1
 
@@ -26,25 +34,70 @@ def save_dataclass(obj, path) -> None:
         else:
             meta[f.name] = value
     path.parent.mkdir(parents=True, exist_ok=True)
-    np.savez_compressed(path.with_suffix(".npz"), **arrays)
-    header = {"class": type(obj).__name__, "format": FORMAT_VERSION, "fields": meta}
-    path.with_suffix(".json").write_text(json.dumps(header, indent=1, default=_jsonable))
+    npz, tmp = path.with_suffix(".npz"), path.with_name(f".{path.name}.{os.getpid()}.tmp.npz")
+    np.savez_compressed(tmp, **arrays)
+    digest = _sha256(tmp)
+    _fsync(tmp)
+    os.replace(tmp, npz)
+    header = {"class": type(obj).__name__, "format": FORMAT_VERSION, "npz_sha256": digest, "fields": meta}
+    _write_atomic(path.with_suffix(".json"), json.dumps(header, indent=1, default=_jsonable))
 
 
 def load_dataclass(cls, path):
-    """Read an instance of `cls` written by `save_dataclass`."""
+    """Read an instance of `cls` written by `save_dataclass`; `StoreError` naming the file if the
+    pair is damaged, its `.npz` is not the one the `.json` was written with, or a field is missing."""
     path = Path(path)
-    header = json.loads(path.with_suffix(".json").read_text())
-    if header.get("class") != cls.__name__ or header.get("format") != FORMAT_VERSION:
-        raise ValueError(f"{path.with_suffix('.json')} holds {header.get('class')} v{header.get('format')}, "
-                         f"not {cls.__name__} v{FORMAT_VERSION}")
-    with np.load(path.with_suffix(".npz"), allow_pickle=False) as data:
-        arrays = {k: data[k] for k in data.files}
-    kwargs = {**header["fields"], **arrays}
+    js, npz = path.with_suffix(".json"), path.with_suffix(".npz")
+    try:
+        header = json.loads(js.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise StoreError(f"{js}: cannot be read as JSON ({e}); delete it to rebuild") from None
+    if not isinstance(header, dict) or header.get("class") != cls.__name__ or header.get("format") != FORMAT_VERSION:
+        raise StoreError(f"{js} holds {header.get('class') if isinstance(header, dict) else header!r} "
+                         f"v{header.get('format') if isinstance(header, dict) else '?'}, not {cls.__name__} v{FORMAT_VERSION}")
+    try:
+        digest = _sha256(npz)
+    except OSError as e:
+        raise StoreError(f"{npz}: cannot be read ({e}); delete {js} to rebuild") from None
+    if header.get("npz_sha256") != digest:
+        raise StoreError(f"{npz}: its SHA-256 {digest[:12]}… is not the {str(header.get('npz_sha256'))[:12]}… "
+                         f"written with {js.name} (damaged or changed); delete both to rebuild")
+    try:
+        with np.load(npz, allow_pickle=False) as data:
+            arrays = {k: data[k] for k in data.files}
+    except (OSError, ValueError, zipfile.BadZipFile, EOFError) as e:
+        raise StoreError(f"{npz}: cannot be read ({e}); delete it to rebuild") from None
+    kwargs = {**header.get("fields", {}), **arrays}
+    missing = [f.name for f in dataclasses.fields(cls) if f.name not in kwargs and f.default is dataclasses.MISSING
+               and f.default_factory is dataclasses.MISSING]
+    if missing:
+        raise StoreError(f"{path}: lacks fields {missing} of {cls.__name__}; delete it to rebuild")
     for f in dataclasses.fields(cls):
         if isinstance(kwargs.get(f.name), list) and str(f.type).startswith("tuple"):
             kwargs[f.name] = tuple(kwargs[f.name])
-    return cls(**kwargs)
+    return cls(**{f.name: kwargs[f.name] for f in dataclasses.fields(cls) if f.name in kwargs})
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _fsync(path: Path) -> None:
+    with open(path, "rb+") as fh:
+        os.fsync(fh.fileno())
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    with open(tmp, "w") as fh:
+        fh.write(text)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
 
 
 def _jsonable(value):

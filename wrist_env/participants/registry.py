@@ -8,13 +8,14 @@ the annotations and the builder version.
 from __future__ import annotations
 
 import os
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from wrist_env.anatomy.template import BoneSurface, carry_parts, load_template
 from wrist_env.build.pipeline import BuildParams, build_model, source_hash
-from wrist_env.errors import ParticipantError
+from wrist_env.errors import ParticipantError, StoreError
 from wrist_env.model import BONES, Model
 from wrist_env.participants import builtin
 
@@ -81,9 +82,17 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
     """The participant's model, built on first use and cached by the hash of its inputs."""
     params = params or BuildParams()
     b = bones(name, params)
-    path = cache_dir() / f"{name}-{source_hash(name, b, params)}"
-    if cache and path.with_suffix(".json").exists() and path.with_suffix(".npz").exists():
-        return Model.load(path)
+    digest = source_hash(name, b, params)
+    path = cache_dir() / f"{name}-{digest}"
+    if cache and path.with_suffix(".json").exists():
+        try:
+            model = Model.load(path)
+            if model.name != name or model.source_hash != digest:
+                raise StoreError(f"{path.with_suffix('.json')} holds {model.name!r} {model.source_hash}, "
+                                 f"not {name!r} {digest}")
+            return model
+        except StoreError as e:
+            warnings.warn(f"rebuilding a damaged cached model: {e}", stacklevel=2)
     model = build_model(name, b, params)
     if cache:
         model.save(path)
