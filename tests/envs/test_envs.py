@@ -80,3 +80,25 @@ def test_freeze_wrapper_keeps_ligaments_intact():
     _, reward, terminated, _, info = env.step(np.zeros(22, dtype=np.float32))
     expected = task("P1", "calibrate").evaluate(design.population())
     assert reward == expected.reward
+
+
+def test_a_failed_run_gives_the_same_nan_free_info_single_and_vectorized():
+    """Failed runs (dislocated random designs) report zeros, never NaN or None, in the single env and
+    in the vector env, whether the batch's first run failed or a later one."""
+    rng = np.random.default_rng(11)
+    actions = rng.uniform(-1, 1, (64, 27))[[0, 14, 19, 1]]  # ok, failed, failed, ok (Idealized P1)
+    single = gym.make("wrist_env/Idealized-P1-v0")
+    single.reset(seed=0)
+    infos = [single.step(a)[4] for a in actions]
+    assert [i["failed"] for i in infos] == [False, True, True, False]
+    for order in ([0, 1, 2, 3], [1, 0, 2, 3]):
+        vec = gym.make_vec("wrist_env/Idealized-P1-v0", num_envs=4, vectorization_mode="vector_entry_point")
+        vec.reset(seed=0)
+        _, rewards, _, _, vinfo = vec.step(actions[order])
+        for k, i in enumerate(order):
+            for key in ("error_p75", "rmse", "cost_terms"):
+                for bone, dofs in infos[i][key].items():
+                    for dof, value in dofs.items():
+                        assert value is not None and np.isfinite(value), (key, bone, dof, value)
+                        got = vinfo[key][bone][dof][k]
+                        assert np.asarray(vinfo[key][bone][dof]).dtype == np.float64 and got == value, (key, got, value)

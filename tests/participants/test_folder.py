@@ -204,6 +204,37 @@ def test_missing_bone_file(folder):
         load_participant_folder(folder)
 
 
+def _outside(tmp_path):
+    secret = tmp_path / "outside" / "secret.stl"
+    secret.parent.mkdir()
+    secret.write_text("SECRET-CONTENT")
+    return secret
+
+
+@pytest.mark.parametrize("how", ["dotdot", "absolute", "symlink", "proc"])
+def test_listed_files_must_stay_inside_the_folder(folder, tmp_path, how):
+    """A bone or trial path that leaves the folder (`..`, absolute, a link out, /proc) is refused
+    before it is read: the message names participant.toml and never carries the file's content."""
+    secret = _outside(tmp_path)
+    entry = {"dotdot": "../outside/secret.stl", "absolute": str(secret), "symlink": "bones/link.stl",
+             "proc": "../../../../../../../../proc/self/environ"}[how]
+    if how == "symlink":
+        (folder / "bones" / "link.stl").symlink_to(secret)
+    key = '"trials/unresisted.csv"' if how == "proc" else '"bones/lunate.stl"'
+    edit_toml(folder, key, '"' + entry + '"')
+    with pytest.raises(ParticipantError) as err:
+        load_participant_folder(folder)
+    message = str(err.value)
+    assert str(folder / "participant.toml") in message and ("outside" in message or "relative" in message), message
+    assert "SECRET" not in message and "PATH=" not in message
+
+
+def test_a_link_inside_the_folder_is_fine(folder):
+    (folder / "bones" / "lunate.stl").rename(folder / "bones" / "real_lunate.stl")
+    (folder / "bones" / "lunate.stl").symlink_to(folder / "bones" / "real_lunate.stl")
+    assert "lunate" in load_participant_folder(folder).bones
+
+
 def test_unreadable_mesh_file(folder):
     (folder / "bones" / "lunate.ply").write_bytes(b"\x00\x01 not a mesh\n")
     edit_toml(folder, '"bones/lunate.stl"', '"bones/lunate.ply"')

@@ -109,9 +109,12 @@ def outputs(result: Result, report=None) -> dict:
         r = report.to_dict()
         info["cost"] = r["total"]
         info["failed"] = info["failed"] or r["failed"]
-        info["error_p75"] = r["error_p75"]
-        info["rmse"] = r["rmse"]
-        info["cost_terms"] = r["terms"]
+        def zero_none(per_bone):  # a failed run's undefined errors are 0, as its arrays are
+            return {b: {dof: 0.0 if v is None else v for dof, v in dofs.items()} for b, dofs in per_bone.items()}
+
+        info["error_p75"] = zero_none(r["error_p75"])
+        info["rmse"] = zero_none(r["rmse"])
+        info["cost_terms"] = zero_none(r["terms"])
     return info
 
 

@@ -274,10 +274,17 @@ def _check_table(config: dict, key: str, toml_path: Path) -> dict:
 
 
 def _listed_file(folder: Path, relative, where: str, toml_path: Path) -> Path:
-    """The file a participant.toml entry names, relative to the folder; ParticipantError if absent."""
+    """The file a participant.toml entry names, relative to the folder and inside it once links are
+    resolved; ParticipantError if absent or outside (its content is never read then)."""
     if not isinstance(relative, str):
         raise ParticipantError(f"{toml_path}: {where} must be a path string, but got {relative!r}.")
+    if Path(relative).is_absolute():
+        raise ParticipantError(f"{toml_path}: {where} = {relative!r} must be relative to the participant folder.")
     file = folder / relative
+    root = folder.resolve()
+    if not file.resolve().is_relative_to(root):
+        raise ParticipantError(f"{toml_path}: {where} = {relative!r} resolves outside the participant folder "
+                               f"{root} (through '..' or a link); refused, not read.")
     if not file.is_file():
         raise ParticipantError(f"{toml_path}: {where} = {relative!r}, but {file} does not exist.")
     return file
