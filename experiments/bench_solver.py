@@ -12,8 +12,8 @@ Prints, for P1 (or the participant named on the command line):
   pose, plus the amortized active-set rebuild), over the time of a full step;
 - the ratio to the preprint's 45 s per Abaqus simulation.
 
-Run: `python experiments/bench_solver.py [P1] [--distal-row] [--fossa-sweep F D] [--load N]`
-(the flags pick an anatomy variant and the idealized load, as for `wrist-bench validate`).
+Run: `python experiments/bench_solver.py [P1] [--fossa-sweep F D] [--no-distal-row] [--no-fixed-ligaments]
+[--load N]` (the flags pick an anatomy variant and the idealized load, as for `wrist-bench validate`).
 Timings are medians of repeated runs on a shared machine; expect ±10 %.
 """
 

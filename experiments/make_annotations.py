@@ -4,8 +4,8 @@ Each ligament site is placed on the template bones (RCS: x volar, y proximal,
 z radial) by an anatomical rule quoted from the descriptions the preprint
 cites (Table 2): Berger 2001 (SLIL regions, RSC, LRL), Nagao 2005 (SRL, DRC,
 UL), Mizuseki 1989 (DRC), Ringler 2013 (RCL), Apergis 2013 (SCL), Moritomo
-2013 (UCL); Berger 2001 and Garcia-Elias 2017 for the fixed TC and TH. A rule picks the extreme vertex of a bone region along an
-anatomical direction; the patch is the bone surface within `radius_mm` of it.
+2013 (UCL); Berger 2001 and Garcia-Elias 2017 for the fixed TC and TH. A rule
+picks the extreme vertex of a bone region along an anatomical direction; the patch is the bone surface within `radius_mm` of it.
 Cartilage coverage is the part of each bone facing its partner within a gap.
 
 The output is plain data, reviewed in `experiments/figures/template_annotations.png`

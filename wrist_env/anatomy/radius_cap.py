@@ -9,7 +9,7 @@ flexion–extension and of radial–ulnar deviation (no sweep: the moulded fossa
 of builder version 1). Turned about its own centre, each bone rolls and
 slides in its fossa while the row as a whole is held (swept instead about the
 wrist's centre in the capitate head, the row could turn with the capitate at
-no cost: it lagged the capitate by up to 25° in a sweep and returned only
+no cost: in an experiment (issue 10) it lagged the capitate by up to 25° and returned only
 past neutral, where a real wrist shows no such hysteresis).
 A fossa moulded to the neutral pose alone locks the row (turning the lunate
 5° in place overlapped it by 0.18 mm); the swept envelope is the surface the

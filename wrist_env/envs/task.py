@@ -109,13 +109,15 @@ def outputs(result: Result, report=None) -> dict:
         r = report.to_dict()
         info["cost"] = r["total"]
         info["failed"] = info["failed"] or r["failed"]
-        def zero_none(per_bone):  # a failed run's undefined errors are 0, as its arrays are
-            return {b: {dof: 0.0 if v is None else v for dof, v in dofs.items()} for b, dofs in per_bone.items()}
-
-        info["error_p75"] = zero_none(r["error_p75"])
-        info["rmse"] = zero_none(r["rmse"])
-        info["cost_terms"] = zero_none(r["terms"])
+        info["error_p75"] = _zero_undefined(r["error_p75"])
+        info["rmse"] = _zero_undefined(r["rmse"])
+        info["cost_terms"] = _zero_undefined(r["terms"])
     return info
+
+
+def _zero_undefined(per_bone: dict) -> dict:
+    """{bone: {DOF: value}} with a failed run's undefined (None) values as 0, as its arrays are."""
+    return {b: {dof: 0.0 if v is None else v for dof, v in dofs.items()} for b, dofs in per_bone.items()}
 
 
 @functools.lru_cache(maxsize=32)
