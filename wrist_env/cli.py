@@ -332,7 +332,7 @@ def _montecarlo(args) -> int:
         raise ParticipantError(f"unknown participants {unknown}; known: {list(registry.participants())}")
     config = StudyConfig(tuple(args.participants), args.n, args.seed, args.tear_probability)
     where = (f"the dask scheduler {args.scheduler}" if args.scheduler else
-             f"{args.workers} local worker processes" if args.workers else "this process (Numba threads on every core)")
+             f"{args.workers} local worker processes" if args.workers > 1 else "this process (Numba threads on every core)")
     print(f"Monte Carlo: {', '.join(config.participants)}, {config.n:,} successful runs each, seed {config.seed}, "
           f"batch {args.batch}, on {where}; run log {args.out}", flush=True)
     summary = run_study(config, args.out, batch=args.batch, scheduler=args.scheduler, workers=args.workers,
@@ -503,7 +503,8 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("--scheduler", help="dask.distributed scheduler address (e.g. tcp://host:8786); one task per batch")
     s.add_argument("--batch", type=int, default=64, help="runs per batch: one vector-env step, one log part (default 64)")
     s.add_argument("--workers", type=int, default=0,
-                   help="local worker processes (default 0: this process, Numba threads on every core)")
+                   help="local worker processes, which die with this one (default 0, or 1: this process, "
+                        "Numba threads on every core)")
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
     s.add_argument("--folder", action="append", help="register this participant folder (in every worker)")
     s.set_defaults(run=_montecarlo)

@@ -13,6 +13,8 @@ import dataclasses
 import hashlib
 import json
 import os
+import time
+import uuid
 import zipfile
 from pathlib import Path
 
@@ -34,13 +36,17 @@ def save_dataclass(obj, path) -> None:
         else:
             meta[f.name] = value
     path.parent.mkdir(parents=True, exist_ok=True)
-    npz, tmp = path.with_suffix(".npz"), path.with_name(f".{path.name}.{os.getpid()}.tmp.npz")
-    np.savez_compressed(tmp, **arrays)
-    digest = _sha256(tmp)
-    _fsync(tmp)
-    os.replace(tmp, npz)
-    header = {"class": type(obj).__name__, "format": FORMAT_VERSION, "npz_sha256": digest, "fields": meta}
-    _write_atomic(path.with_suffix(".json"), json.dumps(header, indent=1, default=_jsonable))
+    digest = {}
+
+    def write_npz(tmp: Path) -> None:
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, **arrays)
+        digest["sha256"] = _sha256(tmp)
+
+    atomic_write(path.with_suffix(".npz"), write_npz)
+    header = {"class": type(obj).__name__, "format": FORMAT_VERSION, "npz_sha256": digest["sha256"], "fields": meta}
+    text = json.dumps(header, indent=1, default=_jsonable)
+    atomic_write(path.with_suffix(".json"), lambda p: Path(p).write_text(text))
 
 
 def load_dataclass(cls, path):
@@ -91,13 +97,69 @@ def _fsync(path: Path) -> None:
         os.fsync(fh.fileno())
 
 
-def _write_atomic(path: Path, text: str) -> None:
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    with open(tmp, "w") as fh:
-        fh.write(text)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+def _fsync_dir(folder: Path) -> None:
+    """Make a rename in `folder` durable (a no-op where directories cannot be opened)."""
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def atomic_write(path, write) -> Path:
+    """Write a file whole or not at all: `write(tmp_path)` to a hidden name in the same folder,
+    fsync, `os.replace` onto `path`, fsync the folder. A reader, or a writer killed midway, never
+    sees half a file; a killed writer leaves at most a `.<name>.<hex>.tmp` (`clean_temporary`)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
+    try:
+        write(tmp)
+        _fsync(tmp)
+        os.replace(tmp, path)
+        _fsync_dir(path.parent)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return path
+
+
+def clean_temporary(folder, min_age_s: float = 0.0) -> int:
+    """Remove the temporary files killed `atomic_write`s left in `folder` (those at least `min_age_s`
+    old: a live writer's file is younger); returns how many."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        return 0
+    now, removed = time.time(), 0
+    for p in folder.glob(".*.tmp"):
+        try:
+            if now - p.stat().st_mtime >= min_age_s:
+                p.unlink()
+                removed += 1
+        except FileNotFoundError:
+            pass
+    return removed
+
+
+def write_json(path, data) -> Path:
+    """Strict JSON (no NaN; sorted keys), atomically (`atomic_write`)."""
+    text = json.dumps(data, indent=1, allow_nan=False, sort_keys=True, default=_jsonable) + "\n"
+    return atomic_write(path, lambda p: Path(p).write_text(text))
+
+
+def read_json(path, what: str = "file", advice: str = "") -> dict | list:
+    """The JSON in `path`; `StoreError` naming the file (and `advice`) if it is missing, truncated or garbage."""
+    path = Path(path)
+    try:
+        return json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise StoreError(f"{path}: this {what} cannot be read as JSON ({type(e).__name__}: {e})"
+                         + (f"; {advice}" if advice else "")) from None
 
 
 def _jsonable(value):

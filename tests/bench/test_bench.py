@@ -2,6 +2,7 @@
 
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -18,6 +19,7 @@ from wrist_env.bench.calibrate import accepts_storage
 from wrist_env.bench.leaderboard import write_leaderboard
 from wrist_env.bench.log import KEY_FIELDS
 from wrist_env.cli import main
+from wrist_env.errors import StoreError
 
 REPO = Path(wrist_env.__file__).resolve().parent.parent
 TINY = ["random", "lhs"] if "lhs" in optimizers.available() else ["random"]
@@ -167,3 +169,97 @@ def test_only_optuna_calibrators_take_a_storage():
     for name in ("optuna-tpe", "optuna-cmaes"):
         if name in optimizers.available():
             assert accepts_storage(optimizers.get(name))
+
+
+@pytest.fixture(scope="module")
+def finished(p1, tmp_path_factory):
+    """A finished tiny benchmark (random, 2 seeds, budget 12, batches of 4 by default) and its leaderboard CSVs."""
+    out = tmp_path_factory.mktemp("finished")
+    assert not benchmark([p1], ["random"], 2, 12, out / "runs", workers=1, progress=False).failed
+    write_leaderboard(out / "runs", out / "lb")
+    return out
+
+
+def _copy_runs(finished, tmp_path) -> Path:
+    import shutil
+
+    shutil.copytree(finished / "runs", tmp_path / "runs")
+    return tmp_path / "runs"
+
+
+def test_a_finished_cell_without_its_evaluations_is_an_error_then_rerun(p1, finished, tmp_path):
+    from wrist_env.bench.log import IncompleteCellError
+
+    runs = _copy_runs(finished, tmp_path)
+    evals = sorted((runs / "evals").glob("cell-*seed0*.parquet"))
+    assert len(evals) == 1
+    evals[0].unlink()
+    with pytest.raises(IncompleteCellError, match=r"seed0.*\.json.*12 evaluations, but 0 are logged.*rerun"):
+        write_leaderboard(runs, tmp_path / "lb")
+    with pytest.warns(UserWarning, match="seed0.*runs again"):
+        report = benchmark([p1], ["random"], 2, 12, runs, workers=1, progress=False)
+    assert [k.seed for k in report.ran] == [0] and [k.seed for k in report.skipped] == [1]
+    write_leaderboard(runs, tmp_path / "lb")
+    assert _csvs(tmp_path / "lb") == _csvs(finished / "lb")
+
+
+@pytest.mark.parametrize("damage", ["truncated", "empty", "garbage"])
+def test_a_damaged_evaluation_file_is_named_then_resimulated(p1, finished, tmp_path, damage):
+    runs = _copy_runs(finished, tmp_path)
+    path = sorted((runs / "evals").glob("cell-*seed1*.parquet"))[0]
+    data = path.read_bytes()
+    path.write_bytes({"truncated": data[:len(data) // 2], "empty": b"", "garbage": b"garbage" * 50}[damage])
+    with pytest.raises(StoreError, match=re.escape(path.name) + ".*damaged Parquet.*rerun the benchmark"):
+        write_leaderboard(runs, tmp_path / "lb")
+    with pytest.warns(UserWarning, match=re.escape(path.name)):
+        report = benchmark([p1], ["random"], 2, 12, runs, workers=1, progress=False)
+    assert [k.seed for k in report.ran] == [1] and (runs / "damaged" / path.name).is_file()
+    write_leaderboard(runs, tmp_path / "lb")
+    assert _csvs(tmp_path / "lb") == _csvs(finished / "lb")
+
+
+def test_a_damaged_part_of_an_unfinished_cell_drops_it_and_what_follows(p1, tmp_path):
+    class Stop(Exception):
+        pass
+
+    def stop_after_six(n_new, nfev):
+        if nfev == 6:
+            raise Stop
+
+    key, log = RunKey(p1, "nelder-mead", 0, 12), RunLog(tmp_path / "runs")
+    with pytest.raises(Stop):  # one evaluation per batch: batches 0 … 5 logged
+        calibrate(p1, "nelder-mead", 12, 0, log=log, callback=stop_after_six)
+    assert log.logged_range(key) == 6
+    sorted((tmp_path / "runs" / "evals").glob("part-*b00002*.parquet"))[0].write_bytes(b"")
+    with pytest.warns(UserWarning, match="b00002"):
+        assert log.repair() == 4  # the damaged batch and the three after it
+    assert log.logged_range(key) == 2 and len(list((tmp_path / "runs" / "damaged").iterdir())) == 4
+    report = benchmark([p1], ["nelder-mead"], [0], 12, tmp_path / "runs", workers=1, progress=False)
+    assert report.ran == [key] and log.summary(key)["replayed"] == 2
+    reference = benchmark([p1], ["nelder-mead"], [0], 12, tmp_path / "reference", workers=1, progress=False)
+    assert not reference.failed
+    assert log.read_cell(key).cost.tolist() == RunLog(tmp_path / "reference").read_cell(key).cost.tolist()
+
+
+def test_a_truncated_cell_summary_is_named_then_rerun_by_replay(p1, finished, tmp_path):
+    runs = _copy_runs(finished, tmp_path)
+    path = sorted((runs / "cells").glob("*seed0*.json"))[0]
+    path.write_text(path.read_text()[:40])
+    with pytest.raises(StoreError, match=re.escape(str(path)) + ".*cannot be read as JSON"):
+        write_leaderboard(runs, tmp_path / "lb")
+    with pytest.warns(UserWarning, match="damaged cell summary"):
+        report = benchmark([p1], ["random"], 2, 12, runs, workers=1, progress=False)
+    assert [k.seed for k in report.ran] == [0] and RunLog(runs).summary(report.ran[0])["replayed"] == 12
+
+
+def test_two_benchmarks_on_one_folder_at_once_log_every_evaluation_once(p1, tmp_path):
+    args = ["--participants", p1, "--optimizers", "random", "--seeds", "3", "--budget", "24", "--out",
+            str(tmp_path / "runs"), "--workers", "1", "--no-progress"]
+    env = dict(os.environ, PYTHONPATH=str(REPO))
+    procs = [subprocess.Popen([sys.executable, "-m", "wrist_env.cli", "benchmark", *args], env=env,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.PIPE) for _ in range(2)]
+    for proc in procs:
+        assert proc.wait(timeout=600) == 0, proc.stderr.read().decode()[-2000:]
+    log = RunLog(tmp_path / "runs")
+    rows = log.read(dedupe=False)
+    assert len(rows) == 3 * 24 and _duplicates(rows) == 0 and len(log.summaries()) == 3

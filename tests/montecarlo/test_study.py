@@ -1,6 +1,8 @@
 """The Monte Carlo study on the solver: the same log twice, on a LocalCluster, after a kill; exclusions; report."""
 
 import os
+import re
+import shutil
 import signal
 import subprocess
 import sys
@@ -11,8 +13,9 @@ import pyarrow as pa
 import pytest
 
 from wrist_env.design import NAMES
+from wrist_env.errors import StoreError
 from wrist_env.montecarlo import StudyConfig, StudyError, read_runs, run_study
-from wrist_env.montecarlo.log import PartExistsError, PartLog
+from wrist_env.runs import StoreBusyError
 from wrist_env.montecarlo.sampler import FRAME_COLUMNS, SCHEMA, TEAR_COLUMNS
 
 CONFIG = StudyConfig(("P1",), n=40, seed=3)
@@ -94,6 +97,67 @@ def test_killed_study_resumes_with_no_run_lost_or_repeated(reference, tmp_path):
     assert read_runs(tmp_path).equals(reference[1])
 
 
+def _start_cli_study(out, batch=2, workers=0):
+    cmd = [sys.executable, "-m", "wrist_env.cli", "montecarlo", "P1", "--n", "40", "--seed", "3", "--batch",
+           str(batch), "--workers", str(workers), "--out", str(out), "--no-progress"]
+    return subprocess.Popen(cmd, env=dict(os.environ), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+
+
+def _wait_for_parts(proc, out, n: int, seconds: float = 120) -> None:
+    runs, deadline = out / "runs", time.monotonic() + seconds
+    while time.monotonic() < deadline and proc.poll() is None:
+        if runs.is_dir() and len(list(runs.glob("*.parquet"))) >= n:
+            return
+        time.sleep(0.01)
+    assert proc.poll() is None, f"the study ended too soon: {proc.stderr.read().decode()[-2000:]}"
+
+
+def test_a_second_run_on_the_same_folder_is_refused_while_one_runs(reference, tmp_path):
+    proc = _start_cli_study(tmp_path)
+    try:
+        _wait_for_parts(proc, tmp_path, 1)
+        with pytest.raises(StoreBusyError, match=r"pid \d+.*Monte Carlo"):
+            run_study(CONFIG, tmp_path, batch=7)
+        assert proc.wait(timeout=300) == 0, proc.stderr.read().decode()[-2000:]
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert read_runs(tmp_path).equals(reference[1])  # nothing duplicated by the refused run
+    assert run_study(CONFIG, tmp_path, batch=7).simulated == 0  # the lock is free once the first run ended
+
+
+@pytest.mark.parametrize("damage", ["truncated", "empty", "garbage"])
+def test_a_damaged_part_is_named_then_resimulated(reference, tmp_path, damage):
+    shutil.copytree(reference[0], tmp_path, dirs_exist_ok=True)
+    part = sorted((tmp_path / "runs").glob("*.parquet"))[2]
+    data = part.read_bytes()
+    part.write_bytes({"truncated": data[:len(data) // 2], "empty": b"", "garbage": b"not parquet" * 10}[damage])
+    with pytest.raises(StoreError, match=re.escape(part.name) + ".*rerun the montecarlo command"):
+        read_runs(tmp_path)
+    with pytest.warns(UserWarning, match=re.escape(part.name)):
+        summary = run_study(CONFIG, tmp_path, batch=5)
+    assert summary.done and 0 < summary.simulated <= 5
+    assert read_runs(tmp_path).equals(reference[1])
+    assert (tmp_path / "damaged" / part.name).is_file()  # kept for inspection
+
+
+def test_killing_the_parent_kills_its_workers(reference, tmp_path):
+    import psutil
+
+    proc = _start_cli_study(tmp_path, batch=2, workers=2)
+    try:
+        _wait_for_parts(proc, tmp_path, 1)
+        children = psutil.Process(proc.pid).children(recursive=True)
+        assert len([c for c in children if "spawn" in " ".join(c.cmdline())]) >= 2
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait(timeout=30)
+        _, alive = psutil.wait_procs(children, timeout=20)
+        assert not alive, f"workers outlived their parent: {[c.pid for c in alive]}"
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+
+
 def test_excluded_runs_are_flagged_counted_and_replaced(built, tmp_path):
     config = StudyConfig(("P1",), n=8, seed=3, exclude_above_mpa=3.0)
     summary = run_study(config, tmp_path, batch=4)
@@ -111,18 +175,6 @@ def test_another_study_in_the_same_folder_is_refused(reference):
     out, _ = reference
     with pytest.raises(StudyError, match="seed"):
         run_study(StudyConfig(("P1",), n=40, seed=4), out)
-
-
-def test_part_log_writes_once_and_atomically(tmp_path):
-    log = PartLog(tmp_path / "parts")
-    assert log.read() is None
-    t = pa.table({"x": [1, 2]})
-    log.write("a-1", t)
-    with pytest.raises(PartExistsError):
-        log.write("a-1", t)
-    (tmp_path / "parts" / ".a-2.parquet.dead.tmp").write_bytes(b"half a file")
-    assert log.names() == ["a-1"] and log.read().equals(t)
-    assert log.clean() == 1
 
 
 def test_report_writes_tables_and_figures(reference, tmp_path):

@@ -7,10 +7,11 @@ Layout of a run directory (`RunLog(root)`)::
     root/cells/<cell>.json                                 a finished cell's summary (calibrated design,
                                                            held-out cost, parameter recovery)
     root/locks/<cell>.lock                                 held (flock) while a process runs the cell
+    root/damaged/                                          damaged or orphaned files moved aside by `repair`
 
-Every file is written to a temporary name in the same folder and moved into
-place with `os.replace`, so a reader (or a killed writer) never sees half a
-file. A row is one evaluation: the run key (participant, optimizer, seed,
+It is a `wrist_env.runs.store.RunStore` (parts in `evals/`, records in
+`cells/`): every file is written whole or not at all (temporary name, fsync,
+`os.replace`), and a damaged file is a `StoreError` naming it. A row is one evaluation: the run key (participant, optimizer, seed,
 budget), its index in the run (`eval`, 0-based, the optimizer's order) and
 batch (`batch`), the 22 normalized material variables (`x.<name>`), the
 kinematic cost on the calibration trial, `failed`, and the RMSE of the 12
@@ -24,13 +25,9 @@ removing its batch files, which the next compaction repairs).
 
 from __future__ import annotations
 
-import fcntl
-import json
 import os
 import re
 import time
-import uuid
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -40,7 +37,10 @@ import pyarrow.parquet as pq
 
 from wrist_env.cost import COST_BONES
 from wrist_env.design import N_MATERIAL, NAMES
+from wrist_env.errors import StoreError
 from wrist_env.frames import DOF_NAMES
+from wrist_env.io import atomic_write
+from wrist_env.runs.store import RunStore, read_parquet
 
 KEY_FIELDS = ("participant", "optimizer", "seed", "budget")
 X_COLUMNS = tuple(f"x.{n}" for n in NAMES[:N_MATERIAL])
@@ -81,19 +81,11 @@ class RunKey:
         return {"participant": self.participant, "optimizer": self.optimizer, "seed": self.seed, "budget": self.budget}
 
 
-def _atomic_write(path: Path, write) -> None:
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
+class IncompleteCellError(StoreError):
+    """A cell whose summary says it finished, but whose evaluations are not all in the log."""
 
 
-def write_json_atomic(path: Path, data) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    _atomic_write(path, lambda p: p.write_text(json.dumps(data, indent=1, allow_nan=False)))
+RERUN = "rerun the benchmark command (same arguments) to redo it"
 
 
 class RunLog:
@@ -101,9 +93,10 @@ class RunLog:
 
     def __init__(self, root):
         self.root = Path(root)
-        self.evals_dir = self.root / "evals"
-        self.cells_dir = self.root / "cells"
-        self.locks_dir = self.root / "locks"
+        self.store = RunStore(self.root, parts="evals", records="cells")
+        self.evals_dir = self.store.parts_dir
+        self.cells_dir = self.store.records_dir
+        self.locks_dir = self.store.locks_dir
 
     # writing
 
@@ -119,7 +112,6 @@ class RunLog:
         rmse = np.asarray(rmse, dtype=np.float64).reshape(k, len(RMSE_COLUMNS))
         if x.shape[1] != len(X_COLUMNS):
             raise ValueError(f"x must have {len(X_COLUMNS)} columns, but got {x.shape}")
-        self.evals_dir.mkdir(parents=True, exist_ok=True)
         logged = self.logged_range(key)
         if start != logged:
             raise DuplicateEvaluationError(
@@ -139,9 +131,7 @@ class RunLog:
         columns["failed"] = failed
         columns.update({c: rmse[:, i] for i, c in enumerate(RMSE_COLUMNS)})
         table = pa.Table.from_pydict(columns, schema=SCHEMA)
-        path = self.evals_dir / f"part-{key.name}-b{batch:05d}-e{start:06d}-{start + k:06d}.parquet"
-        _atomic_write(path, lambda p: pq.write_table(table, p))
-        return path
+        return self.store.write_part(f"part-{key.name}-b{batch:05d}-e{start:06d}-{start + k:06d}", table)
 
     def compact(self, key: RunKey) -> Path | None:
         """Merge a cell's batch files into one file (then remove them); the rows are unchanged."""
@@ -150,27 +140,56 @@ class RunLog:
             return None
         path = self.evals_dir / f"cell-{key.name}-n{len(frame):06d}.parquet"
         table = pa.Table.from_pandas(frame, schema=SCHEMA, preserve_index=False)
-        _atomic_write(path, lambda p: pq.write_table(table, p))
+        atomic_write(path, lambda p: pq.write_table(table, p))
         for p in self._files(key):
             if p != path:
                 p.unlink(missing_ok=True)
         return path
 
     def write_summary(self, key: RunKey, summary: dict) -> Path:
-        path = self.cells_dir / f"{key.name}.json"
-        write_json_atomic(path, summary)
-        return path
+        return self.store.write_record(key.name, summary)
 
-    @contextmanager
     def lock(self, key: RunKey):
         """Hold the cell's lock (an flock, released when the process dies) while running it."""
-        self.locks_dir.mkdir(parents=True, exist_ok=True)
-        with open(self.locks_dir / f"{key.name}.lock", "a+") as handle:
-            fcntl.flock(handle, fcntl.LOCK_EX)
+        return self.store.lock(key.name, what=f"cell {key.name}")
+
+    # repairing
+
+    def repair(self) -> int:
+        """Make the log consistent before a run: remove temporary files; move to `damaged/` every
+        unreadable Parquet file (with the later batches of its cell, so the cell resumes from the
+        gap), every unreadable summary and every summary whose evaluations are not all logged (those
+        cells run again, by replay where their evaluations are logged). Returns the files moved."""
+        self.store.clean()
+        moved = 0
+        by_cell: dict[str, list[tuple[int, Path]]] = {}
+        for p in self._files():
+            m = _PART.match(p.name) or _CELL.match(p.name)
+            by_cell.setdefault(m["cell"], []).append((int(m["start"]) if "start" in m.groupdict() else 0, p))
+        for name, damaged in self.store.damaged_parts(SCHEMA):
+            path = self.store.part_path(name)
+            m = _PART.match(path.name) or _CELL.match(path.name)
+            if m is None:
+                continue
+            first = int(m["start"]) if "start" in m.groupdict() else 0
+            for start, p in sorted(by_cell.get(m["cell"], [])):
+                if p == path or start >= first:
+                    moved += self.store.quarantine(
+                        p, "damaged Parquet file, its evaluations are re-simulated" if p == path
+                        else f"follows the damaged {path.name} in its cell, re-simulated") is not None
+        for name in self.store.record_names():
+            path = self.store.record_path(name)
             try:
-                yield
-            finally:
-                fcntl.flock(handle, fcntl.LOCK_UN)
+                summary = self.store.read_record(name)
+                n = int(summary["nfev"])
+            except (StoreError, KeyError, TypeError, ValueError):
+                moved += self.store.quarantine(path, "damaged cell summary, the cell runs again (by replay)") is not None
+                continue
+            logged = self.progress().get(name, 0)
+            if logged < n:
+                moved += self.store.quarantine(path, f"the cell's summary counts {n} evaluations, but {logged} are "
+                                                     f"logged; the cell runs again") is not None
+        return moved
 
     # reading
 
@@ -185,6 +204,9 @@ class RunLog:
                 out.append(p)
         return out
 
+    def _table(self, files) -> pa.Table:
+        return pa.concat_tables([read_parquet(p, SCHEMA, advice=RERUN) for p in files])
+
     def read(self, *, dedupe: bool = True):
         """Every logged evaluation as a pandas DataFrame (sorted by run key and eval), duplicates dropped."""
         import pandas as pd
@@ -192,7 +214,7 @@ class RunLog:
         files = self._files()
         if not files:
             return pd.DataFrame({f.name: pd.Series(dtype=f.type.to_pandas_dtype()) for f in SCHEMA})
-        frame = pa.concat_tables([pq.read_table(p, schema=SCHEMA) for p in files]).to_pandas()
+        frame = self._table(files).to_pandas()
         if dedupe:
             frame = frame.drop_duplicates(subset=list(KEY_FIELDS) + ["eval"], keep="first")
         return frame.sort_values(list(KEY_FIELDS) + ["eval"], kind="stable").reset_index(drop=True)
@@ -202,13 +224,14 @@ class RunLog:
         files = self._files(key)
         if not files:
             return None
-        frame = pa.concat_tables([pq.read_table(p, schema=SCHEMA) for p in files]).to_pandas()
+        frame = self._table(files).to_pandas()
         frame = frame[(frame.participant == key.participant) & (frame.optimizer == key.optimizer)
                       & (frame.seed == key.seed) & (frame.budget == key.budget)]
         frame = frame.drop_duplicates(subset=["eval"], keep="first").sort_values("eval", kind="stable")
         frame = frame.reset_index(drop=True)
         if not np.array_equal(frame["eval"].to_numpy(), np.arange(len(frame))):
-            raise RuntimeError(f"{key.name}: the logged evaluations are not 0 … n−1: {frame['eval'].tolist()}")
+            raise StoreError(f"{self.evals_dir}: the logged evaluations of {key.name} are not 0 … n−1 "
+                             f"({frame['eval'].tolist()[:20]}…); {RERUN}")
         return frame
 
     def logged_range(self, key: RunKey) -> int:
@@ -232,11 +255,26 @@ class RunLog:
         return out
 
     def summary(self, key: RunKey) -> dict | None:
-        path = self.cells_dir / f"{key.name}.json"
-        return json.loads(path.read_text()) if path.is_file() else None
+        """The summary of a finished cell, or None if the cell has not finished.
+
+        `IncompleteCellError` if the summary counts more evaluations than are logged; `StoreError` if
+        it is damaged (both name the file; a rerun of the benchmark repairs them)."""
+        return self._finished(key.name, self.progress())
+
+    def _finished(self, name: str, progress: dict) -> dict | None:
+        summary = self.store.read_record(name, advice=RERUN)
+        if summary is None:
+            return None
+        n = summary.get("nfev") if isinstance(summary, dict) else None
+        if not isinstance(n, int):
+            raise StoreError(f"{self.store.record_path(name)}: not a cell summary (no evaluation count); {RERUN}")
+        if progress.get(name, 0) < n:
+            raise IncompleteCellError(
+                f"{self.store.record_path(name)}: the cell finished with {n} evaluations, but "
+                f"{progress.get(name, 0)} are logged in {self.evals_dir}; {RERUN}")
+        return summary
 
     def summaries(self) -> list[dict]:
-        """The summaries of every finished cell."""
-        if not self.cells_dir.is_dir():
-            return []
-        return [json.loads(p.read_text()) for p in sorted(self.cells_dir.glob("*.json"))]
+        """The summaries of every finished cell (errors as `summary`)."""
+        progress = self.progress()
+        return [self._finished(name, progress) for name in self.store.record_names()]

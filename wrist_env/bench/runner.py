@@ -18,16 +18,12 @@ from __future__ import annotations
 
 import itertools
 import os
-import sys
 import time
-import traceback
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from wrist_env.bench.log import RunKey, RunLog
-
-POLL_SECONDS = 0.5
-
+from wrist_env.runs.executor import describe, executor, set_threads
 
 @dataclass
 class BenchmarkReport:
@@ -79,15 +75,6 @@ def cell_storage(storage: str | None, key: RunKey) -> str | None:
     return url
 
 
-def set_threads(threads: int | None) -> None:
-    """Limit Numba's parallel threads in this process (None: leave as is)."""
-    if threads is None:
-        return
-    import numba
-
-    numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
-
-
 def run_cell(key: RunKey, out_dir: str, storage: str | None = None, options: dict | None = None,
              threads: int | None = None, folders: tuple = (), callback=None) -> dict:
     """Run (or resume, or skip) one cell; returns {"status": "ran" | "skipped", "summary": {...}}.
@@ -111,21 +98,6 @@ def run_cell(key: RunKey, out_dir: str, storage: str | None = None, options: dic
                         storage=cell_storage(storage, key),
                         options=(options or {}).get(key.optimizer), callback=callback)
         return {"status": "ran", "summary": run.to_dict()}
-
-
-def _init_worker(threads: int | None, parent: int) -> None:
-    """Local worker process: die with the parent (a killed run leaves no process logging), set threads."""
-    if sys.platform.startswith("linux"):
-        import ctypes
-        import signal
-
-        try:
-            ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
-        except OSError:
-            pass
-    if os.getppid() != parent:
-        os._exit(1)
-    set_threads(threads)
 
 
 def benchmark(participants, optimizers, seeds, budget: int, out_dir, *, workers: int | None = None,
@@ -153,25 +125,31 @@ def benchmark(participants, optimizers, seeds, budget: int, out_dir, *, workers:
         storage = None
     _prepare_storage(cells, storage)
     log = RunLog(out_dir)
+    log.repair()
     done = {k for k in cells if log.summary(k) is not None}
     report = BenchmarkReport(out_dir, cells, skipped=[k for k in cells if k in done])
     todo = [k for k in cells if k not in done]
     cores = os.cpu_count() or 1
+    if scheduler is None:
+        workers = max(1, min(int(workers or cores), max(1, len(todo))))
+        threads = threads if threads is not None else max(1, cores // workers)
     total = sum(k.budget for k in cells)
     bar = _bar(progress, total, sum(min(log.progress().get(k.name, 0), k.budget) for k in cells), len(cells), len(done))
+    folders = tuple(str(f) for f in folders)
     try:
-        if scheduler is not None:
-            report.scheduler = scheduler if isinstance(scheduler, str) else str(scheduler)
-            _run_dask(todo, scheduler, out_dir, storage, options, tuple(str(f) for f in folders), report, bar, log)
-        else:
-            workers = max(1, min(int(workers or cores), max(1, len(todo))))
-            threads = threads if threads is not None else max(1, cores // workers)
-            report.workers, report.threads = workers, threads
-            if workers == 1:
-                _run_here(todo, out_dir, storage, options, threads, tuple(str(f) for f in folders), report, bar)
-            else:
-                _run_processes(todo, workers, threads, out_dir, storage, options, tuple(str(f) for f in folders),
-                               report, bar, log)
+        with executor(scheduler, workers, threads) as ex:
+            report.workers, report.threads, report.scheduler = ex.workers, ex.threads, ex.scheduler
+            handles = {}
+            for key in todo:
+                tick = _tick(bar) if ex.inline else None  # out of process, the bar follows the log
+                handles[ex.submit(run_cell, key, str(out_dir), storage, options, None, folders, callback=tick)] = key
+            for handle, out, error in ex.results(list(handles), on_poll=lambda: _update(bar, log, cells, report)):
+                key = handles[handle]
+                if error is not None:
+                    report.failed.append((key, describe(error)))
+                else:
+                    (report.skipped if out["status"] == "skipped" else report.ran).append(key)
+            _update(bar, log, cells, report)
     finally:
         if bar is not None:
             bar.close()
@@ -226,61 +204,8 @@ def _update(bar, log: RunLog, cells, report) -> None:
                         + (f", {len(report.failed)} failed" if report.failed else ""), refresh=False)
 
 
-def _collect(report: BenchmarkReport, key: RunKey, future) -> None:
-    try:
-        out = future.result()
-    except Exception as exc:  # noqa: BLE001  (a failed cell must not stop the others)
-        detail = "".join(traceback.format_exception_only(type(exc), exc)).strip()
-        report.failed.append((key, detail))
-        return
-    (report.skipped if out["status"] == "skipped" else report.ran).append(key)
-
-
-def _run_here(todo, out_dir, storage, options, threads, folders, report, bar) -> None:
-    for key in todo:
-        def tick(n_new, nfev):
-            if bar is not None and n_new:
-                bar.update(n_new)
-        try:
-            out = run_cell(key, out_dir, storage, options, threads, folders, callback=tick)
-        except Exception as exc:  # noqa: BLE001  (a failed cell must not stop the others)
-            report.failed.append((key, "".join(traceback.format_exception_only(type(exc), exc)).strip()))
-            continue
-        (report.skipped if out["status"] == "skipped" else report.ran).append(key)
-        if bar is not None:
-            bar.set_postfix_str(f"cells {len(report.ran) + len(report.skipped)}/{len(report.cells)}", refresh=False)
-
-
-def _run_processes(todo, workers, threads, out_dir, storage, options, folders, report, bar, log) -> None:
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
-
-    context = multiprocessing.get_context("spawn")  # no fork after Numba's threads started
-    with ProcessPoolExecutor(max_workers=workers, mp_context=context, initializer=_init_worker,
-                             initargs=(threads, os.getpid())) as pool:
-        futures = {pool.submit(run_cell, key, str(out_dir), storage, options, None, folders): key for key in todo}
-        _wait(futures, report, bar, log)
-
-
-def _run_dask(todo, scheduler, out_dir, storage, options, folders, report, bar, log) -> None:
-    from distributed import Client
-
-    client = Client(scheduler) if isinstance(scheduler, str) else scheduler
-    try:
-        futures = {client.submit(run_cell, key, str(out_dir), storage, options, None, folders, pure=False,
-                                 key=f"wrist-bench-{key.name}-{os.getpid()}-{time.time_ns()}"): key for key in todo}
-        _wait(futures, report, bar, log)
-    finally:
-        if isinstance(scheduler, str):
-            client.close()
-
-
-def _wait(futures: dict, report, bar, log) -> None:
-    pending = dict(futures)
-    while pending:
-        for future in [f for f in pending if f.done()]:
-            _collect(report, pending.pop(future), future)
-        _update(bar, log, report.cells, report)
-        if pending:
-            time.sleep(POLL_SECONDS)
-    _update(bar, log, report.cells, report)
+def _tick(bar):
+    def tick(n_new, nfev):
+        if bar is not None and n_new:
+            bar.update(n_new)
+    return tick

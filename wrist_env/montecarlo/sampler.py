@@ -108,16 +108,12 @@ def _frames(rows: np.ndarray, missing=None) -> pa.Array:
 
 
 def run_chunk(participant: str, sample_ids, blocks, actions, *, exclude_above_mpa: float = EXCLUDE_ABOVE_MPA,
-              folders=(), threads: int | None = None) -> pa.Table:
+              folders=()) -> pa.Table:
     """Simulate k runs (actions of shape (k, 27)) in one vector-env step; their log rows (`SCHEMA`).
 
     Runs wherever it is called: in this process, a local worker process or a dask worker
-    (`folders`: user participant folders to register there first; `threads`: Numba threads).
+    (`folders`: user participant folders to register there first).
     """
-    if threads:
-        import numba
-
-        numba.set_num_threads(min(int(threads), numba.config.NUMBA_NUM_THREADS))
     if folders:
         from wrist_env.participants import registry
 

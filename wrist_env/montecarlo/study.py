@@ -9,18 +9,21 @@ a pure function of (seed, participant, block, size) and every outcome of its
 draw, so the set of runs, and the log, do not depend on batch size, worker
 count, scheduler, or on being killed and resumed.
 
-Log: `<out>/runs/<participant>-<first id>-<end id>.parquet`, one part per
-chunk, written atomically by this process as the chunk finishes
-(`wrist_env.montecarlo.log.PartLog`; rows: `sampler.SCHEMA`), and
-`<out>/study.json` (participants, n, seed, tear probability, exclusion
-threshold). Rerunning the same command resumes: logged runs are read back,
-only missing sample ids are simulated. A different seed, n, tear probability
-or threshold in the same folder is refused.
+Log: a run store (`wrist_env.runs.store.RunStore`, the benchmark's too):
+`<out>/runs/<participant>-<first id>-<end id>.parquet`, one part per chunk,
+written atomically by this process as the chunk finishes (rows:
+`sampler.SCHEMA`), and `<out>/study.json` (participants, n, seed, tear
+probability, exclusion threshold). Rerunning the same command resumes: logged
+runs are read back, only missing sample ids are simulated; a damaged part is
+moved to `<out>/damaged/` and its runs simulated again. A different seed, n,
+tear probability or threshold in the same folder is refused, and so is a
+second run while one is writing to the folder (`<out>/locks/store.lock`).
 
-Where chunks run: in this process (`workers=0`: one batched call at a time,
-Numba's prange on every core — the default, measured fastest on this 2-core
-machine), in `workers` local processes (each with cores / workers Numba
-threads), or on a `dask.distributed` scheduler (`scheduler="tcp://…"`, or a
+Where chunks run (`wrist_env.runs.executor`, the benchmark's too): in this
+process (`workers` 0 or 1: one batched call at a time, Numba's prange on every
+core — the default, measured fastest on this 2-core machine), in `workers`
+local processes (each with cores / workers Numba threads; they die with this
+process), or on a `dask.distributed` scheduler (`scheduler="tcp://…"`, or a
 `distributed.Client`); workers only compute, this process writes the log.
 """
 
@@ -37,8 +40,11 @@ import pyarrow as pa
 
 from wrist_env import design
 from wrist_env.errors import WristEnvError
+from wrist_env.errors import StoreError
+from wrist_env.io import read_json, write_json
 from wrist_env.montecarlo import sampler
-from wrist_env.montecarlo.log import PartLog, write_json
+from wrist_env.runs.executor import executor
+from wrist_env.runs.store import RunStore
 
 MANIFEST = "study.json"
 RUNS = "runs"
@@ -130,14 +136,29 @@ class StudySummary:
 # ---------------------------------------------------------------------------- the log
 
 
-def runs_log(out) -> PartLog:
-    return PartLog(Path(out) / RUNS)
+RERUN = "rerun the montecarlo command (same arguments) to simulate its runs again"
+
+
+def runs_log(out) -> RunStore:
+    """The study's run store (parts in `<out>/runs`)."""
+    return RunStore(Path(out), parts=RUNS)
+
+
+def repair(out) -> int:
+    """Before a run: remove killed writers' temporary files and move damaged parts to `<out>/damaged/`
+    (their runs are then missing, and simulated again). Returns the parts moved."""
+    store = runs_log(out)
+    store.clean(min_age_s=0.0)  # the caller holds the store lock: no live writer
+    moved = 0
+    for name, _ in store.damaged_parts(sampler.SCHEMA):
+        moved += store.quarantine(store.part_path(name), "damaged Parquet part, its runs are simulated again") is not None
+    return moved
 
 
 def read_runs(out, columns=None) -> pa.Table | None:
     """Every logged run of the study in `out`, sorted by (participant, sample_id); None if empty.
-    StudyError if a run is logged twice."""
-    table = runs_log(out).read(schema=sampler.SCHEMA, columns=columns)
+    StudyError if a run is logged twice; StoreError naming a damaged part."""
+    table = runs_log(out).read_parts(schema=sampler.SCHEMA, columns=columns, advice=RERUN)
     if table is None:
         return None
     keys = ["participant", "sample_id"]
@@ -158,9 +179,7 @@ def _manifest(out: Path, config: StudyConfig) -> None:
     key = config.key()
     participants = list(config.participants)
     if path.is_file():
-        import json
-
-        old = json.loads(path.read_text())
+        old = read_json(path, "study manifest", "it records the study's settings: restore it, or use another --out")
         old_key = {k: old.get(k) for k in key}
         if old_key != key:
             diff = ", ".join(f"{k} {old_key[k]!r} (asked {key[k]!r})" for k in key if old_key[k] != key[k])
@@ -172,12 +191,10 @@ def _manifest(out: Path, config: StudyConfig) -> None:
 
 
 def read_manifest(out) -> dict:
-    import json
-
     path = Path(out) / MANIFEST
     if not path.is_file():
         raise StudyError(f"{out} holds no Monte Carlo study (no {MANIFEST})")
-    return json.loads(path.read_text())
+    return read_json(path, "study manifest", "it records the study's settings: restore it, or use another --out")
 
 
 # ---------------------------------------------------------------------------- rounds
@@ -237,77 +254,6 @@ def part_name(participant: str, ids: tuple[int, ...]) -> str:
     return f"{participant}-{ids[0]:07d}-{ids[-1] + 1:07d}"
 
 
-# ---------------------------------------------------------------------------- executors
-
-
-class _Inline:
-    """Chunks in this process, one at a time (each a batched prange call over every core)."""
-
-    def submit(self, fn, *args, **kwargs):
-        return (fn, args, kwargs)
-
-    def as_completed(self, tasks):
-        for fn, args, kwargs in tasks:
-            yield fn(*args, **kwargs)
-
-    def close(self):
-        pass
-
-
-class _Pool:
-    """Chunks on local worker processes (spawned; Numba threads split between them)."""
-
-    def __init__(self, workers: int):
-        import multiprocessing
-        from concurrent.futures import ProcessPoolExecutor
-
-        self.threads = max(1, (os.cpu_count() or 1) // workers)
-        self.pool = ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"))
-
-    def submit(self, fn, *args, **kwargs):
-        return self.pool.submit(fn, *args, threads=self.threads, **kwargs)
-
-    def as_completed(self, futures):
-        from concurrent.futures import as_completed
-
-        for f in as_completed(futures):
-            yield f.result()
-
-    def close(self):
-        self.pool.shutdown(cancel_futures=True)
-
-
-class _Dask:
-    """Chunks on a dask.distributed scheduler (an address or a Client)."""
-
-    def __init__(self, scheduler):
-        from distributed import Client
-
-        self.own = not isinstance(scheduler, Client)
-        self.client = Client(scheduler) if self.own else scheduler
-
-    def submit(self, fn, *args, **kwargs):
-        return self.client.submit(fn, *args, pure=False, **kwargs)
-
-    def as_completed(self, futures):
-        from distributed import as_completed
-
-        for f in as_completed(futures):
-            yield f.result()
-
-    def close(self):
-        if self.own:
-            self.client.close()
-
-
-def _executor(scheduler, workers: int):
-    if scheduler is not None:
-        return _Dask(scheduler)
-    if workers and workers > 0:
-        return _Pool(int(workers))
-    return _Inline()
-
-
 # ---------------------------------------------------------------------------- the study
 
 
@@ -316,26 +262,37 @@ def run_study(config: StudyConfig, out, *, batch: int = 64, scheduler=None, work
     """Run (or resume) a study into the folder `out`; returns the counts and the wall time.
 
     batch: runs per chunk (one vector-env step, one log part). scheduler: a dask.distributed
-    address or Client (default: local). workers: local worker processes (0: this process).
+    address or Client (default: local). workers: local worker processes (0 or 1: this process).
     folders: user participant folders (registered here and on every worker). progress: a tqdm
-    bar of successful runs (postfix: excluded and failed so far).
+    bar of successful runs (postfix: excluded and failed so far). A second run on the same `out`
+    while this one is running is refused (`StoreBusyError`).
     """
     if int(batch) < 1:
         raise StudyError(f"batch must be at least 1, but got {batch}")
-    start_time = time.perf_counter()
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    _manifest(out, config)
-    log = runs_log(out)
-    log.clean()
-    outcomes: dict[str, dict[int, tuple[bool, bool]]] = {p: {} for p in config.participants}
+    with runs_log(out).lock(wait=False, what=f"a Monte Carlo study in {out}"):
+        return _run_locked(config, out, int(batch), scheduler, workers, tuple(str(f) for f in folders), progress)
+
+
+def _logged_outcomes(out: Path, participants) -> dict[str, dict[int, tuple[bool, bool]]]:
+    """{participant: {sample_id: (ok, excluded)}} of the logged runs."""
+    outcomes: dict[str, dict[int, tuple[bool, bool]]] = {p: {} for p in participants}
     logged = read_runs(out, None)
     if logged is not None:
         cols = logged.select(["participant", "sample_id", "ok", "excluded"]).to_pydict()
         for p, s, ok, ex in zip(cols["participant"], cols["sample_id"], cols["ok"], cols["excluded"]):
-            if p in outcomes:
-                outcomes[p][int(s)] = (bool(ok), bool(ex))
-    folders = tuple(str(f) for f in folders)
+            outcomes.setdefault(p, {})[int(s)] = (bool(ok), bool(ex))
+    return outcomes
+
+
+def _run_locked(config: StudyConfig, out: Path, batch: int, scheduler, workers, folders: tuple,
+                progress: bool) -> StudySummary:
+    start_time = time.perf_counter()
+    _manifest(out, config)
+    repair(out)
+    log = runs_log(out)
+    outcomes = _logged_outcomes(out, config.participants)
     if folders:
         from wrist_env.participants import registry
 
@@ -348,46 +305,47 @@ def run_study(config: StudyConfig, out, *, batch: int = 64, scheduler=None, work
         from tqdm import tqdm
 
         bar = tqdm(total=config.n * len(config.participants), unit="run", desc="Monte Carlo", smoothing=0.05)
-    executor = _executor(scheduler, workers)
     try:
-        while True:
-            rounds = {}
-            for p in config.participants:
-                rnd, summary.counts[p] = _plan(p, config, outcomes[p])
-                if rnd is not None:
-                    rounds[p] = rnd
-            excluded, failed = summary.excluded, summary.failed
-            if bar is not None:
-                bar.n = sum(c.succeeded for c in summary.counts.values())
-                bar.set_postfix(excluded=excluded, failed=failed)
-                bar.refresh()
-            if not rounds:
-                summary.done = True
-                break
-            tasks = []
-            for p, rnd in rounds.items():
-                block = sampler.block_actions(config.seed, p, rnd.block, rnd.size, config.tear_probability)
-                for ids in _chunks(rnd.missing, int(batch)):
-                    rows = np.asarray(ids) - rnd.start
-                    tasks.append(executor.submit(sampler.run_chunk, p, ids, [rnd.block] * len(ids), block[rows],
-                                                 exclude_above_mpa=config.exclude_above_mpa, folders=folders))
-            for table in executor.as_completed(tasks):
-                cols = table.select(["participant", "sample_id", "ok", "excluded"]).to_pydict()
-                p = cols["participant"][0]
-                ids = tuple(int(s) for s in cols["sample_id"])
-                log.write(part_name(p, ids), table)
-                good = 0
-                for s, ok, ex in zip(ids, cols["ok"], cols["excluded"]):
-                    outcomes[p][s] = (bool(ok), bool(ex))
-                    good += bool(ok) and not bool(ex)
-                    excluded += bool(ok) and bool(ex)
-                    failed += not bool(ok)
-                summary.simulated += len(ids)
+        with executor(scheduler, workers) as ex:
+            while True:
+                rounds = {}
+                for p in config.participants:
+                    rnd, summary.counts[p] = _plan(p, config, outcomes[p])
+                    if rnd is not None:
+                        rounds[p] = rnd
+                excluded, failed = summary.excluded, summary.failed
                 if bar is not None:
-                    bar.update(good)
+                    bar.n = sum(c.succeeded for c in summary.counts.values())
                     bar.set_postfix(excluded=excluded, failed=failed)
+                    bar.refresh()
+                if not rounds:
+                    summary.done = True
+                    break
+                tasks = []
+                for p, rnd in rounds.items():
+                    block = sampler.block_actions(config.seed, p, rnd.block, rnd.size, config.tear_probability)
+                    for ids in _chunks(rnd.missing, batch):
+                        rows = np.asarray(ids) - rnd.start
+                        tasks.append(ex.submit(sampler.run_chunk, p, ids, [rnd.block] * len(ids), block[rows],
+                                               exclude_above_mpa=config.exclude_above_mpa, folders=folders))
+                for _, table, error in ex.results(tasks):
+                    if error is not None:
+                        raise error
+                    cols = table.select(["participant", "sample_id", "ok", "excluded"]).to_pydict()
+                    p = cols["participant"][0]
+                    ids = tuple(int(s) for s in cols["sample_id"])
+                    log.write_part(part_name(p, ids), table)
+                    good = 0
+                    for s, ok, ex_ in zip(ids, cols["ok"], cols["excluded"]):
+                        outcomes[p][s] = (bool(ok), bool(ex_))
+                        good += bool(ok) and not bool(ex_)
+                        excluded += bool(ok) and bool(ex_)
+                        failed += not bool(ok)
+                    summary.simulated += len(ids)
+                    if bar is not None:
+                        bar.update(good)
+                        bar.set_postfix(excluded=excluded, failed=failed)
     finally:
-        executor.close()
         if bar is not None:
             bar.close()
     for p in config.participants:  # recount from the log's outcomes
@@ -406,12 +364,7 @@ def config_of(out, participants=None) -> StudyConfig:
 def counts(out) -> dict[str, ParticipantCounts]:
     """Per-participant counts of a study folder, from its log."""
     config = config_of(out)
-    table = read_runs(out)
-    outcomes: dict[str, dict[int, tuple[bool, bool]]] = {p: {} for p in config.participants}
-    if table is not None:
-        cols = table.select(["participant", "sample_id", "ok", "excluded"]).to_pydict()
-        for p, s, ok, ex in zip(cols["participant"], cols["sample_id"], cols["ok"], cols["excluded"]):
-            outcomes.setdefault(p, {})[int(s)] = (bool(ok), bool(ex))
+    outcomes = _logged_outcomes(Path(out), config.participants)
     return {p: _plan(p, config, outcomes[p])[1] for p in config.participants}
 
 

@@ -1,0 +1,60 @@
+"""The executor both studies use: this process, local processes (dying with their parent), errors handed back."""
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from wrist_env.runs.executor import Inline, Processes, executor
+
+
+def _square(x):
+    if x < 0:
+        raise ValueError(f"negative {x}")
+    return x * x
+
+
+@pytest.mark.parametrize("make", [lambda: Inline(), lambda: Processes(2, threads=1)], ids=["inline", "processes"])
+def test_results_hand_back_values_and_errors(make):
+    with make() as ex:
+        handles = {ex.submit(_square, x): x for x in (1, -2, 3)}
+        out = {handles[h]: (value, error) for h, value, error in ex.results(list(handles))}
+    assert out[1] == (1, None) and out[3] == (9, None)
+    assert out[-2][0] is None and isinstance(out[-2][1], ValueError)
+
+
+def test_executor_chooses_by_workers():
+    assert isinstance(executor(None, 0), Inline) and isinstance(executor(None, 1), Inline)
+    with executor(None, 2, threads=1) as ex:
+        assert isinstance(ex, Processes) and (ex.workers, ex.threads) == (2, 1)
+
+
+def test_local_workers_die_with_their_parent(tmp_path):
+    psutil = pytest.importorskip("psutil")
+    script = textwrap.dedent("""
+        import sys, time
+        from wrist_env.runs.executor import Processes
+        if __name__ == "__main__":
+            ex = Processes(2, threads=1)
+            handles = [ex.submit(time.sleep, 600) for _ in range(2)]
+            time.sleep(3)
+            print("ready", flush=True)
+            time.sleep(600)
+    """)
+    path = tmp_path / "parent.py"
+    path.write_text(script)
+    proc = subprocess.Popen([sys.executable, str(path)], stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout.readline().strip() == "ready"
+        workers = [c for c in psutil.Process(proc.pid).children(recursive=True) if "spawn_main" in " ".join(c.cmdline())]
+        assert len(workers) == 2
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait(timeout=30)
+        _, alive = psutil.wait_procs(workers, timeout=20)
+        assert not alive, f"workers outlived their parent: {[w.pid for w in alive]}"
+    finally:
+        if proc.poll() is None:
+            proc.kill()

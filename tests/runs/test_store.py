@@ -1,0 +1,77 @@
+"""The run store: write-once atomic parts, damaged files named, quarantine, locks, temporary files."""
+
+import os
+import re
+import time
+
+import pyarrow as pa
+import pytest
+
+from wrist_env.errors import StoreError
+from wrist_env.runs import PartExistsError, RunStore, StoreBusyError
+
+TABLE = pa.table({"x": [1, 2]})
+
+
+def test_parts_are_written_once_and_read_back_in_name_order(tmp_path):
+    store = RunStore(tmp_path, parts="p")
+    assert store.read_parts() is None
+    store.write_part("b", pa.table({"x": [3]}))
+    store.write_part("a", TABLE)
+    with pytest.raises(PartExistsError, match="written once"):
+        store.write_part("a", TABLE)
+    assert store.part_names() == ["a", "b"] and store.read_parts()["x"].to_pylist() == [1, 2, 3]
+    with pytest.raises(ValueError, match="plain file name"):
+        store.write_part("../escape", TABLE)
+
+
+@pytest.mark.parametrize("damage", [b"", b"PAR1 garbage", None])
+def test_a_damaged_part_is_a_store_error_naming_it(tmp_path, damage):
+    store = RunStore(tmp_path, parts="p")
+    path = store.write_part("a", TABLE)
+    data = path.read_bytes()
+    path.write_bytes(data[: len(data) // 2] if damage is None else damage)
+    with pytest.raises(StoreError, match=re.escape(str(path)) + ".*damaged Parquet.*do this"):
+        store.read_parts(advice="do this")
+    assert [name for name, _ in store.damaged_parts()] == ["a"]
+
+
+def test_records_round_trip_and_a_truncated_record_is_named(tmp_path):
+    store = RunStore(tmp_path)
+    store.write_record("cell", {"nfev": 3})
+    assert store.read_record("cell") == {"nfev": 3} and store.read_record("other") is None
+    path = store.record_path("cell")
+    path.write_text(path.read_text()[:5])
+    with pytest.raises(StoreError, match=re.escape(str(path)) + ".*cannot be read as JSON"):
+        store.read_record("cell")
+
+
+def test_quarantine_moves_the_file_aside_with_a_warning(tmp_path):
+    store = RunStore(tmp_path, parts="p")
+    path = store.write_part("a", TABLE)
+    with pytest.warns(UserWarning, match="a.parquet: broken"):
+        target = store.quarantine(path, "broken")
+    assert not path.exists() and target == tmp_path / "damaged" / "a.parquet" and target.is_file()
+    assert store.quarantine(path, "gone") is None
+
+
+def test_only_stale_temporary_files_are_cleaned(tmp_path):
+    store = RunStore(tmp_path, parts="p")
+    store.write_part("a", TABLE)
+    stale, live = tmp_path / "p" / ".b.parquet.dead.tmp", tmp_path / "p" / ".c.parquet.live.tmp"
+    stale.write_bytes(b"half a file")
+    live.write_bytes(b"being written")
+    old = time.time() - 3600
+    os.utime(stale, (old, old))
+    assert store.clean(min_age_s=60) == 1 and not stale.exists() and live.exists()
+    assert store.part_names() == ["a"]
+
+
+def test_a_held_lock_refuses_a_second_holder_that_will_not_wait(tmp_path):
+    store = RunStore(tmp_path)
+    with store.lock(what="a test study"):
+        with pytest.raises(StoreBusyError, match=rf"pid {os.getpid()}\) is running a test study"):
+            with RunStore(tmp_path).lock(wait=False, what="a test study"):
+                pass
+    with RunStore(tmp_path).lock(wait=False):  # released
+        pass

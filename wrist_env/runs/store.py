@@ -1,0 +1,178 @@
+"""The run store both studies log to: write-once Parquet parts, JSON records, locks, damage checks.
+
+A `RunStore(root, parts=...)` is a folder::
+
+    root/<parts>/<name>.parquet   write-once parts (one batch of evaluations, one chunk of runs)
+    root/<records>/<name>.json    JSON records (a finished benchmark cell's summary)
+    root/locks/<name>.lock        flocks: a key's lock while a process runs it, "store" for a whole study
+    root/damaged/                 files moved aside by `quarantine` (never deleted)
+
+Every file is written by `wrist_env.io.atomic_write` (temporary name, fsync,
+`os.replace`, folder fsync): a reader, or a writer killed midway, never sees
+half a file. A part name that exists is never overwritten. A damaged part or
+record (truncated, empty, garbage) is a `StoreError` naming the file and what
+to do; the studies move such files to `damaged/` on resume and redo their work.
+Nothing here knows what a row means: `wrist_env.bench.log` (the benchmark's
+evaluations) and `wrist_env.montecarlo.study` (the Monte Carlo runs) do.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import os
+import shutil
+import warnings
+from contextlib import contextmanager
+from pathlib import Path
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from wrist_env.errors import StoreError
+from wrist_env.io import atomic_write, clean_temporary, read_json, write_json
+
+DAMAGED = "damaged"
+LOCKS = "locks"
+STORE_LOCK = "store"
+
+
+class PartExistsError(StoreError, FileExistsError):
+    """A part of that name is already in the store (parts are written once)."""
+
+
+class StoreBusyError(StoreError):
+    """Another process holds a lock this one was not allowed to wait for."""
+
+
+def read_parquet(path, schema: pa.Schema | None = None, columns=None, advice: str = "") -> pa.Table:
+    """One Parquet file; `StoreError` naming it (and `advice`) if it is truncated, empty or not Parquet."""
+    try:
+        return pq.read_table(path, schema=schema, columns=columns)
+    except (OSError, pa.ArrowException, ValueError) as e:
+        raise StoreError(f"{path}: damaged Parquet file ({type(e).__name__}: {str(e).splitlines()[0][:200]})"
+                         + (f"; {advice}" if advice else "")) from None
+
+
+class RunStore:
+    """Parts, records and locks under `root` (folders created on the first write)."""
+
+    def __init__(self, root, *, parts: str = "parts", records: str = "records"):
+        self.root = Path(root)
+        self.parts_dir = self.root / parts
+        self.records_dir = self.root / records
+        self.locks_dir = self.root / LOCKS
+        self.damaged_dir = self.root / DAMAGED
+
+    # parts
+
+    def part_path(self, name: str) -> Path:
+        if not name or "/" in name or name.startswith("."):
+            raise ValueError(f"a part name must be a plain file name, but got {name!r}")
+        return self.parts_dir / f"{name}.parquet"
+
+    def part_names(self) -> list[str]:
+        """The parts written so far, sorted by name (temporary files are not parts)."""
+        if not self.parts_dir.is_dir():
+            return []
+        return sorted(p.name[:-len(".parquet")] for p in self.parts_dir.glob("*.parquet") if not p.name.startswith("."))
+
+    def write_part(self, name: str, table: pa.Table) -> Path:
+        """Write one part, atomically and once (`PartExistsError` if `name` is taken)."""
+        path = self.part_path(name)
+        if path.exists():
+            raise PartExistsError(f"{path} is already in the store (parts are written once)")
+        return atomic_write(path, lambda p: pq.write_table(table, p))
+
+    def read_part(self, name: str, schema: pa.Schema | None = None, columns=None, advice: str = "") -> pa.Table:
+        return read_parquet(self.part_path(name), schema, columns, advice)
+
+    def read_parts(self, names=None, schema: pa.Schema | None = None, columns=None, advice: str = "") -> pa.Table | None:
+        """The parts `names` (default all) concatenated in name order, or None if there are none."""
+        names = self.part_names() if names is None else list(names)
+        if not names:
+            return None
+        return pa.concat_tables([self.read_part(n, schema, columns, advice) for n in names])
+
+    def damaged_parts(self, schema: pa.Schema | None = None) -> list[tuple[str, str]]:
+        """(name, error) of every part that cannot be read whole against `schema`."""
+        out = []
+        for name in self.part_names():
+            try:
+                self.read_part(name, schema)
+            except StoreError as e:
+                if self.part_path(name).exists():  # not removed meanwhile by a concurrent compaction
+                    out.append((name, str(e)))
+        return out
+
+    def remove_part(self, name: str) -> None:
+        self.part_path(name).unlink(missing_ok=True)
+
+    # records
+
+    def record_path(self, name: str) -> Path:
+        if not name or "/" in name or name.startswith("."):
+            raise ValueError(f"a record name must be a plain file name, but got {name!r}")
+        return self.records_dir / f"{name}.json"
+
+    def write_record(self, name: str, data) -> Path:
+        return write_json(self.record_path(name), data)
+
+    def read_record(self, name: str, advice: str = ""):
+        """The record `name`, or None if there is none; `StoreError` naming it if it is damaged."""
+        path = self.record_path(name)
+        return read_json(path, "record", advice) if path.is_file() else None
+
+    def record_names(self) -> list[str]:
+        if not self.records_dir.is_dir():
+            return []
+        return sorted(p.stem for p in self.records_dir.glob("*.json") if not p.name.startswith("."))
+
+    # repair
+
+    def quarantine(self, path, reason: str) -> Path | None:
+        """Move a damaged or orphaned file to `damaged/` (kept for inspection) with a warning naming it
+        (None if it is already gone)."""
+        path = Path(path)
+        if not path.exists():
+            return None
+        self.damaged_dir.mkdir(parents=True, exist_ok=True)
+        target = self.damaged_dir / path.name
+        k = 1
+        while target.exists():
+            target, k = self.damaged_dir / f"{path.name}.{k}", k + 1
+        shutil.move(str(path), target)
+        warnings.warn(f"{path}: {reason}; moved to {target}", stacklevel=2)
+        return target
+
+    def clean(self, min_age_s: float = 60.0) -> int:
+        """Remove temporary files killed writers left behind (at least `min_age_s` old, so a concurrent
+        writer's file is spared); returns how many."""
+        return sum(clean_temporary(d, min_age_s) for d in (self.parts_dir, self.records_dir, self.root))
+
+    # locks
+
+    @contextmanager
+    def lock(self, name: str = STORE_LOCK, *, wait: bool = True, what: str = "this run store"):
+        """Hold the flock `locks/<name>.lock` (released when the process dies, even by SIGKILL).
+
+        wait=False: `StoreBusyError` naming the holder's process id if another process holds it.
+        """
+        self.locks_dir.mkdir(parents=True, exist_ok=True)
+        path = self.locks_dir / f"{name}.lock"
+        with open(path, "a+") as handle:
+            try:
+                fcntl.flock(handle, fcntl.LOCK_EX | (0 if wait else fcntl.LOCK_NB))
+            except BlockingIOError:
+                handle.seek(0)
+                holder = handle.read().strip() or "?"
+                raise StoreBusyError(f"{path}: another process (pid {holder}) is running {what}; wait for it to "
+                                     f"finish or stop it (a killed run releases the lock)") from None
+            handle.seek(0)
+            handle.truncate()
+            handle.write(str(os.getpid()))
+            handle.flush()
+            try:
+                yield
+            finally:
+                handle.truncate(0)
+                fcntl.flock(handle, fcntl.LOCK_UN)
