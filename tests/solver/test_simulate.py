@@ -106,3 +106,17 @@ def test_random_designs_across_the_bounds_never_raise(p1):
         else:
             assert r.message.startswith("failed") and np.all(np.isnan(r.poses))
     assert sum(r.ok for r in results) > 0.7 * len(results)
+
+
+def test_prepared_arrays_give_the_same_run_and_refuse_another_mode(p1, sweep):
+    from wrist_env.solver.arrays import EXPERIMENTAL
+    from wrist_env.solver.simulate import prepare
+
+    driver = idealized(p1)
+    prepared = prepare(p1, None, driver.mode)
+    again = simulate(p1, design.population(), driver, prepared=prepared)
+    np.testing.assert_array_equal(again.poses, sweep.poses)
+    np.testing.assert_array_equal(simulate_batch(p1, [design.population()], driver, prepared=prepared)[0].poses,
+                                  sweep.poses)
+    with pytest.raises(ValueError, match="driver mode"):
+        simulate(p1, design.population(), driver, prepared=prepare(p1, None, EXPERIMENTAL))

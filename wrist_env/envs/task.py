@@ -18,7 +18,7 @@ from wrist_env.design import ALL_LIGAMENT_NAMES, Design
 from wrist_env.model import BONES, PAIRS, Model
 from wrist_env.participants import builtin, registry
 from wrist_env.solver.arrays import SolverSettings
-from wrist_env.solver.simulate import Driver, Result, experimental, idealized, simulate, simulate_batch
+from wrist_env.solver.simulate import Driver, Result, experimental, idealized, prepare, simulate, simulate_batch
 
 MOTIONS = ("calibrate", "validate", "idealized")
 CONTACT_FIELDS = ("mean_pressure_mpa", "peak_pressure_mpa", "area_mm2", "force_n")
@@ -48,6 +48,7 @@ class Task:
         self.settings, self.weights = settings, weights
         self.model: Model = registry.load_model(participant)
         self.driver, self.reference = self._driver_and_reference()
+        self.prepared = prepare(self.model, settings, self.driver.mode)
         self.reference_points = self.model.centroid[[BONES.index(b) for b in COST_BONES]]
 
     def _driver_and_reference(self) -> tuple[Driver, np.ndarray | None]:
@@ -63,12 +64,13 @@ class Task:
 
     def evaluate(self, design: Design) -> Evaluation:
         """Simulate one design and score it."""
-        return self._score(design, simulate(self.model, design, self.driver, self.settings))
+        return self._score(design, simulate(self.model, design, self.driver, prepared=self.prepared))
 
     def evaluate_batch(self, designs) -> list[Evaluation]:
         """Simulate many designs at once (Numba prange); the same numbers as one at a time."""
         designs = list(designs)
-        return [self._score(d, r) for d, r in zip(designs, simulate_batch(self.model, designs, self.driver, self.settings))]
+        results = simulate_batch(self.model, designs, self.driver, prepared=self.prepared)
+        return [self._score(d, r) for d, r in zip(designs, results)]
 
     def evaluate_action(self, action) -> Evaluation:
         return self.evaluate(design_vars.from_action(action))

@@ -45,7 +45,7 @@ class WristEnv(gym.Env):
         return OBSERVATION.copy(), {}
 
     def step(self, action):
-        evaluation = self.task.evaluate_action(design.check_action(action))
+        evaluation = self.task.evaluate_action(action)
         return OBSERVATION.copy(), float(evaluation.reward), True, False, evaluation.info
 
 
@@ -73,7 +73,7 @@ class WristVectorEnv(VectorEnv):
         actions = np.asarray(actions)
         if actions.shape != (self.num_envs, design.N_DESIGN):
             raise ValueError(f"actions must have shape ({self.num_envs}, {design.N_DESIGN}), but got {actions.shape}")
-        evaluations = self.task.evaluate_batch(design.from_action(design.check_action(a)) for a in actions)
+        evaluations = self.task.evaluate_batch(design.from_action(a) for a in actions)
         infos = {}
         for i, e in enumerate(evaluations):
             infos = self._add_info(infos, e.info, i)

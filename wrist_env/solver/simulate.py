@@ -112,31 +112,65 @@ def _outputs(n: int, n_frames: int):
             np.full(shape + (n_frames, 2), np.nan), np.zeros(shape + (n_frames,), np.int64), np.zeros(shape + (1,), np.int64))
 
 
-def _prepare(model: Model, settings: arrays.SolverSettings | None, driver: Driver):
+@dataclass(frozen=True)
+class Prepared:
+    """A model's kernel arrays under one solver setting and driver mode: built once (`prepare`),
+    reused by every `simulate` / `simulate_batch` call that passes it (a `Task` keeps one)."""
+
+    model: Model
+    mode: int
+    bodies: arrays.Bodies
+    grids: arrays.Grids
+    fibres: arrays.Fibres
+    membrane: arrays.Membrane
+    settings: arrays.Settings
+    law: np.ndarray
+
+    def check(self, model: Model, driver: Driver) -> None:
+        if model is not self.model or driver.mode != self.mode:
+            raise ValueError(f"these prepared arrays are for model {self.model.name!r} and driver mode {self.mode}, "
+                             f"but got model {model.name!r} and mode {driver.mode}")
+
+
+def prepare(model: Model, settings: arrays.SolverSettings | None = None, mode: int = arrays.EXPERIMENTAL) -> Prepared:
+    """The kernel arrays of `model` under `settings` (default `SolverSettings()`) for drivers of `mode`."""
     s = settings or arrays.SolverSettings()
-    bod, grd, fib = arrays.bodies(model, s), arrays.grids(model), arrays.fibres(model)
-    mem = arrays.membrane(model, grd)
-    return s, bod, grd, fib, mem, arrays.settings_tuple(s, driver.mode), np.ascontiguousarray(model.contact_law, dtype=np.float64)
+    grd = arrays.grids(model)
+    return Prepared(model, int(mode), arrays.bodies(model, s), grd, arrays.fibres(model), arrays.membrane(model, grd),
+                    arrays.settings_tuple(s, mode), np.ascontiguousarray(model.contact_law, dtype=np.float64))
 
 
-def simulate(model: Model, design: Design, driver: Driver, settings: arrays.SolverSettings | None = None) -> Result:
-    """Simulate one design: settle, move the capitate to the first pose, then the motion."""
-    s, bod, grd, fib, mem, st, law = _prepare(model, settings, driver)
-    f_l0, f_K, m_l0, m_K = arrays.design_arrays(model, fib, mem, design)
+def _prepared(model, settings, driver, prepared) -> Prepared:
+    if prepared is None:
+        return prepare(model, settings, driver.mode)
+    prepared.check(model, driver)
+    return prepared
+
+
+def simulate(model: Model, design: Design, driver: Driver, settings: arrays.SolverSettings | None = None, *,
+             prepared: Prepared | None = None) -> Result:
+    """Simulate one design: settle, move the capitate to the first pose, then the motion.
+
+    prepared: `prepare(model, settings, driver.mode)`, to skip rebuilding the kernel arrays."""
+    p = _prepared(model, settings, driver, prepared)
+    f_l0, f_K, m_l0, m_K = arrays.design_arrays(model, p.fibres, p.membrane, design)
     out = _outputs(0, len(driver.rotation))
-    kernel.run(bod, grd, law, fib, f_l0, f_K, mem, m_l0, m_K, st, driver.rotation, driver.com, driver.load_n, *out)
+    kernel.run(p.bodies, p.grids, p.law, p.fibres, f_l0, f_K, p.membrane, m_l0, m_K, p.settings, driver.rotation,
+               driver.com, driver.load_n, *out)
     return _result(out, driver, int(out[-1][0]))
 
 
-def simulate_batch(model: Model, designs, driver: Driver, settings: arrays.SolverSettings | None = None) -> list[Result]:
+def simulate_batch(model: Model, designs, driver: Driver, settings: arrays.SolverSettings | None = None, *,
+                   prepared: Prepared | None = None) -> list[Result]:
     """Simulate many designs in parallel (Numba prange); same results as one at a time."""
-    s, bod, grd, fib, mem, st, law = _prepare(model, settings, driver)
-    per = [arrays.design_arrays(model, fib, mem, d) for d in designs]
-    f_l0, f_K, m_l0, m_K = (np.ascontiguousarray(np.stack([p[i] for p in per])) for i in range(4))
+    p = _prepared(model, settings, driver, prepared)
+    per = [arrays.design_arrays(model, p.fibres, p.membrane, d) for d in designs]
+    f_l0, f_K, m_l0, m_K = (np.ascontiguousarray(np.stack([q[i] for q in per])) for i in range(4))
     out = _outputs(len(per), len(driver.rotation))
     previous = numba.set_parallel_chunksize(1)  # designs differ in cost: hand them out one at a time
     try:
-        kernel.run_batch(bod, grd, law, fib, f_l0, f_K, mem, m_l0, m_K, st, driver.rotation, driver.com, driver.load_n, *out)
+        kernel.run_batch(p.bodies, p.grids, p.law, p.fibres, f_l0, f_K, p.membrane, m_l0, m_K, p.settings,
+                         driver.rotation, driver.com, driver.load_n, *out)
     finally:
         numba.set_parallel_chunksize(previous)
     return [_result(tuple(o[i] for o in out), driver, int(out[-1][i, 0])) for i in range(len(per))]
