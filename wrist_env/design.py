@@ -63,6 +63,8 @@ ALL_LIGAMENTS = LIGAMENTS + FIXED_LIGAMENTS
 ALL_LIGAMENT_NAMES = tuple(lig.name for lig in ALL_LIGAMENTS)
 """The design's eleven ligaments, then the fixed ones: the order of every per-bundle output."""
 INJURABLE = tuple(lig.name for lig in LIGAMENTS if lig.injurable)
+RSC_INDEX = LIGAMENT_NAMES.index("RSC")
+"""Index of the RSC, the one ligament modelled as a membrane, in `LIGAMENT_NAMES` and `ALL_LIGAMENT_NAMES`."""
 N_LIGAMENTS = len(LIGAMENTS)
 N_MATERIAL = 2 * N_LIGAMENTS
 N_DESIGN = N_MATERIAL + len(INJURABLE)

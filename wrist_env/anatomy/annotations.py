@@ -20,9 +20,10 @@ import numpy as np
 
 from wrist_env.anatomy.template import load_template
 from wrist_env.design import ALL_LIGAMENT_NAMES, LIGAMENT_NAMES
-from wrist_env.model import BODY_PARTS
+from wrist_env.model import BODY_PARTS, PAIRS
 
-ARTICULATIONS = ("radioscaphoid", "radiolunate", "scapholunate", "scaphocapitate", "lunocapitate")
+ARTICULATIONS = PAIRS
+"""The cartilage-covered articulations: the contact pairs (`model.PAIRS`)."""
 
 
 @dataclass(frozen=True)

@@ -20,7 +20,7 @@ from scipy.spatial import cKDTree
 from wrist_env.anatomy.annotations import ARTICULATIONS, template_annotations
 from wrist_env.anatomy.template import load_template
 from wrist_env.build import cartilage, contact_law, fibres, mass, morph, sdf
-from wrist_env.design import ALL_LIGAMENTS, LIGAMENTS, LIGAMENT_NAMES
+from wrist_env.design import ALL_LIGAMENTS, LIGAMENTS, LIGAMENT_NAMES, RSC_INDEX
 from wrist_env.errors import BuildError
 from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model, offsets
 
@@ -277,9 +277,8 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None, *, wo
     empty = np.zeros((0, 0, 0), np.float32)
     grid_list = [grids.get(b) for b in BONES]
     ref_len = np.array([next((bd.reference_length_mm for k2, _, _, bd in bundles if k2 == k), np.nan) for k in range(len(LIGAMENTS))])
-    rsc = LIGAMENT_NAMES.index("RSC")
     along = membrane.connector_kind == 0
-    ref_len[rsc] = float(np.sum(membrane.reference_length_mm[along]) / membrane.shape[1])  # mean chain length
+    ref_len[RSC_INDEX] = float(np.sum(membrane.reference_length_mm[along]) / membrane.shape[1])  # mean chain length
     membrane_bone = np.full(len(membrane.nodes), -1, np.int64)
     membrane_bone[membrane.radius_nodes] = BONES.index("radius")
     membrane_bone[membrane.capitate_nodes] = BONES.index("capitate")

@@ -18,10 +18,10 @@ from wrist_env.design import ALL_LIGAMENT_NAMES, Design
 from wrist_env.model import BONES, PAIRS, Model
 from wrist_env.participants import builtin, registry
 from wrist_env.solver.arrays import SolverSettings
+from wrist_env.solver.forces import CONTACT_FIELDS
 from wrist_env.solver.simulate import Driver, Result, experimental, idealized, prepare, simulate, simulate_batch
 
 MOTIONS = ("calibrate", "validate", "idealized")
-CONTACT_FIELDS = ("mean_pressure_mpa", "peak_pressure_mpa", "area_mm2", "force_n")
 
 
 @dataclass(frozen=True)

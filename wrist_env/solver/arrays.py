@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wrist_env.design import LIGAMENT_NAMES, Design, ligament_arrays
+from wrist_env.design import RSC_INDEX, Design, ligament_arrays
 from wrist_env.model import BONES, PAIR_BONES, Model
 
 Bodies = namedtuple("Bodies", "com0 inv_mass inv_inertia mass inertia")
@@ -24,7 +24,7 @@ Settings = namedtuple(
     "active_band_mm rebuild_every node_mass membrane_contact_stiffness driver max_disp_mm max_rot_rad fire_alpha0",
 )
 
-RSC = LIGAMENT_NAMES.index("RSC")
+RSC = RSC_INDEX
 EXPERIMENTAL, LOADED = 0, 1
 
 

@@ -18,8 +18,12 @@ from numba import njit
 from wrist_env.solver.contact import OUTSIDE_MM, law_energy, law_pressure, sdf_lookup_scalar
 from wrist_env.solver.ligaments import blankevoort_energy, blankevoort_force
 
-# columns of the per-pair contact statistics
+# columns of the per-pair contact statistics the force kernels accumulate
 C_FORCE, C_AREA, C_PEAK = 0, 1, 2
+CONTACT_FIELDS = ("mean_pressure_mpa", "peak_pressure_mpa", "area_mm2", "force_n")
+"""Columns of `Result.contact` (per frame and pair): mean pressure over the contacting area (MPa),
+peak pressure (MPa), contact area (mm²), force (N)."""
+R_MEAN, R_PEAK, R_AREA, R_FORCE = (CONTACT_FIELDS.index(f) for f in CONTACT_FIELDS)
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -12,14 +12,14 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from wrist_env.design import ALL_LIGAMENT_NAMES
-from wrist_env.solver.forces import C_AREA, C_FORCE, C_PEAK, contact_forces, fibre_forces, membrane_forces, place_nodes, rebuild_active
+from wrist_env.design import ALL_LIGAMENT_NAMES, RSC_INDEX
+from wrist_env.model import BONES, CAPITATE, LUNATE, PAIRS, SCAPHOID
+from wrist_env.solver.forces import (C_AREA, C_FORCE, C_PEAK, R_AREA, R_FORCE, R_MEAN, R_PEAK, contact_forces, fibre_forces, membrane_forces, place_nodes, rebuild_active)
 from wrist_env.solver.rigid import interpolate_pose, matrix_to_rotvec, orthonormalize, rotate_in_place, smoothstep
 
-SCAPHOID, LUNATE, CAPITATE = 2, 3, 4
-N_BONES, N_PAIRS = 5, 5
+N_BONES, N_PAIRS = len(BONES), len(PAIRS)
 N_LIGAMENTS = len(ALL_LIGAMENT_NAMES)
-RSC = ALL_LIGAMENT_NAMES.index("RSC")
+RSC = RSC_INDEX
 OK, FAILED_NAN, FAILED_DIVERGED = 0, 1, 2
 
 
@@ -284,10 +284,10 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x, f
             poses[f, b, 3, 3] = 1.0
         for p in range(stats.shape[0]):
             area = stats[p, C_AREA]
-            contact[f, p, 0] = stats[p, C_FORCE] / area if area > 0 else 0.0
-            contact[f, p, 1] = stats[p, C_PEAK]
-            contact[f, p, 2] = area
-            contact[f, p, 3] = stats[p, C_FORCE]
+            contact[f, p, R_MEAN] = stats[p, C_FORCE] / area if area > 0 else 0.0
+            contact[f, p, R_PEAK] = stats[p, C_PEAK]
+            contact[f, p, R_AREA] = area
+            contact[f, p, R_FORCE] = stats[p, C_FORCE]
         bundle_out[f] = bundle
         energy_out[f, 0] = _kinetic(R, v, w, nv, bod, st)
         energy_out[f, 1] = energy

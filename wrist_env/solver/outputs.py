@@ -13,6 +13,7 @@ import numpy as np
 from wrist_env.design import ALL_LIGAMENT_NAMES
 from wrist_env.model import BONES, PAIRS, Model
 from wrist_env.solver import arrays, forces
+from wrist_env.solver.forces import CONTACT_FIELDS
 
 
 def _state(model: Model, pose_frame):
@@ -91,8 +92,7 @@ def result_to_dict(result, model: Model) -> dict:
             "capitate_angle_deg": _num(result.angle_deg[f]),
             "rotation_deg": {b: [_num(a) for a in angles[f, i]] for i, b in enumerate(BONES)},
             "poses": {b: _matrix(result.poses[f, i]) for i, b in enumerate(BONES)},
-            "contact": {p: {"mean_pressure_mpa": _num(c[0]), "peak_pressure_mpa": _num(c[1]),
-                            "area_mm2": _num(c[2]), "force_n": _num(c[3])}
+            "contact": {p: {field: _num(v) for field, v in zip(CONTACT_FIELDS, c)}
                         for p, c in zip(PAIRS, result.contact[f])},
             "ligament_force_n": {name: _num(v) for name, v in zip(ALL_LIGAMENT_NAMES, result.bundle_force[f])},
             "kinetic_energy_nmm": _num(result.energy[f, 0]),
