@@ -10,11 +10,13 @@ from __future__ import annotations
 
 from importlib.metadata import entry_points
 
+from wrist_env.errors import WristEnvError
+
 ENTRY_POINT_GROUP = "wrist_env.optimizers"
 _REGISTRY: dict[str, type] = {}
 
 
-class UnknownOptimizerError(KeyError):
+class UnknownOptimizerError(WristEnvError, KeyError):
     """An optimizer name that is not registered (the message lists the valid ones)."""
 
     def __str__(self) -> str:

@@ -126,3 +126,20 @@ def test_evaluate_table_and_design_file(capsys, built, tmp_path):
     assert len(rows) == 12 and {r[-1] for r in rows} == {"mm", "deg"}
     assert main(["evaluate", "P9"]) == 2
     assert "unknown participant 'P9'" in capsys.readouterr().err
+
+
+def test_every_participant_command_takes_folder_once_and_registers_it(tmp_path):
+    from wrist_env.cli import parser
+
+    p = parser()
+    sub = next(a for a in p._actions if a.dest == "command")
+    with_folder = [name for name, s in sub.choices.items() if any("--folder" in a.option_strings for a in s._actions)]
+    assert set(with_folder) >= {"participants", "build", "simulate", "evaluate", "validate", "figure", "calibrate",
+                                "benchmark", "leaderboard", "montecarlo"}
+    assert main(["participants", "--folder", str(tmp_path / "missing")]) == 2  # registered (and refused) before the command
+
+
+def test_an_unknown_calibrator_is_one_line_and_exit_2(capsys):
+    assert main(["calibrate", "P1", "--optimizer", "nope", "--budget", "2"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("wrist-bench: error: unknown optimizer 'nope'") and len(err.strip().splitlines()) == 1

@@ -14,22 +14,18 @@ FIGURES = Path("experiments") / "figures"
 def _participants(args) -> int:
     from wrist_env.participants import builtin, registry
 
-    for folder in args.folder or []:
-        registry.add_folder(folder)
     for name in registry.participants():
         if name in builtin.BUILTIN:
             i = builtin.info(name)
             print(f"{name}  built-in (synthetic)  {i.sex}, {i.age} y, facet type {i.facet_type}, task: {i.task}")
         else:
-            print(f"{name}  folder {registry._FOLDERS[name]}")
+            print(f"{name}  folder {registry.folder(name)}")
     return 0
 
 
 def _build(args) -> int:
     from wrist_env.participants import registry
 
-    for folder in args.folder or []:
-        registry.add_folder(folder)
     start = time.perf_counter()
     model = registry.load_model(args.participant, cache=not args.no_cache)
     summary = dict(model.report)
@@ -55,34 +51,18 @@ def load_design(spec: str, participant: str):
         if participant not in builtin.BUILTIN:
             raise DesignError(f"--design truth needs a built-in participant {list(builtin.BUILTIN)}, but got {participant!r}")
         return builtin.truth(participant)
-    path = Path(spec)
-    if not path.is_file():
+    if not Path(spec).is_file():
         raise DesignError(f"--design must be 'population', 'truth' or a JSON file of a design, but {spec!r} is none of these")
-    try:
-        data = json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise DesignError(f"{path}: not valid JSON ({exc})") from None
-    if isinstance(data, dict) and isinstance(data.get("design"), dict):
-        data = data["design"]
-    if not isinstance(data, dict):
-        raise DesignError(f"{path}: expected a JSON object of design variables, but got {type(data).__name__}")
-    try:
-        return design.Design.from_dict(data)
-    except DesignError as exc:
-        raise DesignError(f"{path}: {exc}") from None
+    return design.read_json(spec)
 
 
 def make_driver(model, motion: str, frames: int | None, flexion: float, extension: float):
     """The capitate driver of `simulate`: an idealized sweep or the capitate held at neutral."""
-    import numpy as np
-
     from wrist_env.solver import simulate
 
     if motion == "idealized":
         return simulate.idealized(model, flexion_deg=flexion, extension_deg=extension, n_frames=frames or 17)
-    if motion == "static":
-        return simulate.experimental(model, np.tile(np.eye(4), (frames or 3, 1, 1)))
-    raise SystemExit(f"unknown motion {motion!r}")
+    return simulate.static(model, frames or 3)
 
 
 def _simulate(args) -> int:
@@ -91,8 +71,6 @@ def _simulate(args) -> int:
     from wrist_env.solver import simulate
     from wrist_env.solver.outputs import cardan_deg, result_to_dict
 
-    for folder in args.folder or []:
-        registry.add_folder(folder)
     if args.frames is not None and args.frames < 1:
         raise SystemExit("wrist-bench simulate: --frames must be at least 1")
     start = time.perf_counter()
@@ -131,14 +109,10 @@ def _simulate(args) -> int:
 
 def _evaluate(args) -> int:
     from wrist_env.envs.task import task
-    from wrist_env.errors import ParticipantError
     from wrist_env.frames import DOF_NAMES, DOF_UNITS
     from wrist_env.participants import registry
 
-    for folder in args.folder or []:
-        registry.add_folder(folder)
-    if args.participant not in registry.participants():
-        raise ParticipantError(f"unknown participant {args.participant!r}; known: {list(registry.participants())}")
+    registry.require(args.participant)
     d = load_design(args.design, args.participant)
     start = time.perf_counter()
     t = task(args.participant, args.motion)
@@ -173,14 +147,10 @@ def _evaluate(args) -> int:
 def _validate(args) -> int:
     from wrist_env import validation
     from wrist_env.build.pipeline import BuildParams, anatomy_params
-    from wrist_env.errors import ParticipantError
     from wrist_env.participants import registry
     from wrist_env.solver.simulate import IDEALIZED_LOAD_N
 
-    for folder in args.folder or []:
-        registry.add_folder(folder)
-    if args.participant not in registry.participants():
-        raise ParticipantError(f"unknown participant {args.participant!r}; known: {list(registry.participants())}")
+    registry.require(args.participant)
     params = anatomy_params(args)
     report = validation.validate(args.participant, params=params,
                                  load_n=IDEALIZED_LOAD_N if args.load is None else args.load)
@@ -213,30 +183,13 @@ def _figure(args) -> int:
     return 0
 
 
-def _bench_errors(run):
-    """Unknown calibrators are a clear error, like unknown participants."""
-    def wrapped(args) -> int:
-        from optimizers import UnknownOptimizerError
-
-        try:
-            return run(args)
-        except UnknownOptimizerError as exc:
-            print(f"wrist-bench: error: {exc}", file=sys.stderr)
-            return 2
-    return wrapped
-
-
 def _calibrate(args) -> int:
     from wrist_env.bench.calibrate import calibrate
     from wrist_env.bench.leaderboard import reference
     from wrist_env.design import LIGAMENT_NAMES
-    from wrist_env.errors import ParticipantError
     from wrist_env.participants import registry
 
-    for folder in args.folder or []:
-        registry.add_folder(folder)
-    if args.participant not in registry.participants():
-        raise ParticipantError(f"unknown participant {args.participant!r}; known: {list(registry.participants())}")
+    registry.require(args.participant)
     if args.budget < 1:
         raise SystemExit("wrist-bench calibrate: --budget must be at least 1")
     start = time.perf_counter()
@@ -280,8 +233,6 @@ def _benchmark(args) -> int:
     from wrist_env.bench.runner import benchmark, make_cells
     from wrist_env.participants import builtin, registry
 
-    for folder in args.folder or []:
-        registry.add_folder(folder)
     participants = args.participants or list(builtin.BUILTIN)
     names = args.optimizers or list(optimizers.available())
     if args.seeds < 1 or args.budget < 1:
@@ -311,8 +262,6 @@ def _leaderboard(args) -> int:
     from wrist_env.bench.leaderboard import write_leaderboard
     from wrist_env.participants import registry
 
-    for folder in args.folder or []:
-        registry.add_folder(folder)
     if not Path(args.runs).is_dir():
         raise SystemExit(f"wrist-bench leaderboard: no run log at {args.runs}")
     path = write_leaderboard(args.runs, args.out, title=args.title)
@@ -321,15 +270,10 @@ def _leaderboard(args) -> int:
 
 
 def _montecarlo(args) -> int:
-    from wrist_env.errors import ParticipantError
     from wrist_env.montecarlo.study import StudyConfig, run_study
     from wrist_env.participants import registry
 
-    for folder in args.folder or []:
-        registry.add_folder(folder)
-    unknown = [p for p in args.participants if p not in registry.participants()]
-    if unknown:
-        raise ParticipantError(f"unknown participants {unknown}; known: {list(registry.participants())}")
+    registry.require(*args.participants)
     config = StudyConfig(tuple(args.participants), args.n, args.seed, args.tear_probability)
     where = (f"the dask scheduler {args.scheduler}" if args.scheduler else
              f"{args.workers} local worker processes" if args.workers > 1 else "this process (Numba threads on every core)")
@@ -358,19 +302,24 @@ def parser() -> argparse.ArgumentParser:
 
     p = argparse.ArgumentParser(prog="wrist-bench", description=__doc__)
     sub = p.add_subparsers(dest="command", required=True)
+    folders = argparse.ArgumentParser(add_help=False)
+    folders.add_argument("--folder", action="append", help="register this participant folder first (repeatable; "
+                                                           "registered in every worker too)")
 
-    s = sub.add_parser("participants", help="list the known participants")
-    s.add_argument("--folder", action="append", help="also register this participant folder")
+    def command(name, **kwargs):
+        return sub.add_parser(name, parents=[folders], **kwargs)
+
+
+    s = command("participants", help="list the known participants")
     s.set_defaults(run=_participants)
 
-    s = sub.add_parser("build", help="build (or load from cache) a participant model")
+    s = command("build", help="build (or load from cache) a participant model")
     s.add_argument("participant")
     s.add_argument("--json", action="store_true", help="print the build summary as JSON")
     s.add_argument("--no-cache", action="store_true", help="rebuild even if a cached model exists")
-    s.add_argument("--folder", action="append", help="register this participant folder first")
     s.set_defaults(run=_build)
 
-    s = sub.add_parser(
+    s = command(
         "simulate", help="simulate a participant and print the per-frame outputs",
         description="Simulate one participant and design; print per-frame kinematics, contact, ligament "
                     "forces and the wall time of the simulate call. The first call in a fresh environment "
@@ -390,10 +339,9 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("--extension", type=float, default=40.0, help="idealized: last frame's extension, deg (default 40)")
     s.add_argument("--warm-up", action="store_true", help="run a one-frame simulation first (compile_seconds)")
     s.add_argument("--json", action="store_true", help="print all per-frame outputs as JSON")
-    s.add_argument("--folder", action="append", help="register this participant folder first")
     s.set_defaults(run=_simulate)
 
-    s = sub.add_parser(
+    s = command(
         "evaluate", help="score one design on a participant's task (cost, per-DOF errors)",
         description="Simulate one design on a participant's task and print its kinematic cost with the 75th "
                     "percentile |error| and the RMSE of each scaphoid and lunate DOF (mm, deg) against the "
@@ -408,10 +356,9 @@ def parser() -> argparse.ArgumentParser:
                    help="'population' (Table 2 means, default), 'truth' (a built-in participant's hidden "
                         "ground truth) or a JSON file of a design (Design.as_dict)")
     s.add_argument("--json", action="store_true", help="print the cost, per-DOF errors and timings as JSON")
-    s.add_argument("--folder", action="append", help="register this participant folder first")
     s.set_defaults(run=_evaluate)
 
-    s = sub.add_parser(
+    s = command(
         "validate", help="check the model against published wrist measurements (exit 1 if any check fails)",
         description="Simulate the population design (idealized +-40 deg sweep intact and with all three SLIL bundles "
                     "torn, and the capitate held at neutral) and compare carpal kinematics, radiocarpal load share, "
@@ -421,13 +368,12 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("participant")
     s.add_argument("--json", action="store_true", help="print the checks and series as JSON")
     s.add_argument("--out", help=f"figure folder (default {FIGURES})")
-    s.add_argument("--folder", action="append", help="register this participant folder first")
     add_anatomy_arguments(s)
     s.add_argument("--load", type=float, help="compressive load on the capitate in the sweeps, N (default: the idealized "
                                               "driver's; the load-share check always takes 100 N)")
     s.set_defaults(run=_validate)
 
-    s = sub.add_parser("figure", help="write a figure (PNG)",
+    s = command("figure", help="write a figure (PNG)",
                        description="model: bones, cartilage, ligaments; annotations: the template; pressure: "
                                    "contact pressure at the neutral pose viewed from distal (population design); "
                                    "kinematics: scaphoid and lunate rotations over an idealized sweep.")
@@ -439,7 +385,7 @@ def parser() -> argparse.ArgumentParser:
                         "idealized sweep (10 N compressive load)")
     s.set_defaults(run=_figure)
 
-    s = sub.add_parser(
+    s = command(
         "calibrate", help="calibrate a participant's ligament materials with one calibrator",
         description="Search the 22 ligament material variables (injury scalars intact) to minimize the kinematic "
                     "cost on the participant's calibration trial, with a registered calibrator "
@@ -454,10 +400,9 @@ def parser() -> argparse.ArgumentParser:
     s.add_argument("--storage", help="Optuna storage URL for Optuna calibrators (default: in memory)")
     s.add_argument("--out", help="also write the JSON result to this file (usable as --design elsewhere)")
     s.add_argument("--json", action="store_true", help="print the result, design and held-out cost as JSON")
-    s.add_argument("--folder", action="append", help="register this participant folder first")
-    s.set_defaults(run=_bench_errors(_calibrate))
+    s.set_defaults(run=_calibrate)
 
-    s = sub.add_parser(
+    s = command(
         "benchmark", help="run participants x calibrators x seeds into a resumable run log, then the leaderboard",
         description="Cross participants x calibrators x seeds, one cell each, on local processes (default) or a "
                     "dask.distributed scheduler; every evaluation is logged to Parquet in --out as its batch "
@@ -475,20 +420,18 @@ def parser() -> argparse.ArgumentParser:
                                      "sqlite:///<out>/optuna/{cell}.db); 'memory': studies in memory only")
     s.add_argument("--leaderboard", help="leaderboard folder (default: <out>/leaderboards)")
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
-    s.add_argument("--folder", action="append", help="register this participant folder (in every worker)")
-    s.set_defaults(run=_bench_errors(_benchmark))
+    s.set_defaults(run=_benchmark)
 
-    s = sub.add_parser("leaderboard", help="write the leaderboards of a benchmark run log",
+    s = command("leaderboard", help="write the leaderboards of a benchmark run log",
                        description="Tables (Markdown, CSV) and figures (PNG) from a benchmark run log: best cost "
                                    "at the budget, evaluations to cost targets, ECDF and convergence plots, "
                                    "parameter recovery, the held-out trial, the preprint's Tables 3-4.")
     s.add_argument("--runs", default="runs/benchmark", help="run-log folder (default runs/benchmark)")
     s.add_argument("--out", default="leaderboards", help="output folder (default leaderboards)")
     s.add_argument("--title", help="title of the README.md")
-    s.add_argument("--folder", action="append", help="register this participant folder first")
     s.set_defaults(run=_leaderboard)
 
-    s = sub.add_parser(
+    s = command(
         "montecarlo", help="Monte Carlo injury study: n successful idealized sweeps per participant (preprint 2.3.2)",
         description="Latin hypercube over the 27 design variables (materials from Table 2's normals truncated at "
                     "+-3 SD, each of SLIL_v, SLIL_p, SLIL_d, RSC, LRL torn with probability 0.3), simulated through "
@@ -506,7 +449,6 @@ def parser() -> argparse.ArgumentParser:
                    help="local worker processes, which die with this one (default 0, or 1: this process, "
                         "Numba threads on every core)")
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
-    s.add_argument("--folder", action="append", help="register this participant folder (in every worker)")
     s.set_defaults(run=_montecarlo)
 
     s = sub.add_parser("montecarlo-report", help="Tables 5-6 and Figures 8-10 of a Monte Carlo run log",
@@ -526,8 +468,13 @@ def main(argv=None) -> int:
     from wrist_env.errors import WristEnvError
 
     try:
+        if getattr(args, "folder", None):
+            from wrist_env.participants import registry
+
+            for folder in args.folder:
+                registry.add_folder(folder)
         return args.run(args)
-    except WristEnvError as exc:
+    except WristEnvError as exc:  # every project error (unknown calibrators too): one line, exit 2
         print(f"wrist-bench: error: {exc}", file=sys.stderr)
         return 2
 

@@ -146,6 +146,27 @@ class Design:
         return cls.from_vector([data[n] for n in NAMES])
 
 
+def read_json(path) -> Design:
+    """A Design from a JSON file: {name: value} in physical units (`NAMES`), or an object whose
+    "design" is one (a calibration's `--json` output); `DesignError` naming the file otherwise."""
+    import json
+    from pathlib import Path
+
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise DesignError(f"{path}: not a readable JSON file ({type(exc).__name__}: {exc})") from None
+    if isinstance(data, dict) and isinstance(data.get("design"), dict):
+        data = data["design"]
+    if not isinstance(data, dict):
+        raise DesignError(f"{path}: expected a JSON object of design variables, but got {type(data).__name__}")
+    try:
+        return Design.from_dict(data)
+    except DesignError as exc:
+        raise DesignError(f"{path}: {exc}") from None
+
+
 def check_action(action) -> np.ndarray:
     """The action as float64 of shape (27,) in [-1, 1], or a DesignError naming the offending entries."""
     raw = np.asarray(action)

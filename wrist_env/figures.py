@@ -220,7 +220,7 @@ def pressure_figure(name: str, out: Path | None = None, *, static: bool = False)
     model = load_model(name)
     out = out or FIGURES / f"pressure_{name}.png"
     if static:
-        driver = simulate.experimental(model, np.tile(np.eye(4), (3, 1, 1)))
+        driver = simulate.static(model)
         frame = len(driver.rotation) - 1
         how = "capitate held at neutral (all 6 DOF), no external load"
     else:

@@ -159,15 +159,11 @@ def benchmark(participants, optimizers, seeds, budget: int, out_dir, *, workers:
 
 def _check_names(cells, folders) -> None:
     import optimizers
-    from wrist_env.errors import ParticipantError
     from wrist_env.participants import registry
 
     for folder in folders:
         registry.add_folder(folder)
-    known = registry.participants()
-    for name in sorted({k.participant for k in cells}):
-        if name not in known:
-            raise ParticipantError(f"unknown participant {name!r}; known: {list(known)}")
+    registry.require(*sorted({k.participant for k in cells}))
     for name in sorted({k.optimizer for k in cells}):
         optimizers.get(name)  # UnknownOptimizerError lists the registered ones
 

@@ -32,6 +32,22 @@ def participants() -> tuple[str, ...]:
     return builtin.BUILTIN + tuple(n for n in _FOLDERS if n not in builtin.BUILTIN)
 
 
+def require(*names: str) -> None:
+    """`ParticipantError` listing the known participants unless every name is one."""
+    unknown = [n for n in names if n not in participants()]
+    if unknown:
+        raise ParticipantError(f"unknown participant{'s' if len(unknown) > 1 else ''} "
+                               f"{unknown if len(unknown) > 1 else repr(unknown[0])}; known: {list(participants())}")
+
+
+def folder(name: str) -> Path:
+    """The folder a registered participant was read from."""
+    require(name)
+    if name not in _FOLDERS:
+        raise ParticipantError(f"participant {name!r} is built in, not read from a folder")
+    return _FOLDERS[name]
+
+
 def add_folder(folder) -> str:
     """Validate a participant folder and make it known by its name; returns the name."""
     from wrist_env.participants.folder import load_participant_folder
@@ -49,8 +65,7 @@ def bones(name: str, params: BuildParams | None = None) -> dict:
     params = params or BuildParams()
     if name in builtin.BUILTIN:
         return builtin.bones(name, *params.anatomy)
-    if name not in _FOLDERS:
-        raise ParticipantError(f"unknown participant {name!r}; known: {list(participants())}")
+    require(name)
     from wrist_env.participants.folder import load_participant_folder
 
     source = load_participant_folder(_FOLDERS[name])
@@ -62,8 +77,7 @@ def trials(name: str) -> dict:
     """The participant's trials {name: Trial}; at least one has role "calibrate"."""
     if name in builtin.BUILTIN:
         return builtin.trials(name)
-    if name not in _FOLDERS:
-        raise ParticipantError(f"unknown participant {name!r}; known: {list(participants())}")
+    require(name)
     from wrist_env.participants.folder import load_participant_folder
 
     return load_participant_folder(_FOLDERS[name]).trials
@@ -99,4 +113,5 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
     return model
 
 
-__all__ = ["BONES", "add_folder", "bones", "cache_dir", "load_model", "participants", "trial", "trials"]
+__all__ = ["BONES", "add_folder", "bones", "cache_dir", "folder", "load_model", "participants", "require", "trial",
+           "trials"]

@@ -65,6 +65,13 @@ def loaded(model: Model, rotations, load_n=IDEALIZED_LOAD_N, angle_deg=None) -> 
     return Driver(arrays.LOADED, rotation, com, angle, load)
 
 
+def static(model: Model, n_frames: int = 3) -> Driver:
+    """The capitate held at neutral for `n_frames` frames (experimental driver, identity poses, no load)."""
+    if int(n_frames) < 1:
+        raise ValueError(f"n_frames must be at least 1, but got {n_frames}")
+    return experimental(model, np.tile(np.eye(4), (int(n_frames), 1, 1)))
+
+
 def idealized(model: Model, *, flexion_deg: float = 40.0, extension_deg: float = 40.0, n_frames: int = 17,
               angles_deg=None, load_n: float = IDEALIZED_LOAD_N) -> Driver:
     """Idealized flexion–extension (preprint 2.2.3.2): the capitate from `flexion_deg` of
