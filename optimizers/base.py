@@ -13,6 +13,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from wrist_env.errors import InputError
+
+
+class OptionError(InputError):
+    """An option a calibrator does not have (the message lists the ones it has)."""
+
 
 @dataclass(frozen=True)
 class OptimizeResult:
@@ -35,12 +41,18 @@ class OptimizeResult:
 class Optimizer(ABC):
     """Base of every calibrator: bounds, budget, seed, bookkeeping of what was told.
 
-    Subclasses implement `_ask(n_max)` → (k, dim) with 1 ≤ k ≤ n_max and
-    `_tell(x, y)`; they read `self.rng` (a seeded numpy Generator) and the
-    bounds `self.lower`, `self.upper` (dim,).
+    Subclasses implement `_ask(n_max)` → (k, dim) with 1 ≤ k ≤ n_max and, if
+    they learn from values, `_tell(x, y)`; they read `self.rng` (a seeded numpy
+    Generator), the bounds `self.lower`, `self.upper` (dim,) and `self.options`,
+    whose names they declare in `OPTIONS` (any other name is an `OptionError`
+    listing these). One that holds a thread or a file releases it in `close()`.
     """
 
     name: str = ""
+    OPTIONS: tuple[str, ...] = ()
+    """The option names this calibrator reads (`self.options`)."""
+    accepts_storage: bool = False
+    """Whether it takes an Optuna `storage` and `study_name` (the benchmark then passes one per cell)."""
 
     def __init__(self, dim: int, budget: int, seed: int = 0, lower=-1.0, upper=1.0, **options):
         if dim < 1 or budget < 1:
@@ -50,6 +62,10 @@ class Optimizer(ABC):
         self.upper = np.broadcast_to(np.asarray(upper, dtype=np.float64), (self.dim,)).copy()
         if not np.all(self.lower < self.upper):
             raise ValueError(f"bounds must satisfy lower < upper, but got {self.lower} and {self.upper}")
+        unknown = sorted(set(options) - set(self.OPTIONS))
+        if unknown:
+            raise OptionError(f"{self.name or type(self).__name__}: unknown option{'s' if len(unknown) > 1 else ''} "
+                              f"{', '.join(unknown)}; its options are: {', '.join(self.OPTIONS) or '(none)'}")
         self.options = dict(options)
         self.rng = np.random.default_rng(self.seed)
         self._xs: list[np.ndarray] = []
@@ -108,8 +124,18 @@ class Optimizer(ABC):
     @abstractmethod
     def _ask(self, n_max: int) -> np.ndarray: ...
 
-    @abstractmethod
-    def _tell(self, x: np.ndarray, y: np.ndarray) -> None: ...
+    def _tell(self, x: np.ndarray, y: np.ndarray) -> None:
+        """Learn from the values y (k,) of x (k, dim); nothing by default (non-adaptive samplers)."""
+
+    def close(self) -> None:
+        """Release threads or files (nothing by default); the optimizer is not used afterwards."""
+
+    def start_point(self) -> np.ndarray:
+        """The `x0` option clipped into the box (dim,), default the box centre."""
+        x0 = self.options.get("x0")
+        if x0 is None:
+            return 0.5 * (self.lower + self.upper)
+        return np.clip(np.broadcast_to(np.asarray(x0, dtype=np.float64), (self.dim,)), self.lower, self.upper)
 
 
 def minimize(optimizer: Optimizer, fun_batch, callback=None) -> OptimizeResult:

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import contextlib
 
-import cma
 import numpy as np
 
 from optimizers.base import Optimizer
@@ -40,11 +39,11 @@ class CMAES(Optimizer):
     A run that stops before the budget (es.stop()) is restarted.
     """
 
+    OPTIONS = ("cma_options", "popsize", "restart", "sigma0", "x0")
+
     def __init__(self, dim: int, budget: int, seed: int = 0, lower=-1.0, upper=1.0, **options):
         super().__init__(dim, budget, seed, lower, upper, **options)
-        x0 = options.get("x0")
-        self.x0 = 0.5 * (self.lower + self.upper) if x0 is None else np.clip(
-            np.broadcast_to(np.asarray(x0, dtype=np.float64), (self.dim,)), self.lower, self.upper)
+        self.x0 = self.start_point()
         self.restart = options.get("restart", "ipop")
         if self.restart not in ("ipop", "plain"):
             raise ValueError(f"restart must be 'ipop' or 'plain', but got {self.restart!r}")
@@ -82,6 +81,8 @@ class CMAES(Optimizer):
         return fraction * float(width[0]) if np.all(width == width[0]) else fraction
 
     def _new_es(self, x0, popsize: int, seed: int):
+        import cma
+
         self._np_state = None  # cma seeds the global state itself
         with self._own_np_random():
             return cma.CMAEvolutionStrategy(np.asarray(x0, dtype=np.float64).tolist(), self.sigma0(),

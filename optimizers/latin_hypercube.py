@@ -19,6 +19,8 @@ class LatinHypercube(Optimizer):
     on the first ask, so it depends only on the seed and the budget.
     """
 
+    OPTIONS = ("batch_size", "optimization", "scramble")
+
     def _ask(self, n_max: int) -> np.ndarray:
         if not hasattr(self, "_design"):
             sampler = qmc.LatinHypercube(self.dim, scramble=bool(self.options.get("scramble", True)),
@@ -26,6 +28,3 @@ class LatinHypercube(Optimizer):
             self._design = qmc.scale(sampler.random(self.budget), self.lower, self.upper)
         k = min(n_max, int(self.options.get("batch_size", 16)))
         return self._design[self.nfev:self.nfev + k]
-
-    def _tell(self, x, y) -> None:
-        pass

@@ -103,11 +103,11 @@ class NelderMead(Optimizer):
     deterministic (independent of the seed); restarts draw from `self.rng`.
     """
 
+    OPTIONS = ("adaptive", "fatol", "perturb", "restart", "simplex_scale", "x0", "xatol")
+
     def __init__(self, dim: int, budget: int, seed: int = 0, lower=-1.0, upper=1.0, **options):
         super().__init__(dim, budget, seed, lower, upper, **options)
-        x0 = options.get("x0")
-        self.x0 = 0.5 * (self.lower + self.upper) if x0 is None else np.clip(
-            np.broadcast_to(np.asarray(x0, dtype=np.float64), (self.dim,)), self.lower, self.upper)
+        self.x0 = self.start_point()
         self.restart = options.get("restart", "random")
         if self.restart not in ("random", "best"):
             raise ValueError(f"restart must be 'random' or 'best', but got {self.restart!r}")

@@ -43,7 +43,6 @@ import os
 import warnings
 
 import numpy as np
-import optuna
 
 from optimizers.base import Optimizer
 from optimizers.registry import register
@@ -51,6 +50,8 @@ from optimizers.registry import register
 
 def _storage(storage):
     """None (in memory), an Optuna storage or URL as they are; a plain path → a journal file."""
+    import optuna
+
     if isinstance(storage, (str, os.PathLike)) and "://" not in str(storage):
         try:
             from optuna.storages.journal import JournalFileBackend
@@ -64,8 +65,12 @@ class OptunaOptimizer(Optimizer):
     """An Optuna sampler behind the ask/tell interface (subclasses choose the sampler)."""
 
     default_batch_size = 1
+    accepts_storage = True
+    OPTIONS = ("batch_size", "n_startup_trials", "storage", "study_name")
 
     def __init__(self, dim: int, budget: int, seed: int = 0, lower=-1.0, upper=1.0, **options):
+        import optuna
+
         super().__init__(dim, budget, seed, lower, upper, **options)
         optuna.logging.set_verbosity(optuna.logging.WARNING)
         self._names = [f"x{i}" for i in range(self.dim)]
@@ -89,6 +94,8 @@ class OptunaOptimizer(Optimizer):
         raise NotImplementedError
 
     def _ask(self, n_max: int) -> np.ndarray:
+        import optuna
+
         k = min(n_max, self.batch_size)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", optuna.exceptions.ExperimentalWarning)
@@ -108,8 +115,11 @@ class OptunaTPE(OptunaOptimizer):
     """Optuna's tree-structured Parzen estimator, with a constant liar for pending trials."""
 
     default_batch_size = 8
+    OPTIONS = OptunaOptimizer.OPTIONS + ("multivariate", "n_ei_candidates")
 
     def _make_sampler(self):
+        import optuna
+
         o = self.options
         return optuna.samplers.TPESampler(seed=self.seed, constant_liar=True,
                                           n_startup_trials=int(o.get("n_startup_trials", 10)),
@@ -121,6 +131,8 @@ class OptunaTPE(OptunaOptimizer):
 class OptunaCMAES(OptunaOptimizer):
     """Optuna's CMA-ES sampler (the `cmaes` package); one generation per batch by default."""
 
+    OPTIONS = OptunaOptimizer.OPTIONS + ("popsize", "restart_strategy", "sigma0", "use_separable_cma")
+
     @property
     def popsize(self) -> int:
         return int(self.options.get("popsize", 4 + math.floor(3 * math.log(self.dim))))
@@ -129,6 +141,8 @@ class OptunaCMAES(OptunaOptimizer):
         return self.popsize
 
     def _make_sampler(self):
+        import optuna
+
         o = self.options
         # one-dimensional spaces: Optuna's CMA-ES falls back to its independent (random) sampler
         return optuna.samplers.CmaEsSampler(seed=self.seed, popsize=self.popsize,
@@ -142,8 +156,11 @@ class OptunaGP(OptunaOptimizer):
     """Optuna's Gaussian-process sampler (log-EI, needs PyTorch); one trial per batch by default."""
 
     default_batch_size = 1
+    OPTIONS = OptunaOptimizer.OPTIONS + ("deterministic_objective",)
 
     def _make_sampler(self):
+        import optuna
+
         o = self.options
         return optuna.samplers.GPSampler(seed=self.seed, n_startup_trials=int(o.get("n_startup_trials", 10)),
                                          deterministic_objective=bool(o.get("deterministic_objective", False)))

@@ -12,9 +12,9 @@ from optimizers.registry import register
 class RandomSearch(Optimizer):
     """Uniform samples in the bounds, `batch_size` per ask (default 16)."""
 
+    OPTIONS = ("batch_size",)
+
     def _ask(self, n_max: int) -> np.ndarray:
         k = min(n_max, int(self.options.get("batch_size", 16)))
         return self.rng.uniform(self.lower, self.upper, (k, self.dim))
 
-    def _tell(self, x, y) -> None:
-        pass

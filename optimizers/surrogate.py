@@ -73,6 +73,8 @@ class _Stop(Exception):
 class Surrogate(Optimizer):
     """RBF surrogate search (MATLAB surrogateopt-like) + L-BFGS-B polish with batched finite differences."""
 
+    OPTIONS = ("batch_size", "fd_step", "n_candidates", "n_init", "perturb_prob", "polish_fraction", "smoothing", "weights")
+
     SIGMA_INIT, SIGMA_MAX, SIGMA_MIN = 0.2, 0.5, 0.2 / 64
 
     def __init__(self, dim: int, budget: int, seed: int = 0, lower=-1.0, upper=1.0, **options):

@@ -18,12 +18,11 @@ from optimizers import Optimizer
 class ThirdPartyRandom(Optimizer):
     """Uniform random points, `batch_size` (default 4) per ask."""
 
+    OPTIONS = ("batch_size",)
+
     def _ask(self, n_max):
         k = min(n_max, int(self.options.get("batch_size", 4)))
         return self.rng.uniform(self.lower, self.upper, (k, self.dim))
-
-    def _tell(self, x, y):
-        pass
 '''
 
 

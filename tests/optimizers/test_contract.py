@@ -143,3 +143,19 @@ class TestContract:
         finally:
             if hasattr(opt, "close"):
                 opt.close()
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_an_unknown_option_is_an_error_listing_the_valid_ones(name, third_party_optimizer):
+    cls = optimizers.get(name)
+    with pytest.raises(optimizers.OptionError, match="unknown option batchsize; its options are") as info:
+        optimizers.make(name, dim=5, budget=10, seed=0, batchsize=4)
+    assert all(o in str(info.value) for o in cls.OPTIONS)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_close_is_safe_before_and_after_use(name, third_party_optimizer):
+    opt = optimizers.make(name, dim=5, budget=3, seed=0)
+    optimizers.minimize(opt, lambda x: np.sum(x ** 2, axis=1))
+    opt.close()
+    opt.close()

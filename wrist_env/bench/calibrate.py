@@ -16,7 +16,6 @@ their logged values are told without simulating), then the run continues.
 
 from __future__ import annotations
 
-import inspect
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -57,24 +56,8 @@ def recovery_error(calibrated: Design, truth: Design) -> float:
 
 
 def accepts_storage(cls) -> bool:
-    """Whether a calibrator class takes an Optuna `storage` option.
-
-    A class may say so with a `accepts_storage` attribute; otherwise its
-    source (and its bases') is searched for the option name.
-    """
-    flag = getattr(cls, "accepts_storage", None)
-    if flag is not None:
-        return bool(flag)
-    for klass in cls.__mro__:
-        if klass is object:
-            continue
-        try:
-            source = inspect.getsource(klass)
-        except (OSError, TypeError):
-            continue
-        if '"storage"' in source or "'storage'" in source:
-            return True
-    return False
+    """Whether a calibrator class takes an Optuna `storage` option (its `accepts_storage` attribute)."""
+    return bool(getattr(cls, "accepts_storage", False))
 
 
 def open_storage(url: str):
@@ -237,9 +220,7 @@ def calibrate(participant: str, optimizer_name: str, budget: int, seed: int, *, 
     try:
         result = optimizers.minimize(optimizer, fun_batch, after_batch)
     finally:
-        close = getattr(optimizer, "close", None)
-        if callable(close):
-            close()
+        optimizer.close()
     if state["nfev"] < len(logged_x):
         raise ResumeError(f"{key.name}: the calibrator stopped after {state['nfev']} evaluations, "
                           f"but {len(logged_x)} are logged")
