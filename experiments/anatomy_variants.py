@@ -3,7 +3,7 @@
 Prints, on this machine (each model built or read from the cache):
 1. for P1 (population design), one Markdown row per anatomy variant: the
    `wrist-bench validate` values and the Monte Carlo designs that fail out of
-   200 (`design.monte_carlo_actions`, seed 7, idealized sweep);
+   200 (`sampler.monte_carlo_actions`, seed 7, idealized sweep);
 2. the same failure count for P1–P3 with the default anatomy;
 3. the share of 1,000 uniform random designs (full bounds, tears; 9-frame
    sweep; the draw of `tests/solver/test_simulate.py`) flagged as failed on P1;
@@ -21,6 +21,7 @@ from scipy.spatial import cKDTree
 from wrist_env import design
 from wrist_env.build.pipeline import BuildParams
 from wrist_env.model import BODY_PARTS, BONES, PAIR_BONES, PAIRS
+from wrist_env.montecarlo import sampler
 from wrist_env.participants.registry import load_model
 from wrist_env.solver import arrays
 from wrist_env.solver.forces import sample_pressures
@@ -37,7 +38,7 @@ VARIANTS = (
 
 
 def monte_carlo_failures(model, n: int = 200, seed: int = 7) -> int:
-    actions = design.monte_carlo_actions(n, np.random.SeedSequence(seed))
+    actions = sampler.monte_carlo_actions(n, np.random.SeedSequence(seed))
     return sum(not r.ok for r in simulate_batch(model, [design.from_action(a) for a in actions], idealized(model)))
 
 

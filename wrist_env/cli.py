@@ -299,6 +299,8 @@ def _montecarlo_report(args) -> int:
 
 def parser() -> argparse.ArgumentParser:
     from wrist_env.build.pipeline import add_anatomy_arguments
+    from wrist_env.design import INJURABLE, SPAN_SD
+    from wrist_env.montecarlo.sampler import EXCLUDE_ABOVE_MPA, TEAR_PROBABILITY
 
     p = argparse.ArgumentParser(prog="wrist-bench", description=__doc__)
     sub = p.add_subparsers(dest="command", required=True)
@@ -433,15 +435,17 @@ def parser() -> argparse.ArgumentParser:
 
     s = command(
         "montecarlo", help="Monte Carlo injury study: n successful idealized sweeps per participant (preprint 2.3.2)",
-        description="Latin hypercube over the 27 design variables (materials from Table 2's normals truncated at "
-                    "+-3 SD, each of SLIL_v, SLIL_p, SLIL_d, RSC, LRL torn with probability 0.3), simulated through "
-                    "the Idealized environment; runs whose radioscaphoid mean pressure exceeds 16.5 MPa at any frame "
-                    "are excluded and, like solver failures, replaced until n runs succeed. Every run is logged to "
-                    "Parquet in --out as its batch finishes; run the same command again to resume.")
+        description=f"Latin hypercube over the 27 design variables (materials from Table 2's normals truncated at "
+                    f"+-{SPAN_SD:g} SD, each of {', '.join(INJURABLE)} torn with probability {TEAR_PROBABILITY:g}), "
+                    f"simulated through the Idealized environment; runs whose radioscaphoid mean pressure exceeds "
+                    f"{EXCLUDE_ABOVE_MPA:g} MPa at any frame are excluded and, like solver failures, replaced until n "
+                    f"runs succeed. Every run is logged to Parquet in --out as its batch finishes; run the same "
+                    f"command again to resume.")
     s.add_argument("participants", nargs="+")
     s.add_argument("--n", type=int, default=12500, help="successful runs per participant (default 12500)")
     s.add_argument("--seed", type=int, default=0, help="study seed (default 0)")
-    s.add_argument("--tear-probability", type=float, default=0.3, help="chance of each tear (default 0.3)")
+    s.add_argument("--tear-probability", type=float, default=TEAR_PROBABILITY,
+                   help=f"chance of each tear (default {TEAR_PROBABILITY:g})")
     s.add_argument("--out", default="runs/montecarlo", help="run-log folder (default runs/montecarlo)")
     s.add_argument("--scheduler", help="dask.distributed scheduler address (e.g. tcp://host:8786); one task per batch")
     s.add_argument("--batch", type=int, default=64, help="runs per batch: one vector-env step, one log part (default 64)")

@@ -13,7 +13,7 @@ from wrist_env.montecarlo.study import StudyConfig, _chunks, _plan
 def test_tear_rate_is_0_3_and_tears_are_independent():
     a = sampler.block_actions(0, "P1", 0, 2000)
     torn = a[:, design.N_MATERIAL:] < 0
-    assert set(np.unique(a[:, design.N_MATERIAL:])) == {design.TORN_ACTION, design.INTACT_ACTION}
+    assert set(np.unique(a[:, design.N_MATERIAL:])) == {sampler.TORN_ACTION, sampler.INTACT_ACTION}
     assert np.all(np.abs(torn.mean(axis=0) - 0.3) <= 0.02), torn.mean(axis=0)
     for i in range(5):
         for j in range(i + 1, 5):
@@ -23,7 +23,7 @@ def test_tear_rate_is_0_3_and_tears_are_independent():
 
 def test_each_latin_hypercube_stratum_is_hit_once_per_dimension():
     n = 500
-    u = design.latin_hypercube(n, np.random.SeedSequence(3))
+    u = sampler.latin_hypercube(n, np.random.SeedSequence(3))
     assert u.shape == (n, design.N_DESIGN)
     for k in range(design.N_DESIGN):
         assert np.array_equal(np.sort(np.floor(u[:, k] * n).astype(int)), np.arange(n))
@@ -57,11 +57,11 @@ def test_blocks_are_seeded_by_seed_participant_and_block():
 
 def test_unit_points_are_checked():
     with pytest.raises(DesignError):
-        design.monte_carlo_from_unit(np.zeros((3, 26)))
+        sampler.monte_carlo_from_unit(np.zeros((3, 26)))
     with pytest.raises(DesignError):
-        design.monte_carlo_from_unit(np.full((3, 27), 1.5))
+        sampler.monte_carlo_from_unit(np.full((3, 27), 1.5))
     with pytest.raises(DesignError):
-        design.monte_carlo_from_unit(np.zeros((3, 27)), tear_probability=1.2)
+        sampler.monte_carlo_from_unit(np.zeros((3, 27)), tear_probability=1.2)
 
 
 def test_rounds_replace_excluded_and_failed_runs_with_fresh_blocks():

@@ -37,9 +37,10 @@ class ResumeError(RuntimeError):
 
 
 def action(x) -> np.ndarray:
-    """The 27-variable action of 22 normalized materials, injury scalars intact (+1)."""
-    x = np.asarray(x, dtype=np.float64)
-    return np.concatenate([x, np.ones(x.shape[:-1] + (N_DESIGN - N_MATERIAL,))], axis=-1)
+    """The 27-variable action(s) of 22 normalized materials (..., 22), injury scalars intact (+1)."""
+    from wrist_env.envs.wrappers import full_action
+
+    return full_action(x)
 
 
 def rmse_vector(info: dict) -> np.ndarray:

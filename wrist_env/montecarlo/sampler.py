@@ -1,6 +1,6 @@
 """The Monte Carlo sampler: seeded Latin-hypercube blocks of designs, run through the Idealized environment.
 
-Draws (preprint 2.3.2; the distributions are `wrist_env.design.monte_carlo_actions`):
+Draws (preprint 2.3.2; the distributions are `monte_carlo_actions`):
 a participant's runs come in blocks; block b is a Latin hypercube over all 27
 variables of its own size, seeded by `block_seed(seed, participant, b)` —
 a `numpy.random.SeedSequence` of the study seed with the spawn key
@@ -36,7 +36,56 @@ import numpy as np
 import pyarrow as pa
 
 from wrist_env import design
-from wrist_env.design import INJURABLE, LIGAMENT_NAMES, NAMES
+from wrist_env.errors import DesignError
+from wrist_env.design import INJURABLE, LIGAMENT_NAMES, N_DESIGN, N_MATERIAL, NAMES, SPAN_SD
+
+TEAR_PROBABILITY = 0.3
+"""Chance that each injurable ligament is torn in a Monte Carlo run (preprint 2.3.2)."""
+TORN_ACTION, INTACT_ACTION = -0.5, 1.0
+"""Normalized injury scalars the Monte Carlo study gives a torn and an intact ligament."""
+
+
+def monte_carlo_from_unit(u, *, tear_probability: float = TEAR_PROBABILITY,
+                          truncate_sd: float = SPAN_SD) -> np.ndarray:
+    """Normalized actions of shape (n, 27) from points `u` of shape (n, 27) in [0, 1).
+
+    Materials (the first 22 columns): Table 2's normals truncated at ±`truncate_sd` by
+    inverse CDF, in action units (z / SPAN_SD). Injury scalars (the last 5): torn
+    (`TORN_ACTION`) where u < `tear_probability`, else intact (`INTACT_ACTION`).
+    """
+    from scipy.stats import truncnorm
+
+    u = np.asarray(u, dtype=np.float64)
+    if u.ndim != 2 or u.shape[1] != N_DESIGN:
+        raise DesignError(f"unit points must have shape (n, {N_DESIGN}), but got {u.shape}.")
+    if not np.all((u >= 0.0) & (u <= 1.0)):
+        raise DesignError("unit points must lie in [0, 1].")
+    if not 0.0 <= tear_probability <= 1.0:
+        raise DesignError(f"tear_probability must be in [0, 1], but got {tear_probability!r}.")
+    a = np.empty_like(u)
+    a[:, :N_MATERIAL] = truncnorm.ppf(u[:, :N_MATERIAL], -truncate_sd, truncate_sd) / SPAN_SD
+    a[:, N_MATERIAL:] = np.where(u[:, N_MATERIAL:] < tear_probability, TORN_ACTION, INTACT_ACTION)
+    return np.clip(a, -1.0, 1.0)
+
+
+def latin_hypercube(n: int, seed) -> np.ndarray:
+    """A seeded Latin hypercube of shape (n, 27) in [0, 1) (`scipy.stats.qmc.LatinHypercube`):
+    in every column each of the n strata [k/n, (k+1)/n) holds exactly one point.
+    `seed`: an int, a `numpy.random.SeedSequence` or a `Generator`."""
+    from scipy.stats import qmc
+
+    if isinstance(seed, np.random.SeedSequence):
+        seed = np.random.default_rng(seed)
+    return qmc.LatinHypercube(d=N_DESIGN, rng=seed).random(int(n))
+
+
+def monte_carlo_actions(n: int, seed, *, tear_probability: float = TEAR_PROBABILITY) -> np.ndarray:
+    """The Monte Carlo study's normalized actions of shape (n, 27) (preprint 2.3.2): a seeded
+    Latin hypercube over all 27 variables, mapped by `monte_carlo_from_unit` (materials from
+    Table 2's normals truncated at ±3 SD, each injurable ligament torn with `tear_probability`
+    independently)."""
+    return monte_carlo_from_unit(latin_hypercube(n, seed), tear_probability=tear_probability)
+
 
 EXCLUDE_ABOVE_MPA = 16.5
 RS_PAIR = "radioscaphoid"
@@ -74,9 +123,9 @@ def block_seed(seed: int, participant: str, block: int) -> np.random.SeedSequenc
 
 
 def block_actions(seed: int, participant: str, block: int, size: int,
-                  tear_probability: float = design.TEAR_PROBABILITY) -> np.ndarray:
+                  tear_probability: float = TEAR_PROBABILITY) -> np.ndarray:
     """Normalized actions (size, 27) of one block: a Latin hypercube of `size` points."""
-    return design.monte_carlo_actions(size, block_seed(seed, participant, block), tear_probability=tear_probability)
+    return monte_carlo_actions(size, block_seed(seed, participant, block), tear_probability=tear_probability)
 
 
 _ENVS: dict = {}

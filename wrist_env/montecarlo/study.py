@@ -62,7 +62,7 @@ class StudyConfig:
     participants: tuple[str, ...]
     n: int
     seed: int = 0
-    tear_probability: float = design.TEAR_PROBABILITY
+    tear_probability: float = sampler.TEAR_PROBABILITY
     exclude_above_mpa: float = sampler.EXCLUDE_ABOVE_MPA
     max_attempts: int | None = None
     """Give up (StudyError) after this many runs of one participant; default 5 n + 100."""
