@@ -1,0 +1,132 @@
+"""The leaderboard's COCO-style figures: convergence (best cost so far) and the ECDF of targets solved."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from wrist_env.bench.leaderboard.tables import hit
+
+
+def colors(labels) -> dict:
+    import matplotlib
+
+    cmap = matplotlib.colormaps["tab10"]
+    return {label: cmap(i % 10) for i, label in enumerate(labels)}
+
+
+def convergence_figure(path, board, colors) -> None:
+    """Best cost so far against evaluations: median and IQR band per calibrator, a panel per participant."""
+    import matplotlib.pyplot as plt
+
+    runs_frame, curves, refs, participants, labels, budgets = (board.runs_frame, board.curves, board.refs,
+                                                               board.participants, board.labels, board.budgets)
+
+    n = len(participants)
+    ncols = min(n, 3)
+    nrows = -(-n // ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(4.6 * ncols + 0.4, 4.0 * nrows + 0.5), squeeze=False,
+                             constrained_layout=True)
+    for ax in axes.flat[n:]:
+        ax.set_visible(False)
+    for ax, p in zip(axes.flat, participants):
+        lows = []
+        for label in labels:
+            sub = runs_frame[(runs_frame.participant == p) & (runs_frame.calibrator == label)]
+            cs = [curves[(r.participant, r.optimizer, r.seed, r.budget)] for r in sub.itertuples()
+                  if (r.participant, r.optimizer, r.seed, r.budget) in curves]
+            if not cs:
+                continue
+            length = max(len(c) for c in cs)
+            stack = np.array([np.concatenate([c, np.full(length - len(c), c[-1])]) for c in cs])
+            x = np.arange(1, length + 1)
+            q25, med, q75 = np.quantile(stack, [0.25, 0.5, 0.75], axis=0)
+            lows.append(float(q25.min()))
+            ax.plot(x, med, color=colors[label], lw=1.8, label=f"{label} ({len(cs)} run{'s' if len(cs) > 1 else ''})")
+            ax.fill_between(x, q25, q75, color=colors[label], alpha=0.18, lw=0)
+        pop = refs[p].population["calibrate"]["cost"]
+        ax.axhline(pop, color="0.35", ls="--", lw=1)
+        ax.text(0.99, pop, "population", color="0.35", fontsize=8, ha="right", va="bottom",
+                transform=ax.get_yaxis_transform())
+        if refs[p].truth is not None:
+            truth = refs[p].truth["calibrate"]["cost"]
+            ax.axhline(truth, color="0.1", ls=":", lw=1.2)
+            ax.text(0.01, truth, "hidden truth", color="0.1", fontsize=8, ha="left", va="top",
+                    transform=ax.get_yaxis_transform())
+        ax.set_yscale("log")
+        low = min([refs[p].truth["calibrate"]["cost"] if refs[p].truth is not None else np.inf] + lows) * 0.85
+        ax.set_ylim(low, 1.6 * pop)  # failed runs (cost 1000) would squash the interesting range
+        _plain_log_ticks(ax.yaxis, subs=(1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 7.0))
+        ax.set_title(f"{p}: calibration trial")
+        ax.set_xlabel("evaluations")
+        ax.grid(True, which="both", alpha=0.25)
+        ax.set_xlim(1, max(budgets))
+    for row in axes:
+        row[0].set_ylabel("best cost so far (median, IQR band over seeds)")
+    handles, names = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, names, loc="outside lower center", ncol=min(4, max(1, len(names))), fontsize=9, frameon=False)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _plain_log_ticks(axis, subs=(1.0, 2.0, 5.0)) -> None:
+    """Log-axis ticks as plain numbers (1, 2, 5, 10, …) instead of 2 × 10^0."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    axis.set_major_locator(LogLocator(base=10, subs=subs))
+    axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    axis.set_minor_formatter(NullFormatter())
+
+
+def ecdf_figure(path, board, colors) -> None:
+    """COCO-style ECDF of (run, target) pairs solved against evaluations."""
+    import matplotlib.pyplot as plt
+
+    runs_frame, targets, curves, participants, labels, budgets = (board.runs_frame, board.targets, board.curves,
+                                                                  board.participants, board.labels, board.budgets)
+
+    groups = [("all participants", participants)] + ([(p, [p]) for p in participants] if len(participants) > 1 else [])
+    n = len(groups)
+    ncols = n if n <= 3 else 2 if n == 4 else 3
+    nrows = -(-n // ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(4.6 * ncols + 0.4, 3.9 * nrows + 0.5), squeeze=False,
+                             constrained_layout=True, sharey=True)
+    for ax in axes.flat[n:]:
+        ax.set_visible(False)
+    top = max(budgets)
+    grid = np.unique(np.round(np.geomspace(1, top, 200)).astype(int))
+    for ax, (name, members) in zip(axes.flat, groups):
+        n_targets = 0
+        for label in labels:
+            hits, pairs = [], 0
+            for p in members:
+                sub = runs_frame[(runs_frame.participant == p) & (runs_frame.calibrator == label)]
+                ts = targets[targets.participant == p]
+                for r in sub.itertuples():
+                    curve = curves.get((r.participant, r.optimizer, r.seed, r.budget))
+                    if curve is None:
+                        continue
+                    for t in ts.itertuples():
+                        pairs += 1
+                        h = hit(curve, t.value)
+                        if h is not None:
+                            hits.append(h)
+            if not pairs:
+                continue
+            n_targets = max(n_targets, len(targets[targets.participant.isin(members)]))
+            hits = np.sort(np.array(hits))
+            frac = np.searchsorted(hits, grid, side="right") / pairs
+            ax.step(grid, frac, where="post", color=colors[label], lw=1.8, label=label)
+        ax.set_xscale("log")
+        ax.set_xlim(1, top)
+        _plain_log_ticks(ax.xaxis)
+        ax.set_ylim(0, 1.02)
+        ax.set_xlabel("evaluations")
+        ax.set_title(f"{name} ({n_targets} targets)")
+        ax.grid(True, which="both", alpha=0.25)
+    for row in axes:
+        row[0].set_ylabel("fraction of (run, target) pairs solved")
+        row[0].tick_params(labelleft=True)
+    handles, names = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, names, loc="outside lower center", ncol=min(5, max(1, len(names))), fontsize=9, frameon=False)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

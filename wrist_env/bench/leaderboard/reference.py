@@ -1,0 +1,47 @@
+"""The reference designs a leaderboard compares against: the population and the hidden truth, scored."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from wrist_env.cost import COST_BONES
+from wrist_env.frames import DOF_NAMES
+
+
+@dataclass
+class Reference:
+    """A participant's population (and, if built in, hidden-truth) design scored on both trials."""
+
+    participant: str
+    population: dict  # {"calibrate": score, "validate": score}; score = {"cost", "failed", "rmse"}
+    truth: dict | None
+
+
+def _score(evaluation) -> dict:
+    return {"cost": float(evaluation.cost), "failed": bool(evaluation.failed), "rmse": evaluation.info.get("rmse")}
+
+
+def reference(participant: str) -> Reference:
+    """Simulate the population design (and the hidden truth) on the calibration and held-out trials."""
+    from wrist_env import design
+    from wrist_env.envs.task import task
+    from wrist_env.participants import builtin
+
+    designs = {"population": design.population()}
+    if participant in builtin.BUILTIN:
+        designs["truth"] = builtin.truth(participant)
+    scores = {name: {m: _score(task(participant, m).evaluate(d)) for m in ("calibrate", "validate")}
+              for name, d in designs.items()}
+    return Reference(participant, scores["population"], scores.get("truth"))
+
+
+def rmse_array(rmse: dict | None) -> np.ndarray:
+    """{bone: {DOF: value}} → (2, 6) in COST_BONES × DOF_NAMES order (NaN when missing)."""
+    out = np.full((len(COST_BONES), len(DOF_NAMES)), np.nan)
+    for b, bone in enumerate(COST_BONES):
+        for d, dof in enumerate(DOF_NAMES):
+            v = ((rmse or {}).get(bone) or {}).get(dof)
+            out[b, d] = np.nan if v is None else v
+    return out
