@@ -8,7 +8,7 @@ import sys
 import time
 from pathlib import Path
 
-FIGURES = Path("experiments") / "figures"
+FIGURES_HELP = "$WRIST_ENV_FIGURES or experiments/figures"  # wrist_env.figures.draw.FIGURES (no matplotlib import here)
 
 
 def _participants(args) -> int:
@@ -155,7 +155,9 @@ def _validate(args) -> int:
     report = validation.validate(args.participant, params=params,
                                  load_n=IDEALIZED_LOAD_N if args.load is None else args.load)
     variant = "" if params == BuildParams() and args.load is None else "_variant"
-    out = Path(args.out or FIGURES) / f"validation_{report.participant}{variant}.png"
+    from wrist_env.figures.draw import FIGURES as figures_dir
+
+    out = Path(args.out or figures_dir) / f"validation_{report.participant}{variant}.png"
     figure = validation.validation_figure(report, out)
     if args.json:
         print(json.dumps(dict(report.to_dict(), figure=str(figure)), indent=1, allow_nan=False))
@@ -231,7 +233,7 @@ def _benchmark(args) -> int:
     import optimizers
     from wrist_env.bench.leaderboard import write_leaderboard
     from wrist_env.bench.runner import benchmark, make_cells
-    from wrist_env.participants import builtin, registry
+    from wrist_env.participants import builtin
 
     participants = args.participants or list(builtin.BUILTIN)
     names = args.optimizers or list(optimizers.available())
@@ -260,7 +262,6 @@ def _benchmark(args) -> int:
 
 def _leaderboard(args) -> int:
     from wrist_env.bench.leaderboard import write_leaderboard
-    from wrist_env.participants import registry
 
     if not Path(args.runs).is_dir():
         raise SystemExit(f"wrist-bench leaderboard: no run log at {args.runs}")
@@ -369,7 +370,7 @@ def parser() -> argparse.ArgumentParser:
                     "fails.")
     s.add_argument("participant")
     s.add_argument("--json", action="store_true", help="print the checks and series as JSON")
-    s.add_argument("--out", help=f"figure folder (default {FIGURES})")
+    s.add_argument("--out", help=f"figure folder (default {FIGURES_HELP})")
     add_anatomy_arguments(s)
     s.add_argument("--load", type=float, help="compressive load on the capitate in the sweeps, N (default: the idealized "
                                               "driver's; the load-share check always takes 100 N)")

@@ -23,7 +23,6 @@ from wrist_env import design as design_mod
 from wrist_env.model import BONES, PAIRS
 from wrist_env.solver.simulate import IDEALIZED_LOAD_N
 
-FIGURES = Path("experiments") / "figures"
 
 SLIL = ("SLIL_v", "SLIL_p", "SLIL_d")
 EXTENSION_30_DEG = -30.0  # flexion + / extension −, as the idealized driver's angle_deg
@@ -277,6 +276,8 @@ def validation_figure(report: Report, out: Path | None = None) -> Path:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    from wrist_env.figures.draw import FIGURES
 
     out = Path(out) if out else FIGURES / f"validation_{report.participant}.png"
     out.parent.mkdir(parents=True, exist_ok=True)

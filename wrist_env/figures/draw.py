@@ -1,0 +1,53 @@
+"""What every figure shares: the output folder, colours, the RCS-to-plot axes, mesh drawing."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
+
+from wrist_env.design import ALL_LIGAMENT_NAMES  # noqa: E402
+
+FIGURES = Path(os.environ.get("WRIST_ENV_FIGURES", Path("experiments") / "figures"))
+"""Default folder of every figure: `$WRIST_ENV_FIGURES`, else experiments/figures under the working
+directory (the repository's, where the README's figures live)."""
+BONE_COLOUR = {"radius": "#d9cfc1", "ulna": "#d9cfc1", "scaphoid": "#e8dcc8", "lunate": "#e3d5bd", "capitate": "#eadfcf"}
+VIEWS = (("volar view", 0, 0), ("radial view", 0, 90), ("oblique", 25, 40))
+LIGAMENT_COLOURS = dict(zip(ALL_LIGAMENT_NAMES, plt.get_cmap("tab10").colors + ("#000000", "#7a5195", "#ef5675")))
+
+
+def to_plot(p):
+    """RCS (x volar, y proximal, z radial) to plot axes (radial right, volar towards the viewer, proximal up)."""
+    p = np.asarray(p)
+    return np.stack([p[..., 2], -p[..., 0], p[..., 1]], axis=-1)
+
+
+def add_mesh(ax, vertices, faces, colour, alpha=1.0, facecolors=None):
+    tris = to_plot(vertices[faces])
+    coll = Poly3DCollection(tris, facecolors=facecolors if facecolors is not None else colour,
+                            linewidths=0, alpha=alpha, shade=True, lightsource=matplotlib.colors.LightSource(45, 45))
+    ax.add_collection3d(coll)
+
+
+def frame_axes(ax, points, title):
+    p = to_plot(points)
+    centre = (p.max(axis=0) + p.min(axis=0)) / 2
+    half = (p.max(axis=0) - p.min(axis=0)).max() / 2
+    for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
+        setter(c - half, c + half)
+    ax.set_box_aspect((1, 1, 1), zoom=1.3)
+    ax.set_xlabel("radial (mm)")
+    ax.set_ylabel("dorsal (mm)")
+    ax.set_zlabel("proximal (mm)")
+    ax.set_title(title)
+
+
+def crop(vertices, faces, y_max):
+    return faces[(vertices[faces][:, :, 1] < y_max).all(axis=1)]
+
