@@ -34,7 +34,8 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from wrist_env.errors import InputError
-from wrist_env.frames import DOF_NAMES, DOF_UNITS, error_dof, pose_to_dof, validate_points, validate_poses
+from wrist_env.frames import (DOF_NAMES, DOF_UNITS, error_dof_validated, pose_to_dof_validated, validate_points,
+                              validate_poses)
 
 COST_BONES = ("scaphoid", "lunate")
 PERCENTILE = 75.0
@@ -172,12 +173,12 @@ def kinematic_cost(
         raise InputError(f"model poses: must have the shape of the experimental poses {experiment.shape}, but got {model.shape}.")
     points = _reference_points(reference_points)[:, None, :]  # (2, 1, 3): broadcast over frames
 
-    exp_range = np.ptp(pose_to_dof(experiment, points), axis=1)
+    exp_range = np.ptp(pose_to_dof_validated(experiment, points), axis=1)
     normalizer = np.maximum(exp_range, floor)
     if np.isfinite(model).all():
         model = validate_poses(model, "model poses")
         with np.errstate(over="ignore", invalid="ignore"):
-            error = error_dof(model, experiment, points, expressed_in=expressed_in)
+            error = error_dof_validated(model, experiment, points, expressed_in=expressed_in)
             p75 = np.percentile(np.abs(error), PERCENTILE, axis=1)
             terms = weights.as_array() * p75 / normalizer
             total = float(terms.sum())

@@ -185,6 +185,10 @@ def error_transform(model, experiment, *, expressed_in: str = "bone") -> np.ndar
     m = validate_poses(model, "model poses")
     e = validate_poses(experiment, "experimental poses")
     _same_shape(m, e)
+    return _error_transform(m, e, expressed_in)
+
+
+def _error_transform(m: np.ndarray, e: np.ndarray, expressed_in: str) -> np.ndarray:
     if expressed_in == "bone":
         return invert(e) @ m
     if expressed_in == "rcs":
@@ -201,12 +205,26 @@ def error_dof(model, experiment, reference_point=None, *, expressed_in: str = "b
     "bone": R_expᵀ · (T_model·c − T_exp·c), angles of R_expᵀ·R_model (experimental bone's axes);
     "rcs":  T_model·c − T_exp·c, angles of R_model·R_expᵀ (RCS axes).
     """
+    m = validate_poses(model, "model poses")
     e = validate_poses(experiment, "experimental poses")
-    error = error_transform(model, e, expressed_in=expressed_in)
+    _same_shape(m, e)
     c = np.zeros(3) if reference_point is None else validate_points(reference_point)
-    point = c if expressed_in == "bone" else apply(e, c)
+    return error_dof_validated(m, e, c, expressed_in=expressed_in)
+
+
+def error_dof_validated(model: np.ndarray, experiment: np.ndarray, point: np.ndarray, *,
+                        expressed_in: str = "bone") -> np.ndarray:
+    """`error_dof` of inputs already checked (`validate_poses` of both, one shape; `validate_points`):
+    for callers that validate once and evaluate many times (the cost)."""
+    error = _error_transform(model, experiment, expressed_in)
+    c = point if expressed_in == "bone" else apply(experiment, point)
     # not re-validated: a product of two poses within the orthonormality tolerance may exceed it
-    return _dof(error, point)
+    return _dof(error, c)
+
+
+def pose_to_dof_validated(poses: np.ndarray, point: np.ndarray) -> np.ndarray:
+    """`pose_to_dof` of poses and a point already checked (`validate_poses`, `validate_points`)."""
+    return _dof(poses, point)
 
 
 def rmse(model, experiment, reference_point=None, *, expressed_in: str = "bone") -> np.ndarray:

@@ -96,15 +96,16 @@ def outputs(result: Result, report=None) -> dict:
     def clean(a):
         return np.nan_to_num(np.asarray(a, dtype=np.float64), nan=0.0)
 
+    contact, bundle, energy = clean(result.contact), clean(result.bundle_force), clean(result.energy)
     info = {
         "failed": not result.ok,
         "status": result.message,
         "poses": clean(result.poses),
-        "contact": {pair: {field: clean(result.contact[:, p, k]) for k, field in enumerate(CONTACT_FIELDS)}
+        "contact": {pair: {field: contact[:, p, k] for k, field in enumerate(CONTACT_FIELDS)}
                     for p, pair in enumerate(PAIRS)},
-        "bundle_force_n": {lig: clean(result.bundle_force[:, i]) for i, lig in enumerate(ALL_LIGAMENT_NAMES)},
-        "kinetic_energy_nmm": clean(result.energy[:, 0]),
-        "internal_energy_nmm": clean(result.energy[:, 1]),
+        "bundle_force_n": {lig: bundle[:, i] for i, lig in enumerate(ALL_LIGAMENT_NAMES)},
+        "kinetic_energy_nmm": energy[:, 0],
+        "internal_energy_nmm": energy[:, 1],
         "steps": np.asarray(result.steps, dtype=np.int64),
     }
     if report is not None:
