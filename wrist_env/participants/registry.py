@@ -11,8 +11,6 @@ import os
 import warnings
 from pathlib import Path
 
-import numpy as np
-
 from wrist_env.anatomy.template import BoneSurface, carry_parts, load_template
 from wrist_env.build.pipeline import BuildParams, build_model, source_hash
 from wrist_env.errors import ParticipantError, StoreError
@@ -51,10 +49,10 @@ def bones(name: str, params: BuildParams | None = None) -> dict:
         return builtin.bones(name, *params.anatomy)
     if name not in _FOLDERS:
         raise ParticipantError(f"unknown participant {name!r}; known: {list(participants())}")
-    from wrist_env.participants.folder import load_participant_folder
+    from wrist_env.participants.folder import load_participant_folder, solid_mask
 
     source = load_participant_folder(_FOLDERS[name])
-    principal = {b: BoneSurface(b, v, f, np.ones(len(v), bool)) for b, (v, f) in source.bones.items()}
+    principal = {b: BoneSurface(b, v, f, solid_mask(v, f)) for b, (v, f) in source.bones.items()}
     return carry_parts(principal, load_template()) if params.distal_row else principal
 
 
