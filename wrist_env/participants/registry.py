@@ -13,7 +13,7 @@ from pathlib import Path
 
 from wrist_env.anatomy.template import BoneSurface, carry_parts, load_template
 from wrist_env.build.pipeline import BuildParams, build_model, source_hash
-from wrist_env.errors import ParticipantError, StoreError
+from wrist_env.errors import BuildError, ParticipantError, StoreError
 from wrist_env.model import BONES, Model
 from wrist_env.participants import builtin
 
@@ -91,7 +91,12 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
             return model
         except StoreError as e:
             warnings.warn(f"rebuilding a damaged cached model: {e}", stacklevel=2)
-    model = build_model(name, b, params)
+    try:
+        model = build_model(name, b, params)
+    except BuildError as e:
+        if name in _FOLDERS:  # name the folder's file
+            raise BuildError(f"{_FOLDERS[name] / 'participant.toml'}: {e}") from e
+        raise
     if cache:
         model.save(path)
     return model
