@@ -110,3 +110,22 @@ def test_tracked_centroid_is_the_principal_bones_and_parts_recover_it(built, nam
         assert np.linalg.norm(model.centroid[BONES.index(body)] - model.com[BONES.index(body)]) > 1.0, body
     sizes = [len(model.part_mesh(p)[0]) for p in ("triquetrum", "trapezium", "trapezoid", "hamate")]
     assert min(sizes) > 100, sizes
+
+
+def test_implausible_joint_spaces_stop_the_build():
+    """Each articulation outside its plausible range (or with none measured) is named with its value and
+    range; the built-in participants' 1.5–2.5 mm pass, and the scapholunate may be a dissociated 6 mm."""
+    from wrist_env.build.pipeline import _check_joint_spaces
+    from wrist_env.errors import BuildError
+
+    normal = dict(zip(PAIRS, (1.83, 1.71, 1.72, 2.31, 1.55)))
+    _check_joint_spaces("P1", normal)
+    _check_joint_spaces("P1", normal | {"scapholunate": 6.0})
+    mirrored = dict(zip(PAIRS, (1.50, 14.39, 15.06, 14.82, 4.21)))  # a right wrist declared left (issue 11)
+    with pytest.raises(BuildError, match=r"participant 'U1': implausible joint spaces in the neutral pose: "
+                                         r"radiolunate 14.39 mm \(plausible 0.3–4 mm\); scapholunate 15.06 mm "
+                                         r"\(plausible 0.3–8 mm\); scaphocapitate 14.82 mm .*; lunocapitate 4.21 mm"
+                                         r".*check `side`"):
+        _check_joint_spaces("U1", mirrored)
+    with pytest.raises(BuildError, match=r"radioscaphoid 0.10 mm .*; radiolunate none \(plausible 0.3–4 mm\)"):
+        _check_joint_spaces("U1", normal | {"radioscaphoid": 0.1, "radiolunate": None})

@@ -1,13 +1,17 @@
 """Participant folders: round trip, left-wrist mirroring, and one test per validation rule."""
 
+import dataclasses
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
 import trimesh
 from scipy.spatial.transform import Rotation
 
+from wrist_env.build.pipeline import BuildParams
 from wrist_env.errors import MeshError, ParticipantError, TrialError
+from wrist_env.participants import builtin, folder as folder_module, registry
 from wrist_env.participants.folder import ParticipantSource, load_participant_folder, write_participant_folder
 from wrist_env.trial import MIRROR, Trial
 
@@ -297,7 +301,7 @@ def test_non_watertight_mesh(folder):
 def test_zero_area_faces(folder):
     vertices, faces = bone_meshes()["lunate"]
     replace_mesh(folder, "lunate", vertices, np.vstack([faces, [[0, 0, 1], [2, 2, 3]]]))
-    with raises(MeshError, folder / "bones" / "lunate.stl", "has 2 zero-area faces"):
+    with raises(MeshError, folder / "bones" / "lunate.stl", r"has 2 degenerate faces \(zero area or slivers.*face 320 = \[(\d+), \1, \d+\], area 0 mm²"):
         load_participant_folder(folder)
 
 
@@ -362,3 +366,150 @@ def test_bad_trial_csv_names_its_file(folder):
     path.write_text(path.read_text().replace(",lunate,", ",hamate,", 1))
     with raises(TrialError, path, "line 5 has 'hamate'"):
         load_participant_folder(folder)
+
+
+# --- meshes that passed or got the wrong message before (issue 11): a table of bad folders ----------
+
+
+def sliver_lunate():
+    """The lunate with face 0 (a, b, c) split at the midpoint m of its edge ab, stored as float32 (as an
+    STL is): faces (a, m, c), (m, b, c) and the sliver (a, b, m), last, of area ~2e-7 mm² — not zero,
+    since rounding moves m off the line ab — and height ~2e-7 mm."""
+    vertices, faces = bone_meshes()["lunate"]
+    a, b, c = faces[0]
+    vertices = np.vstack([vertices, (vertices[a] + vertices[b]) / 2]).astype(np.float32).astype(np.float64)
+    m = len(vertices) - 1
+    return vertices, np.vstack([faces[1:], [[a, m, c], [m, b, c], [a, b, m]]])
+
+
+def flat_lunate():
+    """The lunate turned and pressed into the plane z = −2: closed, wound consistently, no two vertices
+    merged and no face of zero area, but of volume 0 (once blamed on inverted winding)."""
+    vertices, faces = bone_meshes()["lunate"]
+    centre = vertices.mean(axis=0)
+    vertices = (vertices - centre) @ Rotation.from_euler("xy", [20, 35], degrees=True).as_matrix().T + centre
+    vertices[:, 2] = -2.0
+    return vertices, faces
+
+
+def pillow_lunate(n: int = 12):
+    """Two sheets on the curved surface z = (x² + y²) / 40 sharing their rim, the lower one's inner vertices
+    1 µm below the upper's: closed and wound outward, not flat, but enclosing almost nothing."""
+    xs = np.linspace(-10, 10, n)
+    x, y = (a.ravel() for a in np.meshgrid(xs, xs, indexing="ij"))
+    top = np.column_stack([x, y - 10, (x**2 + y**2) / 40])
+    inner = (np.abs(x) < 10) & (np.abs(y) < 10)
+    vertices = np.vstack([top, top[inner] - [0, 0, 1e-3]])
+    lower = np.arange(n * n)
+    lower[inner] = n * n + np.arange(inner.sum())
+    i, j = (a.ravel() for a in np.meshgrid(np.arange(n - 1), np.arange(n - 1), indexing="ij"))
+    p00, p01, p10, p11 = ((i + di) * n + j + dj for di, dj in ((0, 0), (0, 1), (1, 0), (1, 1)))
+    towards_centre = ((i < (n - 1) / 2) == (j < (n - 1) / 2))[:, None]  # so no face has three rim vertices
+    cells = np.vstack([np.where(towards_centre, np.column_stack([p00, p10, p11]), np.column_stack([p00, p10, p01])),
+                       np.where(towards_centre, np.column_stack([p00, p11, p01]), np.column_stack([p10, p11, p01]))])
+    return vertices, np.vstack([cells, lower[cells][:, ::-1]])
+
+
+def open_radius():
+    """The radius capsule with one face removed: open, and no closed part left."""
+    vertices, faces = bone_meshes()["radius"]
+    return vertices, faces[1:]
+
+
+def nan_lunate():
+    vertices, faces = bone_meshes()["lunate"]
+    vertices = vertices.copy()
+    vertices[5, 1] = np.nan
+    return vertices, faces
+
+
+NAN_FACE = int(np.flatnonzero((bone_meshes()["lunate"][1] == 5).any(axis=1))[0])
+NAN_CORNER = int(np.flatnonzero(bone_meshes()["lunate"][1][NAN_FACE] == 5)[0])
+
+BAD_MESHES = {  # case: (bone, mesh, file suffix, message after the file name)
+    "sliver": ("lunate", sliver_lunate, "stl",
+               r"1 degenerate faces \(zero area or slivers: least height below 1e-06 × its diagonal = 2.8e-05 mm\) "
+               r"\(first: face 321 = \[\d+, \d+, 162\], area [0-9.]+e-07 mm², height [0-9.]+e-07 mm\)"),
+    "flat": ("lunate", flat_lunate, "stl", "is flat: its vertices lie within 0 mm of one plane"),
+    "no volume": ("lunate", pillow_lunate, "stl", r"encloses almost no volume: 0.3\d+ mm³ inside 86\d.\d mm² of surface \(a flat or folded sheet"),
+    "NaN, STL": ("lunate", nan_lunate, "stl", rf"5 triangle corners are not \(first: triangle {NAN_FACE}, corner "
+                                               rf"{NAN_CORNER} = \[0.0, nan, [0-9.]+\]; indices 0-based, in file order\)"),
+    "NaN, OBJ": ("lunate", nan_lunate, "obj", r"1 vertices are not \(first: vertex 5 = \[0.0, nan, [0-9.]+\], used by "
+                                               r"faces \[\d+, \d+, \d+\]; indices 0-based, in file order\)"),
+    "NaN, PLY": ("lunate", nan_lunate, "ply", r"1 vertices are not \(first: vertex 5 = \[0.0, nan, [0-9.]+\], used by"),
+    "open radius": ("radius", open_radius, "stl", r"the radius mesh must have a closed \(watertight\) part, its "
+                                                  r"articular solid.*spans 0 mm \(it has 3 boundary edges"),
+}
+
+
+@pytest.mark.parametrize("case", BAD_MESHES)
+def test_bad_mesh_gets_a_clear_error(folder, case):
+    """Each bad mesh is refused with a MeshError naming its file, what is wrong and the value."""
+    bone, make, suffix, message = BAD_MESHES[case]
+    replace_mesh(folder, bone, *make(), name=f"{bone}.{suffix}")
+    with raises(MeshError, folder / "bones" / f"{bone}.{suffix}", message):
+        load_participant_folder(folder)
+
+
+def test_a_sliver_is_not_zero_area(folder):
+    """The sliver above passed the old zero-area rule (area <= 1e-12 × diagonal²), and is refused now."""
+    vertices, faces = sliver_lunate()
+    area = trimesh.Trimesh(vertices, faces, process=False).area_faces[-1]
+    assert 1e-12 * np.linalg.norm(np.ptp(vertices, axis=0)) ** 2 < area < 1e-6
+
+
+@pytest.mark.parametrize("suffix", ["stl", "ascii.stl", "obj", "ply", "off"])
+def test_a_mesh_with_too_many_faces_is_refused(folder, monkeypatch, suffix):
+    """Above `MAX_FACES` (here lowered to 1,000 for a carpal, and the lunate subdivided to 1,280 faces) a
+    mesh is refused with the limit; STL, OBJ and PLY before trimesh reads them (headers or lines give the count)."""
+    monkeypatch.setitem(folder_module.MAX_FACES, "carpal", 1000)
+    vertices, faces = trimesh.remesh.subdivide(*bone_meshes()["lunate"])
+    path = folder / "bones" / f"lunate.{suffix}"
+    if suffix == "ascii.stl":
+        path.write_text(trimesh.exchange.stl.export_stl_ascii(trimesh.Trimesh(vertices, faces)))
+        edit_toml(folder, '"bones/lunate.stl"', f'"bones/lunate.{suffix}"')
+    else:
+        replace_mesh(folder, "lunate", vertices, faces, name=f"lunate.{suffix}")
+    if suffix != "off":  # trimesh must not be asked to read it
+        load = trimesh.load_mesh
+        monkeypatch.setattr(folder_module.trimesh, "load_mesh",
+                            lambda file, **kw: pytest.fail("read") if Path(file) == path else load(file, **kw))
+    with raises(MeshError, path, r"the lunate mesh has 1,280 faces, more than the 1,000 a carpal mesh may have.*"
+                                 r"decimate it to at most 1,000 faces"):
+        load_participant_folder(folder)
+
+
+def test_face_limits_leave_room_above_the_builtin_meshes():
+    """The built-in meshes have at most a tenth of the limit (radius 18,224 faces, carpals <= 4,746)."""
+    source = builtin.source("P1")
+    for bone, (_, faces) in source.bones.items():
+        limit = folder_module.MAX_FACES["carpal" if bone in folder_module.CARPALS else "forearm"]
+        assert len(faces) <= limit / 10, bone
+
+
+def test_an_open_ulna_is_accepted_without_solid(folder):
+    """An ulna may be open (ligament sites only), as the built-in ones are; it then has no solid part."""
+    vertices, faces = bone_meshes()["ulna"]
+    replace_mesh(folder, "ulna", vertices, faces[1:])
+    loaded = load_participant_folder(folder)
+    assert not folder_module.solid_mask(*loaded.bones["ulna"]).any()
+    assert folder_module.solid_mask(*loaded.bones["radius"]).all()
+
+
+def test_a_builtin_participant_round_trips_through_a_folder(tmp_path):
+    """Built-in P1 written as a folder loads back (its radius keeps the open shaft beside the closed
+    articular solid, its ulna is open), and the registry gives the build the same bones: triangles to
+    float32 precision, the same solid (contact and mass) faces."""
+    source = dataclasses.replace(builtin.source("P1"), name="P1_copy")
+    loaded = load_participant_folder(write_participant_folder(source, tmp_path / "p1_copy"))
+    assert loaded.meta == source.meta
+    for bone in BONES:
+        assert_same_triangles(loaded.bones[bone], source.bones[bone], atol=1e-5)
+    for name, trial in source.trials.items():
+        np.testing.assert_allclose(loaded.trials[name].transforms, trial.transforms, atol=1e-12)
+    registry.add_folder(tmp_path / "p1_copy")
+    copy = registry.bones("P1_copy", BuildParams(distal_row=False))
+    original = builtin.bones("P1", BuildParams().fossa_sweep_deg, False)
+    for bone in BONES:
+        np.testing.assert_array_equal(copy[bone].solid[copy[bone].faces], original[bone].solid[original[bone].faces])
+    assert not copy["ulna"].solid.any() and 0 < copy["radius"].solid.sum() < len(copy["radius"].solid)

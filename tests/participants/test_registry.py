@@ -1,13 +1,16 @@
 """A user's participant folder becomes a participant that builds like the built-in ones."""
 
+import re
+
 import numpy as np
 import pytest
 import trimesh
 
 from wrist_env.anatomy.template import load_template
+from wrist_env.build.pipeline import BuildParams
 from wrist_env.build.warp import random_warp
 from wrist_env.design import ALL_LIGAMENTS
-from wrist_env.errors import ParticipantError
+from wrist_env.errors import BuildError, ParticipantError
 from wrist_env.participants import registry
 from wrist_env.participants.folder import ParticipantSource, write_participant_folder
 from wrist_env.trial import Trial
@@ -49,3 +52,17 @@ def test_a_folder_cannot_take_a_builtin_name(tmp_path):
     folder = warped_template_folder(tmp_path / "p1", name="P1")
     with pytest.raises(ParticipantError, match=r"participant.toml.*'P1' is taken"):
         registry.add_folder(folder)
+
+
+def test_a_right_wrist_declared_left_is_refused_by_the_build(tmp_path):
+    """Right-hand meshes in a folder saying side = "left" are mirrored into bones the template does not
+    fit: the build stops after the cartilage step on the implausible joint spaces (they were 4–15 mm
+    and the build went on), naming the folder's participant.toml, the articulations and `side`."""
+    folder = warped_template_folder(tmp_path / "u2", name="U2")
+    toml = folder / "participant.toml"
+    toml.write_text(toml.read_text().replace('side = "right"', 'side = "left"'))
+    registry.add_folder(folder)
+    with pytest.raises(BuildError, match=rf"(?s){re.escape(str(toml))}: participant 'U2': implausible joint spaces "
+                                         r"in the neutral pose: .*radiolunate 1\d\.\d\d mm \(plausible 0.3–4 mm\).*"
+                                         r"check `side` in participant.toml"):
+        registry.load_model("U2", BuildParams(distal_row=False), cache=False)  # 5 bones to morph, not 9

@@ -194,14 +194,21 @@ def displaced_vertices(vertices, faces, thickness, *, smoothing_mm=NORMAL_SMOOTH
     return v + t[:, None] * extrusion_directions(v, faces, t > 0, smoothing_mm=smoothing_mm)
 
 
-def closed_faces(faces) -> np.ndarray:
-    """Faces of the watertight connected components of a mesh, shape (k, 3); all faces if none is watertight."""
+def closed_face_mask(faces) -> np.ndarray:
+    """Bool (m,): faces of the watertight connected components of a mesh (components joined across
+    edges of exactly two faces; one with an edge of one face, or of more than two, is open)."""
     f = np.asarray(faces, dtype=np.int64)
     component = trimesh.graph.connected_component_labels(trimesh.graph.face_adjacency(f), node_count=len(f))
     edges = np.sort(f[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
     _, edge_id, uses = np.unique(edges, axis=0, return_inverse=True, return_counts=True)
     open_edge = (uses[edge_id.ravel()] != 2).reshape(-1, 3).any(axis=1)
-    closed = ~np.isin(component, component[open_edge])
+    return ~np.isin(component, component[open_edge])
+
+
+def closed_faces(faces) -> np.ndarray:
+    """Faces of the watertight connected components of a mesh, shape (k, 3); all faces if none is watertight."""
+    f = np.asarray(faces, dtype=np.int64)
+    closed = closed_face_mask(f)
     return f[closed] if closed.any() else f
 
 

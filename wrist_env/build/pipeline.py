@@ -27,6 +27,14 @@ from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model, offsets
 BUILDER_VERSION = 3  # 2: distal row and triquetrum as body parts, swept fossae; 3: both by default, TC and TH
 GRID_BONES = ("radius", "scaphoid", "lunate", "capitate")
 MIN_SITE_VERTICES = 8
+JOINT_SPACE_MM = {art: (0.3, 4.0) for art in PAIRS} | {"scapholunate": (0.3, 8.0)}
+"""Plausible neutral joint space per articulation (mm; the median bone-to-bone gap over its cartilage
+coverage, `cartilage.build_cartilage`). Normal radiocarpal and intercarpal spaces are ~1.5–2 mm
+(Gilula 1979: ~2 mm; a normal scapholunate interval is under 2 mm, Hand (N Y) 2018;13(6):671–677), the
+built-in P1–P3 1.5–2.5 mm. The bounds leave room for variation and disease: under 0.3 mm no cartilage
+fits; a scapholunate gap over 3–4 mm is a dissociation, so that one may reach 8 mm. Outside them the
+bones do not sit as the template's do: right-hand meshes declared left measured 13–16 mm in three or
+four articulations (issue 11)."""
 
 
 @dataclass(frozen=True)
@@ -257,6 +265,8 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None, *, wo
     thickness, cart_report = cartilage.build_cartilage(
         verts, faces, articulations, bandwidth_mm=params.grnn_bandwidth_mm, max_thickness_mm=params.max_thickness_mm)
     thickness = {b: thickness.get(b, np.zeros(len(verts[b]))) for b in BONES}
+    summary = _articulation_summary(cart_report["cartilage"]["articulations"])
+    _check_joint_spaces(name, summary["joint_space_mm"])
     lap("cartilage")
     bundles, membrane = _ligaments(bones, sites, params)
     lap("ligaments")
@@ -292,7 +302,7 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None, *, wo
         "reference_length_mm": {n: round(float(x), 3) for n, x in zip(LIGAMENT_NAMES, ref_len)},
         "contact_law_r2": round(float(law.r2), 5),
         "sites_relocated": relocated,
-        **_articulation_summary(cart_report["cartilage"]["articulations"]),
+        **summary,
         "contact_samples": {p: int(s_off[i + 1] - s_off[i]) for i, p in enumerate(PAIRS)},
         "contact_seating_mm": round(seated, 4),
         **cart_report,
@@ -346,6 +356,20 @@ def _articulation_summary(articulations: dict) -> dict:
         space[names[key]] = art["joint_space_mm"]
         overclosure[names[key]] = art["overclosure_after_mm"]
     return {"cartilage_thickness_mm": thickness, "joint_space_mm": space, "overclosure_mm": overclosure}
+
+
+def _check_joint_spaces(name: str, spaces: dict) -> None:
+    """BuildError unless every articulation's neutral joint space (mm) is within `JOINT_SPACE_MM`."""
+    bad = {art: gap for art, gap in spaces.items()
+           if gap is None or not JOINT_SPACE_MM[art][0] <= gap <= JOINT_SPACE_MM[art][1]}
+    if bad:
+        listed = "; ".join(f"{art} {'none' if gap is None else f'{gap:.2f} mm'} (plausible "
+                           f"{JOINT_SPACE_MM[art][0]:g}–{JOINT_SPACE_MM[art][1]:g} mm)" for art, gap in bad.items())
+        raise BuildError(
+            f"participant {name!r}: implausible joint spaces in the neutral pose: {listed}. The bones do not sit "
+            f"as the template's do: check `side` in participant.toml (right-hand meshes declared \"left\" are "
+            f"mirrored, and the reverse), and that the meshes are in the RCS, mm, neutral pose."
+        )
 
 
 def _solid(bone, part: int | None = None):

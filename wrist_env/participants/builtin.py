@@ -6,6 +6,7 @@ ground-truth ligament properties drawn from Table 2's distributions (fixed
 seed). `experiments/make_participants.py` writes the data files under
 `participants/data/<name>/` (`participant.json`, `truth.json`);
 `experiments/make_trials.py` their trials (`trials.json`, `trials/*.csv`).
+`source` gives one as a `ParticipantSource`, to write as a participant folder.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import functools
 import importlib.resources
 import json
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -77,3 +79,23 @@ def bones(name: str, fossa_sweep_deg: tuple = (0.0, 0.0), distal_row: bool = Fal
         v.setflags(write=False)
         out[bone] = BoneSurface(bone, v, surface.faces, surface.solid, surface.part)
     return out
+
+
+def source(name: str, fossa_sweep_deg: tuple | None = None):
+    """The participant as a `folder.ParticipantSource`: its five principal bones (the radius fossae swept
+    as in `load_template`; default: `BuildParams()`'s), its trials and Table 1 facts, a right wrist.
+
+    `folder.write_participant_folder` writes it as a folder that loads back; its radius keeps the open
+    shaft beside the closed articular solid, and its ulna is open (see `folder`).
+    """
+    from wrist_env.build.pipeline import BuildParams
+    from wrist_env.participants.folder import ParticipantSource
+
+    sweep = BuildParams().fossa_sweep_deg if fossa_sweep_deg is None else fossa_sweep_deg
+    facts = info(name)
+    meta = {"side": "right", "sex": facts.sex, "age": facts.age, "facet_type": facts.facet_type,
+            "task": facts.task, "frames": _data(name, "trials.json")["frames"]}
+    surfaces = bones(name, tuple(float(a) for a in sweep), False)
+    root = importlib.resources.files("wrist_env.participants") / "data" / name
+    return ParticipantSource(name, meta, {b: (s.vertices, s.faces) for b, s in surfaces.items()}, trials(name),
+                             Path(str(root)))

@@ -11,11 +11,9 @@ import os
 import warnings
 from pathlib import Path
 
-import numpy as np
-
 from wrist_env.anatomy.template import BoneSurface, carry_parts, load_template
 from wrist_env.build.pipeline import BuildParams, build_model, source_hash
-from wrist_env.errors import ParticipantError, StoreError
+from wrist_env.errors import BuildError, ParticipantError, StoreError
 from wrist_env.model import BONES, Model
 from wrist_env.participants import builtin
 
@@ -66,10 +64,10 @@ def bones(name: str, params: BuildParams | None = None) -> dict:
     if name in builtin.BUILTIN:
         return builtin.bones(name, *params.anatomy)
     require(name)
-    from wrist_env.participants.folder import load_participant_folder
+    from wrist_env.participants.folder import load_participant_folder, solid_mask
 
     source = load_participant_folder(_FOLDERS[name])
-    principal = {b: BoneSurface(b, v, f, np.ones(len(v), bool)) for b, (v, f) in source.bones.items()}
+    principal = {b: BoneSurface(b, v, f, solid_mask(v, f)) for b, (v, f) in source.bones.items()}
     return carry_parts(principal, load_template()) if params.distal_row else principal
 
 
@@ -107,7 +105,12 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
             return model
         except StoreError as e:
             warnings.warn(f"rebuilding a damaged cached model: {e}", stacklevel=2)
-    model = build_model(name, b, params)
+    try:
+        model = build_model(name, b, params)
+    except BuildError as e:
+        if name in _FOLDERS:  # name the folder's file
+            raise BuildError(f"{_FOLDERS[name] / 'participant.toml'}: {e}") from e
+        raise
     if cache:
         model.save(path)
     return model
