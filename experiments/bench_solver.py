@@ -22,7 +22,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from numba import njit, get_num_threads
+from numba import get_num_threads, njit
 
 from wrist_env import design
 from wrist_env.participants import registry

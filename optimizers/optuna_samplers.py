@@ -41,11 +41,15 @@ import importlib.util
 import math
 import os
 import warnings
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from optimizers.base import Optimizer
 from optimizers.registry import register
+
+if TYPE_CHECKING:
+    import optuna
 
 
 def _storage(storage):

@@ -34,8 +34,14 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from wrist_env.errors import InputError
-from wrist_env.frames import (DOF_NAMES, DOF_UNITS, error_dof_validated, pose_to_dof_validated, validate_points,
-                              validate_poses)
+from wrist_env.frames import (
+    DOF_NAMES,
+    DOF_UNITS,
+    error_dof_validated,
+    pose_to_dof_validated,
+    validate_points,
+    validate_poses,
+)
 
 COST_BONES = ("scaphoid", "lunate")
 PERCENTILE = 75.0

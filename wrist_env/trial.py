@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from wrist_env.model import BONES
 from wrist_env.errors import TrialError
 from wrist_env.frames import validate_poses
+from wrist_env.model import BONES
 
 ROLES = ("calibrate", "validate", "other")
 REQUIRED_BONES = ("scaphoid", "lunate", "capitate")

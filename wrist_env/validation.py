@@ -23,7 +23,6 @@ from wrist_env import design as design_mod
 from wrist_env.model import BONES, PAIRS
 from wrist_env.solver.simulate import IDEALIZED_LOAD_N
 
-
 SLIL = ("SLIL_v", "SLIL_p", "SLIL_d")
 EXTENSION_30_DEG = -30.0  # flexion + / extension −, as the idealized driver's angle_deg
 SL_DISSOCIATION_MM = 3.0  # clinical scapholunate dissociation: gap > 3 mm

@@ -5,7 +5,6 @@ import numpy as np
 import pytest
 
 from wrist_env.anatomy.annotations import template_annotations
-
 from wrist_env.anatomy.myosim import load_myosim_anatomy
 from wrist_env.anatomy.template import JOINT_SPACE_MM, load_template
 

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from wrist_env.build.sdf import DistanceGrid, trilinear
 from wrist_env.anatomy.annotations import read_annotation_data
+from wrist_env.build.sdf import DistanceGrid, trilinear
 from wrist_env.design import ALL_LIGAMENTS
 from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model
 

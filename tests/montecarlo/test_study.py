@@ -9,14 +9,13 @@ import sys
 import time
 
 import numpy as np
-import pyarrow as pa
 import pytest
 
 from wrist_env.design import NAMES
 from wrist_env.errors import StoreError
 from wrist_env.montecarlo import StudyConfig, StudyError, read_runs, run_study
-from wrist_env.runs import StoreBusyError
 from wrist_env.montecarlo.sampler import FRAME_COLUMNS, SCHEMA, TEAR_COLUMNS
+from wrist_env.runs import StoreBusyError
 
 CONFIG = StudyConfig(("P1",), n=40, seed=3)
 

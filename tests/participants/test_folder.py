@@ -11,7 +11,8 @@ from scipy.spatial.transform import Rotation
 
 from wrist_env.build.pipeline import BuildParams
 from wrist_env.errors import MeshError, ParticipantError, TrialError
-from wrist_env.participants import builtin, folder as folder_module, registry
+from wrist_env.participants import builtin, registry
+from wrist_env.participants import folder as folder_module
 from wrist_env.participants.folder import ParticipantSource, load_participant_folder, write_participant_folder
 from wrist_env.trial import MIRROR, Trial
 

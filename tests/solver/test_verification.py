@@ -18,12 +18,12 @@ from dataclasses import fields, replace
 
 import numpy as np
 import pytest
+import synthetic as syn
 from scipy.integrate import quad, solve_ivp
 from scipy.interpolate import RegularGridInterpolator
 from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 
-import synthetic as syn
 from wrist_env import design
 from wrist_env.build.contact_law import fit_contact_law
 from wrist_env.design import LIGAMENT_NAMES

@@ -25,7 +25,7 @@ import numpy as np
 from wrist_env import design as design_vars
 from wrist_env.bench.log import X_COLUMNS, RunKey, RunLog
 from wrist_env.cost import COST_BONES
-from wrist_env.design import N_DESIGN, N_MATERIAL, Design
+from wrist_env.design import N_MATERIAL, Design
 from wrist_env.frames import DOF_NAMES
 
 REPLAY_TOLERANCE = 1e-9

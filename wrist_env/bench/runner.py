@@ -25,6 +25,7 @@ from pathlib import Path
 from wrist_env.bench.log import RunKey, RunLog
 from wrist_env.runs.executor import describe, executor, set_threads
 
+
 @dataclass
 class BenchmarkReport:
     """What a `benchmark` call did: cells run, skipped (already finished) and failed (with the error)."""

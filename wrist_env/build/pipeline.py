@@ -8,8 +8,8 @@ membrane → contact law → signed-distance grids and contact samples → mass.
 from __future__ import annotations
 
 import hashlib
-import os
 import json
+import os
 import time
 from dataclasses import asdict, dataclass
 
@@ -17,10 +17,10 @@ import numpy as np
 import trimesh
 from scipy.spatial import cKDTree
 
-from wrist_env.anatomy.annotations import ARTICULATIONS, template_annotations
+from wrist_env.anatomy.annotations import template_annotations
 from wrist_env.anatomy.template import load_template
 from wrist_env.build import cartilage, contact_law, fibres, mass, morph, sdf
-from wrist_env.design import ALL_LIGAMENTS, LIGAMENTS, LIGAMENT_NAMES, RSC_INDEX
+from wrist_env.design import ALL_LIGAMENTS, LIGAMENT_NAMES, LIGAMENTS, RSC_INDEX
 from wrist_env.errors import BuildError
 from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model, offsets
 

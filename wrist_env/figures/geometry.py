@@ -4,15 +4,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
 import matplotlib
 import matplotlib.pyplot as plt
+import numpy as np
 from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
 from wrist_env.design import ALL_LIGAMENT_NAMES
 from wrist_env.figures import draw
-
 
 MODEL_PANELS = (("volar view", 0, 0), ("radial view", 0, 90), ("dorsal view", 0, 180))
 

@@ -4,10 +4,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
-
 import matplotlib
 import matplotlib.pyplot as plt
+import numpy as np
 
 from wrist_env.figures import draw
 
@@ -57,12 +56,13 @@ def pressure_figure(name: str, out: Path | None = None, *, static: bool = False)
     Samples are drawn at their world positions projected on the RCS x–z plane
     (radial to the right, volar down: the view from distal, not mirrored).
     """
+    from scipy.spatial import cKDTree
+
     from wrist_env import design
     from wrist_env.model import BONES, PAIR_BONES, PAIRS
     from wrist_env.participants.registry import load_model
     from wrist_env.solver import simulate
     from wrist_env.solver.outputs import pair_slice, pressure_map
-    from scipy.spatial import cKDTree
 
     model = load_model(name)
     out = out or draw.FIGURES / f"pressure_{name}.png"

@@ -17,8 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from wrist_env.montecarlo import figures, stats
 from wrist_env.io import write_json
+from wrist_env.montecarlo import figures, stats
 from wrist_env.montecarlo.study import StudyError, config_of, counts, read_runs
 
 PREPRINT = {"mean_pressure_mpa": 0.65, "total_slil_force_30_ext_n": 26.0, "cadaveric_total_slil_force_30_ext_n": (20.0, 3.3),

@@ -36,8 +36,8 @@ import numpy as np
 import pyarrow as pa
 
 from wrist_env import design
-from wrist_env.errors import DesignError
 from wrist_env.design import INJURABLE, LIGAMENT_NAMES, N_DESIGN, N_MATERIAL, NAMES, SPAN_SD
+from wrist_env.errors import DesignError
 
 TEAR_PROBABILITY = 0.3
 """Chance that each injurable ligament is torn in a Monte Carlo run (preprint 2.3.2)."""

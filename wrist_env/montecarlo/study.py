@@ -29,7 +29,6 @@ process), or on a `dask.distributed` scheduler (`scheduler="tcp://…"`, or a
 
 from __future__ import annotations
 
-import os
 import time
 from collections.abc import Iterator
 from dataclasses import asdict, dataclass, field
@@ -38,9 +37,7 @@ from pathlib import Path
 import numpy as np
 import pyarrow as pa
 
-from wrist_env import design
 from wrist_env.errors import WristEnvError
-from wrist_env.errors import StoreError
 from wrist_env.io import read_json, write_json
 from wrist_env.montecarlo import sampler
 from wrist_env.runs.executor import executor

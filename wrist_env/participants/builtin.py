@@ -17,8 +17,6 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 from wrist_env.anatomy.template import BoneSurface, load_template
 from wrist_env.build.warp import Warp
 from wrist_env.design import Design

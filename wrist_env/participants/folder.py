@@ -27,8 +27,8 @@ import numpy as np
 import trimesh
 
 from wrist_env.build.cartilage import closed_face_mask
-from wrist_env.model import BONES
 from wrist_env.errors import MeshError, ParticipantError
+from wrist_env.model import BONES
 from wrist_env.trial import ROLES, Trial, mirror_trial, read_trial_csv, write_trial_csv
 
 PARTICIPANT_FILE = "participant.toml"

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from wrist_env.solver.contact import OUTSIDE_MM, law_energy, law_pressure, sdf_lookup_scalar
+from wrist_env.solver.contact import law_energy, law_pressure, sdf_lookup_scalar
 from wrist_env.solver.ligaments import blankevoort_energy, blankevoort_force
 
 # columns of the per-pair contact statistics the force kernels accumulate

@@ -14,7 +14,20 @@ from numba import njit, prange
 
 from wrist_env.design import ALL_LIGAMENT_NAMES, RSC_INDEX
 from wrist_env.model import BONES, CAPITATE, LUNATE, PAIRS, SCAPHOID
-from wrist_env.solver.forces import (C_AREA, C_FORCE, C_PEAK, R_AREA, R_FORCE, R_MEAN, R_PEAK, contact_forces, fibre_forces, membrane_forces, place_nodes, rebuild_active)
+from wrist_env.solver.forces import (
+    C_AREA,
+    C_FORCE,
+    C_PEAK,
+    R_AREA,
+    R_FORCE,
+    R_MEAN,
+    R_PEAK,
+    contact_forces,
+    fibre_forces,
+    membrane_forces,
+    place_nodes,
+    rebuild_active,
+)
 from wrist_env.solver.rigid import interpolate_pose, matrix_to_rotvec, orthonormalize, rotate_in_place, smoothstep
 
 N_BONES, N_PAIRS = len(BONES), len(PAIRS)

@@ -13,7 +13,6 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
-
 from scipy.spatial.transform import Rotation
 
 from wrist_env.design import ALL_LIGAMENT_NAMES, Design
