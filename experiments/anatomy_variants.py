@@ -29,8 +29,10 @@ from wrist_env.solver.simulate import idealized, loaded, simulate, simulate_batc
 from wrist_env.validation import NEUTRAL_LOAD_N, validate
 
 VARIANTS = (
-    ("builder 1: moulded fossae, five bones (`--fossa-sweep 0 0 --no-distal-row`)",
-     BuildParams(fossa_sweep_deg=(0.0, 0.0), distal_row=False)),
+    (
+        "builder 1: moulded fossae, five bones (`--fossa-sweep 0 0 --no-distal-row`)",
+        BuildParams(fossa_sweep_deg=(0.0, 0.0), distal_row=False),
+    ),
     ("swept fossae only (`--no-distal-row`)", BuildParams(distal_row=False)),
     ("distal row + swept fossae, no TC/TH (`--no-fixed-ligaments`)", BuildParams(fixed_ligaments=False)),
     ("**default**: distal row + swept fossae + TC/TH", BuildParams()),
@@ -50,10 +52,12 @@ def variant_row(label: str, params: BuildParams) -> str:
     def f(key, fmt="{:.2f}"):
         return fmt.format(v[key]) if np.isfinite(v[key]) else "run fails"
 
-    return (f"| {label} | {f('scaphoid_slope')} / {f('lunate_slope')} | {f('rs_rl_force_ratio')} | "
-            f"{f('sl_gap_growth_mm', '{:+.2f} mm')} | {f('rs_mean_pressure_mpa')} MPa | "
-            f"{f('slil_force_30ext_n', '{:.0f}')} N | {sum(c.passed for c in report.rows)}/7 | "
-            f"{monte_carlo_failures(model)} / 200 |")
+    return (
+        f"| {label} | {f('scaphoid_slope')} / {f('lunate_slope')} | {f('rs_rl_force_ratio')} | "
+        f"{f('sl_gap_growth_mm', '{:+.2f} mm')} | {f('rs_mean_pressure_mpa')} MPa | "
+        f"{f('slil_force_30ext_n', '{:.0f}')} N | {sum(c.passed for c in report.rows)}/7 | "
+        f"{monte_carlo_failures(model)} / 200 |"
+    )
 
 
 def distal_row_forces(model) -> dict:
@@ -65,8 +69,8 @@ def distal_row_forces(model) -> dict:
     pressure = np.zeros(len(model.sample_points))
     sample_pressures(R, x, model.com, arrays.grids(model), np.ascontiguousarray(model.contact_law, float), pressure)
     c = BONES.index("capitate")
-    vertices = model.vertices[model.vertex_offsets[c]:model.vertex_offsets[c + 1]]
-    part = model.vertex_part[model.vertex_offsets[c]:model.vertex_offsets[c + 1]]
+    vertices = model.vertices[model.vertex_offsets[c] : model.vertex_offsets[c + 1]]
+    part = model.vertex_part[model.vertex_offsets[c] : model.vertex_offsets[c + 1]]
     tree = cKDTree(vertices)
     out = {p: 0.0 for p in BODY_PARTS["capitate"]}
     for k in range(len(PAIRS)):
@@ -80,8 +84,10 @@ def distal_row_forces(model) -> dict:
 
 
 def main() -> None:
-    print("| variant | scaphoid / lunate slope | RS / RL force (100 N) | SL gap growth, SLIL cut | RS mean pressure "
-          "| SLIL at 30° ext. | checks passed | Monte Carlo designs failed |")
+    print(
+        "| variant | scaphoid / lunate slope | RS / RL force (100 N) | SL gap growth, SLIL cut | RS mean pressure "
+        "| SLIL at 30° ext. | checks passed | Monte Carlo designs failed |"
+    )
     print("|---|---|---|---|---|---|---|---|")
     for label, params in VARIANTS:
         print(variant_row(label, params), flush=True)
@@ -89,10 +95,14 @@ def main() -> None:
         print(f"{name}: {monte_carlo_failures(load_model(name))} of 200 Monte Carlo designs failed (default anatomy)")
     p1 = load_model("P1")
     rng = np.random.default_rng(11)
-    results = simulate_batch(p1, [design.from_action(a) for a in rng.uniform(-1, 1, (1000, 27))], idealized(p1, n_frames=9))
+    results = simulate_batch(
+        p1, [design.from_action(a) for a in rng.uniform(-1, 1, (1000, 27))], idealized(p1, n_frames=9)
+    )
     print(f"P1: {sum(not r.ok for r in results) / 10:.1f} % of 1,000 uniform random designs failed")
     forces = distal_row_forces(p1)
-    print(f"P1, neutral, {NEUTRAL_LOAD_N:g} N: contact force on " + ", ".join(f"{k} {v:.1f} N" for k, v in forces.items()))
+    print(
+        f"P1, neutral, {NEUTRAL_LOAD_N:g} N: contact force on " + ", ".join(f"{k} {v:.1f} N" for k, v in forces.items())
+    )
 
 
 if __name__ == "__main__":

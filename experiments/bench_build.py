@@ -22,20 +22,31 @@ def main(names: list[str]) -> None:
     with tempfile.TemporaryDirectory() as cache:
         env = dict(os.environ, WRIST_ENV_CACHE=cache)
         rows = []
-        print(f"{'participant':<12}{'wall s':>8}{'build s':>9}{'morph':>7}{'cartilage':>10}{'grids':>7}{'× faster than 2 h':>19}")
+        print(
+            f"{'participant':<12}{'wall s':>8}{'build s':>9}{'morph':>7}{'cartilage':>10}{'grids':>7}{'× faster than 2 h':>19}"
+        )
         for name in names:
             start = time.perf_counter()
-            out = subprocess.run([sys.executable, "-m", "wrist_env.cli", "build", name, "--no-cache", "--json"],
-                                 env=env, check=True, capture_output=True, text=True).stdout
+            out = subprocess.run(
+                [sys.executable, "-m", "wrist_env.cli", "build", name, "--no-cache", "--json"],
+                env=env,
+                check=True,
+                capture_output=True,
+                text=True,
+            ).stdout
             wall = time.perf_counter() - start
             summary = json.loads(out)
             t = summary["timings_s"]
-            print(f"{name:<12}{wall:>8.1f}{summary['build_seconds']:>9.1f}{t['morph']:>7.1f}{t['cartilage']:>10.1f}"
-                  f"{t['grids']:>7.1f}{PREPRINT_SECONDS / wall:>19.0f}")
+            print(
+                f"{name:<12}{wall:>8.1f}{summary['build_seconds']:>9.1f}{t['morph']:>7.1f}{t['cartilage']:>10.1f}"
+                f"{t['grids']:>7.1f}{PREPRINT_SECONDS / wall:>19.0f}"
+            )
             rows.append((name, wall, summary))
     print()
-    print("| participant | build, first run (s) | morph error mean / max (mm) | joint space RS / RL / SL / SC / LC (mm) "
-          "| radius cartilage mean (mm) | contact law R² |")
+    print(
+        "| participant | build, first run (s) | morph error mean / max (mm) | joint space RS / RL / SL / SC / LC (mm) "
+        "| radius cartilage mean (mm) | contact law R² |"
+    )
     print("|---|---|---|---|---|---|")
     for name, wall, s in rows:
         err = s["morph_error_mm"]

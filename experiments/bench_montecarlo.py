@@ -54,15 +54,26 @@ def main(argv=None) -> int:
     rate = summary.simulated / summary.wall_seconds
     bad = (summary.excluded + summary.failed) / max(summary.attempts, 1)
     projected = FULL / (1.0 - bad) / rate
-    mode = (f"scheduler {args.scheduler}" if args.scheduler else
-            f"{args.workers} local worker processes" if args.workers else f"one process, {numba.get_num_threads()} Numba threads")
-    print(f"Monte Carlo {', '.join(args.participants)}, n = {args.n} each, seed {args.seed}, batch {args.batch}, {mode}")
+    mode = (
+        f"scheduler {args.scheduler}"
+        if args.scheduler
+        else f"{args.workers} local worker processes"
+        if args.workers
+        else f"one process, {numba.get_num_threads()} Numba threads"
+    )
+    print(
+        f"Monte Carlo {', '.join(args.participants)}, n = {args.n} each, seed {args.seed}, batch {args.batch}, {mode}"
+    )
     print(f"warm-up (model, env, Numba cache): {warm:.1f} s")
     print(f"{summary.simulated} simulations in {summary.wall_seconds:.1f} s: {rate:.1f} simulations/s")
-    print(f"excluded {summary.excluded} ({100 * summary.excluded / summary.attempts:.2f} %), "
-          f"failed {summary.failed} ({100 * summary.failed / summary.attempts:.2f} %) of {summary.attempts} runs")
-    print(f"projected 2 x 12,500 successful runs: {projected / 60:.1f} min "
-          f"(preprint: 13 days, {PREPRINT_SECONDS / projected:,.0f}x faster)")
+    print(
+        f"excluded {summary.excluded} ({100 * summary.excluded / summary.attempts:.2f} %), "
+        f"failed {summary.failed} ({100 * summary.failed / summary.attempts:.2f} %) of {summary.attempts} runs"
+    )
+    print(
+        f"projected 2 x 12,500 successful runs: {projected / 60:.1f} min "
+        f"(preprint: 13 days, {PREPRINT_SECONDS / projected:,.0f}x faster)"
+    )
     return 0
 
 

@@ -69,9 +69,16 @@ def bare_lookups(repeats, R, x, com0, grids, active, n_active):
             for j in range(n_active[p]):
                 s = active[start + j]
                 px, py, pz = grids.points[s, 0], grids.points[s, 1], grids.points[s, 2]
-                total += sdf_lookup_scalar(grids.values, grids.offsets[b], grids.shape[b], grids.origin[b], grids.spacing[b],
-                                           m00 * px + m01 * py + m02 * pz + tx, m10 * px + m11 * py + m12 * pz + ty,
-                                           m20 * px + m21 * py + m22 * pz + tz)[0]
+                total += sdf_lookup_scalar(
+                    grids.values,
+                    grids.offsets[b],
+                    grids.shape[b],
+                    grids.origin[b],
+                    grids.spacing[b],
+                    m00 * px + m01 * py + m02 * pz + tx,
+                    m10 * px + m11 * py + m12 * pz + ty,
+                    m20 * px + m21 * py + m22 * pz + tz,
+                )[0]
     return total
 
 
@@ -105,8 +112,10 @@ def main(name: str, params=None, load_n=None) -> None:
         if not result.ok:
             raise SystemExit(f"{name}: the population design's {label} failed ({result.message}); nothing to time")
         rows.append((label, seconds, steps))
-        print(f"{label:<28} {seconds * 1e3:7.1f} ms on one core  ({steps} steps, {seconds / steps * 1e6:.1f} µs/step, "
-              f"{PREPRINT_SECONDS / seconds:,.0f}× faster than 45 s)")
+        print(
+            f"{label:<28} {seconds * 1e3:7.1f} ms on one core  ({steps} steps, {seconds / steps * 1e6:.1f} µs/step, "
+            f"{PREPRINT_SECONDS / seconds:,.0f}× faster than 45 s)"
+        )
     designs = monte_carlo_designs(64)
     for label, driver in (("idealized sweep, 17 frames", sweep), ("15-frame trial", trial)):
         simulate_batch(model, designs[:2], driver)
@@ -114,11 +123,15 @@ def main(name: str, params=None, load_n=None) -> None:
         results = simulate_batch(model, designs, driver)
         rate = len(designs) / (time.perf_counter() - start)
         ok = sum(r.ok for r in results)
-        print(f"{label:<28} {rate:7.1f} simulations/s batched on {get_num_threads()} threads "
-              f"({ok}/{len(results)} Monte Carlo designs ok)")
+        print(
+            f"{label:<28} {rate:7.1f} simulations/s batched on {get_num_threads()} threads "
+            f"({ok}/{len(results)} Monte Carlo designs ok)"
+        )
         rows.append((label + " batched", rate, ok))
     bare, full, n_active = efficiency(model, rows[0][2], rows[0][1])
-    print(f"efficiency: bare look-ups {bare:.1f} µs of a {full:.1f} µs step ({n_active} active samples) = {bare / full:.0%}")
+    print(
+        f"efficiency: bare look-ups {bare:.1f} µs of a {full:.1f} µs step ({n_active} active samples) = {bare / full:.0%}"
+    )
     print()
     print("| measure | P1 |")
     print("|---|---|")

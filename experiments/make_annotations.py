@@ -59,31 +59,65 @@ def main() -> None:
     site = {
         # Berger 2001: the SLIL is C-shaped, volar, proximal (membranous) and dorsal regions
         # spanning the rims of the scapholunate interval.
-        "SLIL_v": (("scaphoid", extreme(V["scaphoid"], (1, 0, 0), s_sl)), ("lunate", extreme(V["lunate"], (1, 0, 0), l_sl))),
-        "SLIL_p": (("scaphoid", extreme(V["scaphoid"], (0, 1, 0), s_sl)), ("lunate", extreme(V["lunate"], (0, 1, 0), l_sl))),
-        "SLIL_d": (("scaphoid", extreme(V["scaphoid"], (-1, 0, 0), s_sl)), ("lunate", extreme(V["lunate"], (-1, 0, 0), l_sl))),
+        "SLIL_v": (
+            ("scaphoid", extreme(V["scaphoid"], (1, 0, 0), s_sl)),
+            ("lunate", extreme(V["lunate"], (1, 0, 0), l_sl)),
+        ),
+        "SLIL_p": (
+            ("scaphoid", extreme(V["scaphoid"], (0, 1, 0), s_sl)),
+            ("lunate", extreme(V["lunate"], (0, 1, 0), l_sl)),
+        ),
+        "SLIL_d": (
+            ("scaphoid", extreme(V["scaphoid"], (-1, 0, 0), s_sl)),
+            ("lunate", extreme(V["lunate"], (-1, 0, 0), l_sl)),
+        ),
         # Berger 2001: RSC from the volar radial styloid, volar to the scaphoid waist, to the
         # volar capitate waist.
-        "RSC": (("radius", extreme(V["radius"], (1, 0, 1), V["radius"][:, 1] < -2.0)), ("capitate", extreme(V["capitate"], (1, 0, 0.3), cap_waist))),
+        "RSC": (
+            ("radius", extreme(V["radius"], (1, 0, 1), V["radius"][:, 1] < -2.0)),
+            ("capitate", extreme(V["capitate"], (1, 0, 0.3), cap_waist)),
+        ),
         # Berger 2001, Nagao 2005: LRL from the volar rim of the scaphoid fossa, ulnar to the
         # RSC, to the volar-radial horn of the lunate.
-        "LRL": (("radius", extreme(V["radius"], (1, -0.2, 0), distal_radius & (V["radius"][:, 2] > 1) & (V["radius"][:, 2] < 6))),
-                ("lunate", extreme(V["lunate"], (1, 0, 0.6)))),
+        "LRL": (
+            (
+                "radius",
+                extreme(V["radius"], (1, -0.2, 0), distal_radius & (V["radius"][:, 2] > 1) & (V["radius"][:, 2] < 6)),
+            ),
+            ("lunate", extreme(V["lunate"], (1, 0, 0.6))),
+        ),
         # Nagao 2005: SRL from the volar rim of the lunate fossa to the volar-ulnar lunate.
-        "SRL": (("radius", extreme(V["radius"], (1, -0.2, 0), distal_radius & (V["radius"][:, 2] < -3) & (V["radius"][:, 2] > -10))),
-                ("lunate", extreme(V["lunate"], (1, 0.5, -0.3), V["lunate"][:, 1] > lun_c[1]))),
+        "SRL": (
+            (
+                "radius",
+                extreme(
+                    V["radius"], (1, -0.2, 0), distal_radius & (V["radius"][:, 2] < -3) & (V["radius"][:, 2] > -10)
+                ),
+            ),
+            ("lunate", extreme(V["lunate"], (1, 0.5, -0.3), V["lunate"][:, 1] > lun_c[1])),
+        ),
         # Nagao 2005, Mizuseki 1989: DRC from the dorsal rim of the radius (Lister's region)
         # to the dorsal lunate (with the distal row and triquetrum: on to the dorsal tubercle
         # of the triquetrum, which moves with the lunate body; see `part` below).
-        "DRC": (("radius", extreme(V["radius"], (-1, -0.2, 0), distal_radius & (np.abs(V["radius"][:, 2]) < 5))),
-                ("lunate", extreme(V["lunate"], (-1, 0, 0)))),
+        "DRC": (
+            ("radius", extreme(V["radius"], (-1, -0.2, 0), distal_radius & (np.abs(V["radius"][:, 2]) < 5))),
+            ("lunate", extreme(V["lunate"], (-1, 0, 0))),
+        ),
         # Ringler 2013: RCL from the tip of the radial styloid to the radial scaphoid waist.
-        "RCL": (("radius", extreme(V["radius"], (0, -1, 1.2), distal_radius)),
-                ("scaphoid", extreme(V["scaphoid"], (0, 0, 1), np.abs(V["scaphoid"][:, 1] - sca_c[1]) < 3))),
+        "RCL": (
+            ("radius", extreme(V["radius"], (0, -1, 1.2), distal_radius)),
+            ("scaphoid", extreme(V["scaphoid"], (0, 0, 1), np.abs(V["scaphoid"][:, 1] - sca_c[1]) < 3)),
+        ),
         # Apergis 2013: SCL from the volar-ulnar distal pole of the scaphoid to the volar-radial capitate waist.
-        "SCL": (("scaphoid", extreme(V["scaphoid"], (1, -1, -0.5))), ("capitate", extreme(V["capitate"], (0.6, 0, 1), cap_waist))),
+        "SCL": (
+            ("scaphoid", extreme(V["scaphoid"], (1, -1, -0.5))),
+            ("capitate", extreme(V["capitate"], (0.6, 0, 1), cap_waist)),
+        ),
         # Moritomo 2013: UCL from the ulnar fovea/styloid base, volar to the lunate, to the volar capitate.
-        "UCL": (("ulna", extreme(V["ulna"], (1, -0.3, 0), distal_ulna)), ("capitate", extreme(V["capitate"], (1, 0, -0.5), cap_waist))),
+        "UCL": (
+            ("ulna", extreme(V["ulna"], (1, -0.3, 0), distal_ulna)),
+            ("capitate", extreme(V["capitate"], (1, 0, -0.5), cap_waist)),
+        ),
         # Nagao 2005: UL from the volar ulnar head/TFCC to the volar-ulnar lunate.
         "UL": (("ulna", extreme(V["ulna"], (1, -0.5, 0.5), distal_ulna)), ("lunate", extreme(V["lunate"], (1, 0, -1)))),
     }
@@ -96,21 +130,40 @@ def main() -> None:
         }
     # Mizuseki 1989: the DRC's main insertion is the dorsal tubercle of the triquetrum.
     drc = ligaments["DRC"]["insertion"]
-    ligaments["DRC"]["insertion"] = {"bone": "lunate", "part": "triquetrum",
-                                     "centre_mm": np.round(extreme(V["triquetrum"], (-1, 0, 0)), 3).tolist(),
-                                     "radius_mm": drc["radius_mm"], "without_part": drc}
+    ligaments["DRC"]["insertion"] = {
+        "bone": "lunate",
+        "part": "triquetrum",
+        "centre_mm": np.round(extreme(V["triquetrum"], (-1, 0, 0)), 3).tolist(),
+        "radius_mm": drc["radius_mm"],
+        "without_part": drc,
+    }
     # Berger 2001, Garcia-Elias 2017: the ulnar arm of the palmar arcuate ligament, from the
     # palmar-distal triquetrum to the palmar capitate neck (TC, beside the UCL's insertion) and
     # to the palmar hamate body proximal to its hook (TH). Fixed ligaments of the distal row.
-    tri = {"bone": "lunate", "part": "triquetrum", "radius_mm": 2.0,
-           "centre_mm": np.round(extreme(V["triquetrum"], (1, -0.6, 0.4)), 3).tolist()}
+    tri = {
+        "bone": "lunate",
+        "part": "triquetrum",
+        "radius_mm": 2.0,
+        "centre_mm": np.round(extreme(V["triquetrum"], (1, -0.6, 0.4)), 3).tolist(),
+    }
     hamate_body = V["hamate"][:, 1] > V["hamate"][:, 1].mean()
-    ligaments["TC"] = {"origin": tri, "insertion": {
-        "bone": "capitate", "radius_mm": 2.0,
-        "centre_mm": np.round(extreme(V["capitate"], (1, 0, -0.5), cap_waist), 3).tolist()}}
-    ligaments["TH"] = {"origin": tri, "insertion": {
-        "bone": "capitate", "part": "hamate", "radius_mm": 2.0,
-        "centre_mm": np.round(extreme(V["hamate"], (1, 0.3, 0.3), hamate_body), 3).tolist()}}
+    ligaments["TC"] = {
+        "origin": tri,
+        "insertion": {
+            "bone": "capitate",
+            "radius_mm": 2.0,
+            "centre_mm": np.round(extreme(V["capitate"], (1, 0, -0.5), cap_waist), 3).tolist(),
+        },
+    }
+    ligaments["TH"] = {
+        "origin": tri,
+        "insertion": {
+            "bone": "capitate",
+            "part": "hamate",
+            "radius_mm": 2.0,
+            "centre_mm": np.round(extreme(V["hamate"], (1, 0.3, 0.3), hamate_body), 3).tolist(),
+        },
+    }
     # Articulations are between rigid bodies: the scaphocapitate one includes the scaphoid's
     # distal pole against the trapezium and trapezoid (the STT joint), the lunocapitate one the
     # triquetrum against the hamate (Moritomo 2013: the helicoid triquetrohamate joint).

@@ -108,14 +108,29 @@ def make(name: str) -> dict:
             poses[i] = tracking_noise(poses[i], model.centroid[i], rng)
         t = Trial(trial, ROLE[trial], BONES, poses)
         write_trial_csv(t, folder / f"{trial}.csv")
-        out[trial] = {"file": f"trials/{trial}.csv", "role": ROLE[trial], "task": info.task,
-                      "capitate_cardan_deg": angles.round(3).tolist(), "load_n": load.round(3).tolist(),
-                      "steps": int(result.steps.sum())}
-        print(f"{name} {trial}: {info.task}, {int(result.steps.sum())} steps, max residual {result.residual[:, 0].max():.3f} N")
-    meta = {"synthetic": True, "frames": N_FRAMES, "noise_mm": NOISE_MM, "noise_deg": NOISE_DEG,
-            "high_fidelity": {"contact_spacing_mm": HIGH_FIDELITY_BUILD.contact_spacing_mm,
-                              "dt_s": HIGH_FIDELITY_SOLVER.dt_s, "tolerance": HIGH_FIDELITY_SOLVER.tolerance},
-            "trials": out}
+        out[trial] = {
+            "file": f"trials/{trial}.csv",
+            "role": ROLE[trial],
+            "task": info.task,
+            "capitate_cardan_deg": angles.round(3).tolist(),
+            "load_n": load.round(3).tolist(),
+            "steps": int(result.steps.sum()),
+        }
+        print(
+            f"{name} {trial}: {info.task}, {int(result.steps.sum())} steps, max residual {result.residual[:, 0].max():.3f} N"
+        )
+    meta = {
+        "synthetic": True,
+        "frames": N_FRAMES,
+        "noise_mm": NOISE_MM,
+        "noise_deg": NOISE_DEG,
+        "high_fidelity": {
+            "contact_spacing_mm": HIGH_FIDELITY_BUILD.contact_spacing_mm,
+            "dt_s": HIGH_FIDELITY_SOLVER.dt_s,
+            "tolerance": HIGH_FIDELITY_SOLVER.tolerance,
+        },
+        "trials": out,
+    }
     (DATA / name / "trials.json").write_text(json.dumps(meta, indent=1) + "\n")
     return meta
 

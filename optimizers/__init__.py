@@ -6,15 +6,25 @@ module each (imported here so they register).
 """
 
 from optimizers import (  # noqa: F401  (register)  # noqa: F401  (register; "optuna-gp" only with torch)
-           cmaes,
-           latin_hypercube,
-           nelder_mead,
-           optuna_samplers,
-           random_search,  # noqa: F401  (registers)
-           surrogate,
+    cmaes,
+    latin_hypercube,
+    nelder_mead,
+    optuna_samplers,
+    random_search,  # noqa: F401  (registers)
+    surrogate,
 )
 from optimizers.base import Optimizer, OptimizeResult, OptionError, minimize
 from optimizers.registry import ENTRY_POINT_GROUP, UnknownOptimizerError, available, get, make, register
 
-__all__ = ["ENTRY_POINT_GROUP", "OptimizeResult", "OptionError", "Optimizer", "UnknownOptimizerError", "available", "get",
-           "make", "minimize", "register"]
+__all__ = [
+    "ENTRY_POINT_GROUP",
+    "OptimizeResult",
+    "OptionError",
+    "Optimizer",
+    "UnknownOptimizerError",
+    "available",
+    "get",
+    "make",
+    "minimize",
+    "register",
+]

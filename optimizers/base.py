@@ -64,8 +64,10 @@ class Optimizer(ABC):
             raise ValueError(f"bounds must satisfy lower < upper, but got {self.lower} and {self.upper}")
         unknown = sorted(set(options) - set(self.OPTIONS))
         if unknown:
-            raise OptionError(f"{self.name or type(self).__name__}: unknown option{'s' if len(unknown) > 1 else ''} "
-                              f"{', '.join(unknown)}; its options are: {', '.join(self.OPTIONS) or '(none)'}")
+            raise OptionError(
+                f"{self.name or type(self).__name__}: unknown option{'s' if len(unknown) > 1 else ''} "
+                f"{', '.join(unknown)}; its options are: {', '.join(self.OPTIONS) or '(none)'}"
+            )
         self.options = dict(options)
         self.rng = np.random.default_rng(self.seed)
         self._xs: list[np.ndarray] = []
@@ -118,8 +120,15 @@ class Optimizer(ABC):
         best = int(np.argmin(ys))
         stopped = self._stopped() and self.remaining > 0
         message = "the method converged before the budget" if stopped else f"budget of {self.budget} evaluations used"
-        return OptimizeResult(np.array(self._xs[best]), float(ys[best]), self.nfev, bool(np.isfinite(ys[best])),
-                              message, np.array(self._xs), ys)
+        return OptimizeResult(
+            np.array(self._xs[best]),
+            float(ys[best]),
+            self.nfev,
+            bool(np.isfinite(ys[best])),
+            message,
+            np.array(self._xs),
+            ys,
+        )
 
     @abstractmethod
     def _ask(self, n_max: int) -> np.ndarray: ...

@@ -68,8 +68,13 @@ class CMAES(Optimizer):
     def cma_options(self, popsize: int, seed: int, maxfevals: int) -> dict:
         """The options handed to `cma.CMAEvolutionStrategy` for one run."""
         width = self.upper - self.lower
-        opts = {"bounds": [self.lower.tolist(), self.upper.tolist()], "seed": seed, "popsize": popsize,
-                "verbose": -9, "maxfevals": maxfevals}
+        opts = {
+            "bounds": [self.lower.tolist(), self.upper.tolist()],
+            "seed": seed,
+            "popsize": popsize,
+            "verbose": -9,
+            "maxfevals": maxfevals,
+        }
         if not np.all(width == width[0]):
             opts["CMA_stds"] = width.tolist()
         opts.update(self.options.get("cma_options", {}))
@@ -85,8 +90,11 @@ class CMAES(Optimizer):
 
         self._np_state = None  # cma seeds the global state itself
         with self._own_np_random():
-            return cma.CMAEvolutionStrategy(np.asarray(x0, dtype=np.float64).tolist(), self.sigma0(),
-                                            self.cma_options(popsize, seed, self.remaining))
+            return cma.CMAEvolutionStrategy(
+                np.asarray(x0, dtype=np.float64).tolist(),
+                self.sigma0(),
+                self.cma_options(popsize, seed, self.remaining),
+            )
 
     def _ask(self, n_max: int) -> np.ndarray:
         with self._own_np_random():
@@ -95,8 +103,9 @@ class CMAES(Optimizer):
             self.restarts += 1
             if self.restart == "ipop":
                 self.popsize *= 2
-            self.es = self._new_es(self.rng.uniform(self.lower, self.upper), self.popsize,
-                                   int(self.rng.integers(1, 2**31)))
+            self.es = self._new_es(
+                self.rng.uniform(self.lower, self.upper), self.popsize, int(self.rng.integers(1, 2**31))
+            )
         with self._own_np_random():
             self._population = self.es.ask()
         return np.array(self._population[:n_max])

@@ -23,8 +23,12 @@ class LatinHypercube(Optimizer):
 
     def _ask(self, n_max: int) -> np.ndarray:
         if not hasattr(self, "_design"):
-            sampler = qmc.LatinHypercube(self.dim, scramble=bool(self.options.get("scramble", True)),
-                                         optimization=self.options.get("optimization"), rng=self.rng)
+            sampler = qmc.LatinHypercube(
+                self.dim,
+                scramble=bool(self.options.get("scramble", True)),
+                optimization=self.options.get("optimization"),
+                rng=self.rng,
+            )
             self._design = qmc.scale(sampler.random(self.budget), self.lower, self.upper)
         k = min(n_max, int(self.options.get("batch_size", 16)))
-        return self._design[self.nfev:self.nfev + k]
+        return self._design[self.nfev : self.nfev + k]

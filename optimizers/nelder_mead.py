@@ -25,8 +25,8 @@ class _Stop(Exception):
     """Raised inside SciPy's objective to end the worker thread."""
 
 
-_STOP = object()   # sent on the reply queue instead of a value
-_END = object()    # posted on the request queue when the worker has finished
+_STOP = object()  # sent on the reply queue instead of a value
+_END = object()  # posted on the request queue when the worker has finished
 
 
 def initial_simplex(x0, lower, upper, scale: float = 0.25) -> np.ndarray:
@@ -69,9 +69,17 @@ def _worker(requests, replies, budget, lower, upper, x0, rng, scale, restart, pe
             # inf values (failed evaluations) make SciPy compute inf - inf; np.errstate is
             # thread-local (unlike warnings.catch_warnings, which must not be used here)
             with np.errstate(invalid="ignore", over="ignore"):
-                scipy_minimize(fun, start, method="Nelder-Mead", bounds=bounds,
-                               options={**options, "maxfev": budget - evals,
-                                        "initial_simplex": initial_simplex(start, lower, upper, scale)})
+                scipy_minimize(
+                    fun,
+                    start,
+                    method="Nelder-Mead",
+                    bounds=bounds,
+                    options={
+                        **options,
+                        "maxfev": budget - evals,
+                        "initial_simplex": initial_simplex(start, lower, upper, scale),
+                    },
+                )
             if evals >= budget:
                 break
             # converged before the budget: restart
@@ -111,8 +119,11 @@ class NelderMead(Optimizer):
         self.restart = options.get("restart", "random")
         if self.restart not in ("random", "best"):
             raise ValueError(f"restart must be 'random' or 'best', but got {self.restart!r}")
-        self._scipy_options = {"xatol": float(options.get("xatol", 1e-4)), "fatol": float(options.get("fatol", 1e-4)),
-                               "adaptive": bool(options.get("adaptive", False))}
+        self._scipy_options = {
+            "xatol": float(options.get("xatol", 1e-4)),
+            "fatol": float(options.get("fatol", 1e-4)),
+            "adaptive": bool(options.get("adaptive", False)),
+        }
         self._requests: queue.Queue = queue.Queue()
         self._replies: queue.Queue = queue.Queue()
         self._thread: threading.Thread | None = None
@@ -130,10 +141,23 @@ class NelderMead(Optimizer):
             raise RuntimeError(f"{self.name}: the optimizer was closed")
         if self._thread is None:
             self._thread = threading.Thread(
-                target=_worker, name=f"nelder-mead-{id(self):x}", daemon=True,
-                args=(self._requests, self._replies, self.budget, self.lower, self.upper, self.x0, self.rng,
-                      float(self.options.get("simplex_scale", 0.25)), self.restart,
-                      float(self.options.get("perturb", 0.1)), self._scipy_options))
+                target=_worker,
+                name=f"nelder-mead-{id(self):x}",
+                daemon=True,
+                args=(
+                    self._requests,
+                    self._replies,
+                    self.budget,
+                    self.lower,
+                    self.upper,
+                    self.x0,
+                    self.rng,
+                    float(self.options.get("simplex_scale", 0.25)),
+                    self.restart,
+                    float(self.options.get("perturb", 0.1)),
+                    self._scipy_options,
+                ),
+            )
             self._thread.start()
         x = self._next()
         if x is _END:  # cannot happen while budget remains; kept as a guard
@@ -157,7 +181,7 @@ class NelderMead(Optimizer):
             item = self._requests.get()  # the worker's next request, or its end
             if item is not _END and not isinstance(item, BaseException):
                 self._replies.put(_STOP)
-                self._requests.get()     # _END
+                self._requests.get()  # _END
         self._thread.join()
 
     def __del__(self):

@@ -78,17 +78,23 @@ class OptunaOptimizer(Optimizer):
         super().__init__(dim, budget, seed, lower, upper, **options)
         optuna.logging.set_verbosity(optuna.logging.WARNING)
         self._names = [f"x{i}" for i in range(self.dim)]
-        self._distributions = {n: optuna.distributions.FloatDistribution(float(lo), float(hi))
-                               for n, lo, hi in zip(self._names, self.lower, self.upper)}
+        self._distributions = {
+            n: optuna.distributions.FloatDistribution(float(lo), float(hi))
+            for n, lo, hi in zip(self._names, self.lower, self.upper)
+        }
         self.batch_size = int(self.options.get("batch_size", self._default_batch_size()))
         if self.batch_size < 1:
             raise ValueError(f"{self.name}: batch_size must be ≥ 1, but got {self.batch_size}")
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", optuna.exceptions.ExperimentalWarning)
             sampler = self._make_sampler()
-        self.study = optuna.create_study(direction="minimize", sampler=sampler,
-                                         storage=_storage(self.options.get("storage")),
-                                         study_name=self.options.get("study_name"), load_if_exists=True)
+        self.study = optuna.create_study(
+            direction="minimize",
+            sampler=sampler,
+            storage=_storage(self.options.get("storage")),
+            study_name=self.options.get("study_name"),
+            load_if_exists=True,
+        )
         self._trials: list[optuna.trial.Trial] = []
 
     def _default_batch_size(self) -> int:
@@ -125,10 +131,13 @@ class OptunaTPE(OptunaOptimizer):
         import optuna
 
         o = self.options
-        return optuna.samplers.TPESampler(seed=self.seed, constant_liar=True,
-                                          n_startup_trials=int(o.get("n_startup_trials", 10)),
-                                          n_ei_candidates=int(o.get("n_ei_candidates", 24)),
-                                          multivariate=bool(o.get("multivariate", True)))
+        return optuna.samplers.TPESampler(
+            seed=self.seed,
+            constant_liar=True,
+            n_startup_trials=int(o.get("n_startup_trials", 10)),
+            n_ei_candidates=int(o.get("n_ei_candidates", 24)),
+            multivariate=bool(o.get("multivariate", True)),
+        )
 
 
 @register("optuna-cmaes")
@@ -149,11 +158,15 @@ class OptunaCMAES(OptunaOptimizer):
 
         o = self.options
         # one-dimensional spaces: Optuna's CMA-ES falls back to its independent (random) sampler
-        return optuna.samplers.CmaEsSampler(seed=self.seed, popsize=self.popsize,
-                                            n_startup_trials=int(o.get("n_startup_trials", 0)),
-                                            sigma0=o.get("sigma0"), restart_strategy=o.get("restart_strategy"),
-                                            use_separable_cma=bool(o.get("use_separable_cma", False)),
-                                            warn_independent_sampling=False)
+        return optuna.samplers.CmaEsSampler(
+            seed=self.seed,
+            popsize=self.popsize,
+            n_startup_trials=int(o.get("n_startup_trials", 0)),
+            sigma0=o.get("sigma0"),
+            restart_strategy=o.get("restart_strategy"),
+            use_separable_cma=bool(o.get("use_separable_cma", False)),
+            warn_independent_sampling=False,
+        )
 
 
 class OptunaGP(OptunaOptimizer):
@@ -166,8 +179,11 @@ class OptunaGP(OptunaOptimizer):
         import optuna
 
         o = self.options
-        return optuna.samplers.GPSampler(seed=self.seed, n_startup_trials=int(o.get("n_startup_trials", 10)),
-                                         deterministic_objective=bool(o.get("deterministic_objective", False)))
+        return optuna.samplers.GPSampler(
+            seed=self.seed,
+            n_startup_trials=int(o.get("n_startup_trials", 10)),
+            deterministic_objective=bool(o.get("deterministic_objective", False)),
+        )
 
 
 HAS_TORCH = importlib.util.find_spec("torch") is not None

@@ -17,4 +17,3 @@ class RandomSearch(Optimizer):
     def _ask(self, n_max: int) -> np.ndarray:
         k = min(n_max, int(self.options.get("batch_size", 16)))
         return self.rng.uniform(self.lower, self.upper, (k, self.dim))
-

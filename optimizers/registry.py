@@ -25,12 +25,14 @@ class UnknownOptimizerError(WristEnvError, KeyError):
 
 def register(name: str):
     """Class decorator: make an `Optimizer` subclass available under `name`."""
+
     def decorate(cls):
         if name in _REGISTRY and _REGISTRY[name] is not cls:
             raise ValueError(f"optimizer name {name!r} is already taken by {_REGISTRY[name].__qualname__}")
         cls.name = name
         _REGISTRY[name] = cls
         return cls
+
     return decorate
 
 

@@ -73,7 +73,16 @@ class _Stop(Exception):
 class Surrogate(Optimizer):
     """RBF surrogate search (MATLAB surrogateopt-like) + L-BFGS-B polish with batched finite differences."""
 
-    OPTIONS = ("batch_size", "fd_step", "n_candidates", "n_init", "perturb_prob", "polish_fraction", "smoothing", "weights")
+    OPTIONS = (
+        "batch_size",
+        "fd_step",
+        "n_candidates",
+        "n_init",
+        "perturb_prob",
+        "polish_fraction",
+        "smoothing",
+        "weights",
+    )
 
     SIGMA_INIT, SIGMA_MAX, SIGMA_MIN = 0.2, 0.5, 0.2 / 64
 
@@ -117,7 +126,7 @@ class Surrogate(Optimizer):
 
     def _ask(self, n_max: int) -> np.ndarray:
         if len(self._U) < self.n_init:
-            u = self._design[len(self._U):][:n_max]
+            u = self._design[len(self._U) :][:n_max]
             self._asked = "init"
             return self._to_x(u)
         if not self._polished and self.remaining <= self.polish_budget:
@@ -207,7 +216,9 @@ class Surrogate(Optimizer):
         return None
 
     def _adapt(self, best_before: float, batch_best: float) -> None:
-        if np.isfinite(batch_best) and batch_best < best_before - 1e-3 * abs(best_before if np.isfinite(best_before) else 0):
+        if np.isfinite(batch_best) and batch_best < best_before - 1e-3 * abs(
+            best_before if np.isfinite(best_before) else 0
+        ):
             self._successes, self._failures = self._successes + 1, 0
         else:
             self._successes, self._failures = 0, self._failures + 1
@@ -227,8 +238,9 @@ class Surrogate(Optimizer):
         if not np.isfinite(Y[i]):
             return
         self.polish_log.append({"nfev_start": self.nfev, "fun_start": float(Y[i])})
-        self._worker = threading.Thread(target=self._polish, args=(self._U[i].copy(),), daemon=True,
-                                        name=f"surrogate-polish-seed{self.seed}")
+        self._worker = threading.Thread(
+            target=self._polish, args=(self._U[i].copy(),), daemon=True, name=f"surrogate-polish-seed{self.seed}"
+        )
         self._worker.start()
         self._receive()
 
@@ -270,8 +282,14 @@ class Surrogate(Optimizer):
             return float(f0), g
 
         try:
-            res = scipy_minimize(value_and_gradient, u0, jac=True, method="L-BFGS-B", bounds=[(0.0, 1.0)] * d,
-                                 options={"maxiter": 10 ** 6, "maxfun": 10 ** 6})
+            res = scipy_minimize(
+                value_and_gradient,
+                u0,
+                jac=True,
+                method="L-BFGS-B",
+                bounds=[(0.0, 1.0)] * d,
+                options={"maxiter": 10**6, "maxfun": 10**6},
+            )
             message = f"L-BFGS-B: {res.message}"
         except _Stop as stop:
             message = str(stop)

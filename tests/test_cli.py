@@ -15,7 +15,14 @@ def test_build_json_has_the_summary_fields(capsys, built):
     built("P1")
     assert main(["build", "P1", "--json"]) == 0
     summary = json.loads(capsys.readouterr().out)
-    for key in ("build_seconds", "morph_error_mm", "fibres", "cartilage_thickness_mm", "joint_space_mm", "contact_law_r2"):
+    for key in (
+        "build_seconds",
+        "morph_error_mm",
+        "fibres",
+        "cartilage_thickness_mm",
+        "joint_space_mm",
+        "contact_law_r2",
+    ):
         assert key in summary, key
     assert summary["fibres"]["SLIL_d"] == 7 and summary["fibres"]["UL"] == 3
     assert set(summary["cartilage_thickness_mm"]["radioscaphoid"]) == {"min", "mean", "max"}
@@ -47,11 +54,24 @@ def test_simulate_json_has_every_frame_and_the_wall_time(capsys, built):
         return [x]
 
     for frame in out["frames"]:
-        for key in ("poses", "contact", "ligament_force_n", "kinetic_energy_nmm", "internal_energy_nmm", "residual", "steps"):
+        for key in (
+            "poses",
+            "contact",
+            "ligament_force_n",
+            "kinetic_energy_nmm",
+            "internal_energy_nmm",
+            "residual",
+            "steps",
+        ):
             assert key in frame, key
         values = numbers({k: v for k, v in frame.items()})
         assert all(isinstance(v, (int, float)) and math.isfinite(v) for v in values)
-        assert set(frame["contact"]["radioscaphoid"]) == {"mean_pressure_mpa", "peak_pressure_mpa", "area_mm2", "force_n"}
+        assert set(frame["contact"]["radioscaphoid"]) == {
+            "mean_pressure_mpa",
+            "peak_pressure_mpa",
+            "area_mm2",
+            "force_n",
+        }
 
 
 def test_simulate_static_truth_and_design_file(capsys, built, tmp_path):
@@ -134,9 +154,21 @@ def test_every_participant_command_takes_folder_once_and_registers_it(tmp_path):
     p = parser()
     sub = next(a for a in p._actions if a.dest == "command")
     with_folder = [name for name, s in sub.choices.items() if any("--folder" in a.option_strings for a in s._actions)]
-    assert set(with_folder) >= {"participants", "build", "simulate", "evaluate", "validate", "figure", "calibrate",
-                                "benchmark", "leaderboard", "montecarlo"}
-    assert main(["participants", "--folder", str(tmp_path / "missing")]) == 2  # registered (and refused) before the command
+    assert set(with_folder) >= {
+        "participants",
+        "build",
+        "simulate",
+        "evaluate",
+        "validate",
+        "figure",
+        "calibrate",
+        "benchmark",
+        "leaderboard",
+        "montecarlo",
+    }
+    assert (
+        main(["participants", "--folder", str(tmp_path / "missing")]) == 2
+    )  # registered (and refused) before the command
 
 
 def test_an_unknown_calibrator_is_one_line_and_exit_2(capsys):

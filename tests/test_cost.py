@@ -26,9 +26,7 @@ def about(point, axis: str, deg: float, translation=(0.0, 0.0, 0.0)) -> np.ndarr
 
 def experiment(flexion=(-20.0, -5.0, 5.0, 20.0), volar=(0.0, 1.0, 3.0, 4.0)) -> np.ndarray:
     """(2, n_frames, 4, 4): both bones flex about their centroids (range 40°) and glide volar (range 4 mm)."""
-    return np.array(
-        [[about(c, "z", a, (v, 0.0, 0.0)) for a, v in zip(flexion, volar)] for c in CENTROIDS]
-    )
+    return np.array([[about(c, "z", a, (v, 0.0, 0.0)) for a, v in zip(flexion, volar)] for c in CENTROIDS])
 
 
 def with_error(poses, bone: int, axis: str, deg_per_frame, translation=(0.0, 0.0, 0.0)) -> np.ndarray:

@@ -35,13 +35,16 @@ def test_population_is_the_table_2_mean_and_intact():
     assert np.all(p.reference_strain == 1.0) and not p.torn.any()
 
 
-@pytest.mark.parametrize("bad,match", [
-    (np.zeros(26), r"shape \(27,\)"),
-    (np.r_[np.zeros(26), 1.5], r"LRL.injury=1.5"),
-    (np.r_[np.nan, np.zeros(26)], r"SLIL_v.stiffness=nan"),
-    (np.zeros(27) + 0.5j, r"real numbers, but got dtype complex128"),
-    (np.array(["0.1"] * 27), r"real numbers, but got dtype <U3"),
-])
+@pytest.mark.parametrize(
+    "bad,match",
+    [
+        (np.zeros(26), r"shape \(27,\)"),
+        (np.r_[np.zeros(26), 1.5], r"LRL.injury=1.5"),
+        (np.r_[np.nan, np.zeros(26)], r"SLIL_v.stiffness=nan"),
+        (np.zeros(27) + 0.5j, r"real numbers, but got dtype complex128"),
+        (np.array(["0.1"] * 27), r"real numbers, but got dtype <U3"),
+    ],
+)
 def test_bad_actions_name_the_value(bad, match):
     with pytest.raises(DesignError, match=match):
         design.from_action(bad)

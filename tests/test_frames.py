@@ -60,7 +60,9 @@ def test_round_trip_pose_dof_pose(reference_point):
 
 def test_round_trip_dof_pose_dof():
     rng = np.random.default_rng(1)
-    dof = np.c_[rng.uniform(-20, 20, (50, 3)), rng.uniform(-170, 170, 50), rng.uniform(-85, 85, 50), rng.uniform(-170, 170, 50)]
+    dof = np.c_[
+        rng.uniform(-20, 20, (50, 3)), rng.uniform(-170, 170, 50), rng.uniform(-85, 85, 50), rng.uniform(-170, 170, 50)
+    ]
     c = np.array([1.0, -15.0, 4.0])
     np.testing.assert_allclose(pose_to_dof(dof_to_pose(dof, c), c), dof, atol=1e-9)
 
@@ -112,7 +114,9 @@ def test_per_bone_reference_points_broadcast():
 @pytest.mark.parametrize("expressed_in", ["bone", "rcs"])
 def test_error_of_identical_poses_is_zero(expressed_in):
     poses = random_poses((2, 6), seed=4)
-    np.testing.assert_allclose(error_transform(poses, poses, expressed_in=expressed_in), np.tile(np.eye(4), (2, 6, 1, 1)), atol=1e-12)
+    np.testing.assert_allclose(
+        error_transform(poses, poses, expressed_in=expressed_in), np.tile(np.eye(4), (2, 6, 1, 1)), atol=1e-12
+    )
     np.testing.assert_allclose(error_dof(poses, poses, (2.0, -9.0, 5.0), expressed_in=expressed_in), 0.0, atol=1e-10)
     np.testing.assert_allclose(rmse(poses, poses, expressed_in=expressed_in), 0.0, atol=1e-10)
 
@@ -121,7 +125,9 @@ def test_error_transform_definitions():
     experiment = random_poses((5,), seed=5)
     model = random_poses((5,), seed=6)
     np.testing.assert_allclose(error_transform(model, experiment), invert(experiment) @ model, atol=1e-12)
-    np.testing.assert_allclose(error_transform(model, experiment, expressed_in="rcs"), model @ np.linalg.inv(experiment), atol=1e-10)
+    np.testing.assert_allclose(
+        error_transform(model, experiment, expressed_in="rcs"), model @ np.linalg.inv(experiment), atol=1e-10
+    )
     np.testing.assert_allclose(invert(experiment) @ experiment, np.tile(np.eye(4), (5, 1, 1)), atol=1e-12)
 
 

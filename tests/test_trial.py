@@ -20,7 +20,13 @@ from wrist_env.trial import (
 
 BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate")
 # rotation centres (mm, RCS) and share of the hand's motion of each bone
-CENTRES = {"radius": (0, 0, 0), "ulna": (0, 0, -20), "scaphoid": (2, -10, 10), "lunate": (0, -10, -2), "capitate": (0, -28, 3)}
+CENTRES = {
+    "radius": (0, 0, 0),
+    "ulna": (0, 0, -20),
+    "scaphoid": (2, -10, 10),
+    "lunate": (0, -10, -2),
+    "capitate": (0, -28, 3),
+}
 SHARE = {"radius": 0.0, "ulna": 0.0, "scaphoid": 0.8, "lunate": 0.5, "capitate": 1.0}
 
 
@@ -238,7 +244,9 @@ def test_bad_role():
 def test_bottom_row():
     transforms = flexion_transforms()
     transforms[2, 5, 3, 0] = 0.1
-    with pytest.raises(TrialError, match=r"my array: the bottom row.*bone 'scaphoid' frame 5 has \[0.1, 0.0, 0.0, 1.0\]"):
+    with pytest.raises(
+        TrialError, match=r"my array: the bottom row.*bone 'scaphoid' frame 5 has \[0.1, 0.0, 0.0, 1.0\]"
+    ):
         validate_transforms(transforms, "my array", BONES)
 
 

@@ -9,8 +9,15 @@ import pytest
 from wrist_env import design, validation
 from wrist_env.cli import main
 
-CHECK_IDS = ("scaphoid_slope", "lunate_slope", "scaphoid_above_lunate", "rs_rl_force_ratio", "sl_gap_growth_mm",
-             "rs_mean_pressure_mpa", "slil_force_30ext_n")
+CHECK_IDS = (
+    "scaphoid_slope",
+    "lunate_slope",
+    "scaphoid_above_lunate",
+    "rs_rl_force_ratio",
+    "sl_gap_growth_mm",
+    "rs_mean_pressure_mpa",
+    "slil_force_30ext_n",
+)
 
 
 def test_slope_recovers_a_known_line_and_ignores_nan():
@@ -55,16 +62,28 @@ def test_with_tears_uses_the_injurable_names():
 
 def test_report_json_is_strict_and_round_trips():
     inf, nan = float("inf"), float("nan")
-    rows = (validation.Check("a", "finite", 1.5, (1.0, 2.0), "mm", "src", True),
-            validation.Check("b", "failed run", nan, (3.0, inf), "mm", "src", False))
-    series = {"capitate_angle_deg": np.array([40.0, 0.0, -40.0]), "sl_gap_intact_mm": np.array([1.0, nan, 1.2]),
-              "intact_status": "ok"}
+    rows = (
+        validation.Check("a", "finite", 1.5, (1.0, 2.0), "mm", "src", True),
+        validation.Check("b", "failed run", nan, (3.0, inf), "mm", "src", False),
+    )
+    series = {
+        "capitate_angle_deg": np.array([40.0, 0.0, -40.0]),
+        "sl_gap_intact_mm": np.array([1.0, nan, 1.2]),
+        "intact_status": "ok",
+    }
     report = validation.Report("X", rows, series, 1.25)
     text = json.dumps(report.to_dict(), allow_nan=False)
     back = json.loads(text)
     assert back["passed"] is False
-    assert back["checks"][0] == {"id": "a", "description": "finite", "value": 1.5, "band": [1.0, 2.0], "unit": "mm",
-                                 "source": "src", "passed": True}
+    assert back["checks"][0] == {
+        "id": "a",
+        "description": "finite",
+        "value": 1.5,
+        "band": [1.0, 2.0],
+        "unit": "mm",
+        "source": "src",
+        "passed": True,
+    }
     assert back["checks"][1]["value"] is None and back["checks"][1]["band"] == [3.0, None]
     assert back["series"]["sl_gap_intact_mm"] == [1.0, None, 1.2] and back["series"]["intact_status"] == "ok"
     assert "FAIL" in validation.format_table(report)
@@ -88,8 +107,9 @@ def test_cli_validate_json_has_the_seven_checks(capsys, built, tmp_path):
 
 
 def test_a_failed_run_fails_its_check_and_says_why():
-    row = validation._row("sl_gap_growth_mm", "SL gap growth", 5.0, (3.0, math.inf), "mm",
-                          "SLIL-torn sweep run failed: NaN in the state")
+    row = validation._row(
+        "sl_gap_growth_mm", "SL gap growth", 5.0, (3.0, math.inf), "mm", "SLIL-torn sweep run failed: NaN in the state"
+    )
     assert math.isnan(row.value) and not row.passed and "failed: NaN in the state" in row.description
 
 

@@ -168,7 +168,9 @@ def kinematic_cost(
     weights = _weights(weights)
     floor = np.asarray(range_floor, dtype=np.float64)
     if floor.shape != (6,) or not np.all(np.isfinite(floor)) or not np.all(floor > 0):
-        raise InputError(f"range_floor must be six finite values > 0 (mm, mm, mm, deg, deg, deg), but got {range_floor!r}.")
+        raise InputError(
+            f"range_floor must be six finite values > 0 (mm, mm, mm, deg, deg, deg), but got {range_floor!r}."
+        )
     experiment = validate_poses(_by_bone(experimental_poses, "experimental poses"), "experimental poses")
     if experiment.ndim != 4 or experiment.shape[1] < 2:
         raise InputError(
@@ -176,7 +178,9 @@ def kinematic_cost(
         )
     model = _by_bone(model_poses, "model poses")
     if model.shape != experiment.shape:
-        raise InputError(f"model poses: must have the shape of the experimental poses {experiment.shape}, but got {model.shape}.")
+        raise InputError(
+            f"model poses: must have the shape of the experimental poses {experiment.shape}, but got {model.shape}."
+        )
     points = _reference_points(reference_points)[:, None, :]  # (2, 1, 3): broadcast over frames
 
     exp_range = np.ptp(pose_to_dof_validated(experiment, points), axis=1)
@@ -200,11 +204,15 @@ def _by_bone(poses, name: str) -> np.ndarray:
     if isinstance(poses, Mapping):
         missing = [b for b in COST_BONES if b not in poses]
         if missing:
-            raise InputError(f"{name}: bones {list(COST_BONES)} are required, but {missing} are missing (got {list(poses)}).")
+            raise InputError(
+                f"{name}: bones {list(COST_BONES)} are required, but {missing} are missing (got {list(poses)})."
+            )
         try:
             return np.stack([np.asarray(poses[b], dtype=np.float64) for b in COST_BONES])
         except ValueError as exc:
-            raise InputError(f"{name}: scaphoid and lunate poses must be arrays of one shape (n_frames, 4, 4): {exc}") from exc
+            raise InputError(
+                f"{name}: scaphoid and lunate poses must be arrays of one shape (n_frames, 4, 4): {exc}"
+            ) from exc
     try:
         array = np.asarray(poses, dtype=np.float64)
     except (TypeError, ValueError) as exc:

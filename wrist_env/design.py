@@ -81,8 +81,12 @@ NAMES = tuple(
 INTACT_INJURY = {name: 1.0 for name in NAMES[N_MATERIAL:]}
 """Normalized injury scalars of intact ligaments: what calibration freezes."""
 
-MEAN = np.concatenate([[l.stiffness_mean for l in LIGAMENTS], np.full(N_LIGAMENTS, REFERENCE_STRAIN_MEAN), np.ones(len(INJURABLE))])
-SD = np.concatenate([[l.stiffness_sd for l in LIGAMENTS], np.full(N_LIGAMENTS, REFERENCE_STRAIN_SD), np.full(len(INJURABLE), np.nan)])
+MEAN = np.concatenate(
+    [[l.stiffness_mean for l in LIGAMENTS], np.full(N_LIGAMENTS, REFERENCE_STRAIN_MEAN), np.ones(len(INJURABLE))]
+)
+SD = np.concatenate(
+    [[l.stiffness_sd for l in LIGAMENTS], np.full(N_LIGAMENTS, REFERENCE_STRAIN_SD), np.full(len(INJURABLE), np.nan)]
+)
 for _a in (MEAN, SD):
     _a.setflags(write=False)
 
@@ -208,9 +212,11 @@ def ligament_arrays(design: Design) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     """(stiffness N/mm, reference strain, torn) of every ligament in `ALL_LIGAMENT_NAMES` order:
     the design's, then the fixed ligaments' (never torn)."""
     n = len(FIXED_LIGAMENTS)
-    return (np.concatenate([design.stiffness, [lig.stiffness_mean for lig in FIXED_LIGAMENTS]]),
-            np.concatenate([design.reference_strain, np.full(n, FIXED_REFERENCE_STRAIN)]),
-            np.concatenate([design.torn, np.zeros(n, bool)]))
+    return (
+        np.concatenate([design.stiffness, [lig.stiffness_mean for lig in FIXED_LIGAMENTS]]),
+        np.concatenate([design.reference_strain, np.full(n, FIXED_REFERENCE_STRAIN)]),
+        np.concatenate([design.torn, np.zeros(n, bool)]),
+    )
 
 
 def z_scores(design: Design) -> np.ndarray:

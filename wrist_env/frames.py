@@ -78,8 +78,10 @@ def validate_poses(poses, name: str = "poses", *, error: type = InputError, wher
     det = np.linalg.det(rot)
     if (det <= 0).any():
         index = np.unravel_index(np.argmin(det), det.shape)
-        raise error(f"{name}: rotations must be proper (det = +1), but {where(index)} has det = {det[index]:.6g} "
-                    f"(a reflection; mirror left wrists instead).")
+        raise error(
+            f"{name}: rotations must be proper (det = +1), but {where(index)} has det = {det[index]:.6g} "
+            f"(a reflection; mirror left wrists instead)."
+        )
     return t
 
 
@@ -114,7 +116,9 @@ def cardan_rotation(angles) -> np.ndarray:
     """Rotation matrices (..., 3, 3) of Cardan Z-X-Y angles (..., 3) in degrees (Flex/Ext, UlnD/RadD, Pro/Sup)."""
     a = np.asarray(angles, dtype=np.float64)
     if a.ndim < 1 or a.shape[-1] != 3:
-        raise InputError(f"angles: must have shape (..., 3) (Flex/Ext, UlnD/RadD, Pro/Sup in degrees), but got {a.shape}.")
+        raise InputError(
+            f"angles: must have shape (..., 3) (Flex/Ext, UlnD/RadD, Pro/Sup in degrees), but got {a.shape}."
+        )
     if not np.isfinite(a).all():
         raise InputError(f"angles: must be finite, but got {a[~np.isfinite(a)][0]}.")
     lead = a.shape[:-1]
@@ -212,8 +216,9 @@ def error_dof(model, experiment, reference_point=None, *, expressed_in: str = "b
     return error_dof_validated(m, e, c, expressed_in=expressed_in)
 
 
-def error_dof_validated(model: np.ndarray, experiment: np.ndarray, point: np.ndarray, *,
-                        expressed_in: str = "bone") -> np.ndarray:
+def error_dof_validated(
+    model: np.ndarray, experiment: np.ndarray, point: np.ndarray, *, expressed_in: str = "bone"
+) -> np.ndarray:
     """`error_dof` of inputs already checked (`validate_poses` of both, one shape; `validate_points`):
     for callers that validate once and evaluate many times (the cost)."""
     error = _error_transform(model, experiment, expressed_in)

@@ -59,23 +59,30 @@ def load_dataclass(cls, path):
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
         raise StoreError(f"{js}: cannot be read as JSON ({e}); delete it to rebuild") from None
     if not isinstance(header, dict) or header.get("class") != cls.__name__ or header.get("format") != FORMAT_VERSION:
-        raise StoreError(f"{js} holds {header.get('class') if isinstance(header, dict) else header!r} "
-                         f"v{header.get('format') if isinstance(header, dict) else '?'}, not {cls.__name__} v{FORMAT_VERSION}")
+        raise StoreError(
+            f"{js} holds {header.get('class') if isinstance(header, dict) else header!r} "
+            f"v{header.get('format') if isinstance(header, dict) else '?'}, not {cls.__name__} v{FORMAT_VERSION}"
+        )
     try:
         digest = _sha256(npz)
     except OSError as e:
         raise StoreError(f"{npz}: cannot be read ({e}); delete {js} to rebuild") from None
     if header.get("npz_sha256") != digest:
-        raise StoreError(f"{npz}: its SHA-256 {digest[:12]}… is not the {str(header.get('npz_sha256'))[:12]}… "
-                         f"written with {js.name} (damaged or changed); delete both to rebuild")
+        raise StoreError(
+            f"{npz}: its SHA-256 {digest[:12]}… is not the {str(header.get('npz_sha256'))[:12]}… "
+            f"written with {js.name} (damaged or changed); delete both to rebuild"
+        )
     try:
         with np.load(npz, allow_pickle=False) as data:
             arrays = {k: data[k] for k in data.files}
     except (OSError, ValueError, zipfile.BadZipFile, EOFError) as e:
         raise StoreError(f"{npz}: cannot be read ({e}); delete it to rebuild") from None
     kwargs = {**header.get("fields", {}), **arrays}
-    missing = [f.name for f in dataclasses.fields(cls) if f.name not in kwargs and f.default is dataclasses.MISSING
-               and f.default_factory is dataclasses.MISSING]
+    missing = [
+        f.name
+        for f in dataclasses.fields(cls)
+        if f.name not in kwargs and f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+    ]
     if missing:
         raise StoreError(f"{path}: lacks fields {missing} of {cls.__name__}; delete it to rebuild")
     for f in dataclasses.fields(cls):
@@ -158,8 +165,9 @@ def read_json(path, what: str = "file", advice: str = "") -> dict | list:
     try:
         return json.loads(path.read_text())
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        raise StoreError(f"{path}: this {what} cannot be read as JSON ({type(e).__name__}: {e})"
-                         + (f"; {advice}" if advice else "")) from None
+        raise StoreError(
+            f"{path}: this {what} cannot be read as JSON ({type(e).__name__}: {e})" + (f"; {advice}" if advice else "")
+        ) from None
 
 
 def _jsonable(value):

@@ -30,7 +30,9 @@ distal row with the capitate (within 3°: Akhbari 2019)."""
 PARTS = tuple(p for b in BONES for p in BODY_PARTS[b])
 """All nine bones of the model: the five principal bones, then the triquetrum and the distal row."""
 PAIRS = ("radioscaphoid", "radiolunate", "scapholunate", "scaphocapitate", "lunocapitate")
-PAIR_BONES = np.array([[SCAPHOID, RADIUS], [LUNATE, RADIUS], [SCAPHOID, LUNATE], [CAPITATE, SCAPHOID], [CAPITATE, LUNATE]])
+PAIR_BONES = np.array(
+    [[SCAPHOID, RADIUS], [LUNATE, RADIUS], [SCAPHOID, LUNATE], [CAPITATE, SCAPHOID], [CAPITATE, LUNATE]]
+)
 """(sample bone, grid bone) of each contact pair: samples of the first are looked up in the second's grid."""
 
 
@@ -105,15 +107,17 @@ class Model:
     def bone_mesh(self, bone: str) -> tuple[np.ndarray, np.ndarray]:
         """(vertices (n, 3) mm, faces (m, 3)) of one bone, neutral pose."""
         i = BONES.index(bone)
-        return (self.vertices[self.vertex_offsets[i]:self.vertex_offsets[i + 1]],
-                self.faces[self.face_offsets[i]:self.face_offsets[i + 1]])
+        return (
+            self.vertices[self.vertex_offsets[i] : self.vertex_offsets[i + 1]],
+            self.faces[self.face_offsets[i] : self.face_offsets[i + 1]],
+        )
 
     def part_mesh(self, part: str) -> tuple[np.ndarray, np.ndarray]:
         """(vertices (n, 3) mm, faces (m, 3)) of one of the nine bones (`PARTS`), neutral pose."""
         body = next(b for b in BONES if part in BODY_PARTS[b])
         v, f = self.bone_mesh(body)
         i = BONES.index(body)
-        keep = self.vertex_part[self.vertex_offsets[i]:self.vertex_offsets[i + 1]] == BODY_PARTS[body].index(part)
+        keep = self.vertex_part[self.vertex_offsets[i] : self.vertex_offsets[i + 1]] == BODY_PARTS[body].index(part)
         f = f[keep[f].all(axis=1)]
         new = np.cumsum(keep) - 1
         return v[keep], new[f]
@@ -121,12 +125,12 @@ class Model:
     def bone_thickness(self, bone: str) -> np.ndarray:
         """Cartilage thickness (n,) mm on one bone's vertices."""
         i = BONES.index(bone)
-        return self.thickness[self.vertex_offsets[i]:self.vertex_offsets[i + 1]]
+        return self.thickness[self.vertex_offsets[i] : self.vertex_offsets[i + 1]]
 
     def grid(self, bone: str) -> np.ndarray:
         """The signed-distance values (nx, ny, nz) of one bone's contact grid."""
         i = BONES.index(bone)
-        return self.grid_values[self.grid_offsets[i]:self.grid_offsets[i + 1]].reshape(self.grid_shape[i])
+        return self.grid_values[self.grid_offsets[i] : self.grid_offsets[i + 1]].reshape(self.grid_shape[i])
 
     def save(self, path) -> None:
         """Write `path.npz` + `path.json`."""

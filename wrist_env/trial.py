@@ -130,9 +130,7 @@ def read_trial_csv(
     missing = [c for c in COLUMNS if c not in table.columns]
     extra = [c for c in table.columns if c not in COLUMNS]
     if missing or extra:
-        raise TrialError(
-            f"{path}: columns must be {','.join(COLUMNS)}, but {missing=} and {extra=}."
-        )
+        raise TrialError(f"{path}: columns must be {','.join(COLUMNS)}, but {missing=} and {extra=}.")
     if table.empty:
         raise TrialError(f"{path}: the file has a header but no rows.")
     for column in ("frame",) + MATRIX_COLUMNS:
@@ -153,9 +151,7 @@ def read_trial_csv(
     unknown = sorted(set(table["bone"]) - set(BONES))
     if unknown:
         row = int(np.flatnonzero(table["bone"] == unknown[0])[0])
-        raise TrialError(
-            f"{path}: bone names must be lower case from {BONES}, but line {row + 2} has {unknown[0]!r}."
-        )
+        raise TrialError(f"{path}: bone names must be lower case from {BONES}, but line {row + 2} has {unknown[0]!r}.")
     duplicated = table.duplicated(["frame", "bone"])
     if duplicated.any():
         row = int(np.flatnonzero(duplicated)[0])

@@ -30,23 +30,33 @@ RAINBOW_SCAPHOID = 0.72  # Rainbow 2013: scaphoid 70 % (flexion), 74 % (extensio
 RAINBOW_LUNATE = 0.44  # Rainbow 2013: lunate 46 % (flexion), 42 % (extension)
 NEUTRAL_LOAD_N = 100.0  # axial load of the load-share check: Hara 1992 loaded neutral wrists with up to 12 kg
 
-RAINBOW = ("Rainbow et al. 2013, J Hand Surg Am 38:278-288 (in vivo CT, 12 wrists, extreme loaded flexion and "
-           "extension: {} of the capitate's flexion / extension)")
+RAINBOW = (
+    "Rainbow et al. 2013, J Hand Surg Am 38:278-288 (in vivo CT, 12 wrists, extreme loaded flexion and "
+    "extension: {} of the capitate's flexion / extension)"
+)
 SOURCES = {
     "scaphoid_slope": RAINBOW.format("scaphoid 70 % / 74 %"),
     "lunate_slope": RAINBOW.format("lunate 46 % / 42 %"),
     "scaphoid_above_lunate": RAINBOW.format("scaphoid 70-74 % against lunate 42-46 %"),
-    "rs_rl_force_ratio": ("Hara et al. 1992, J Hand Surg Am 17:339-347 (neutral wrist: 50 % of the load through the "
-                          "scaphoid fossa, 35 % through the lunate fossa, ratio 1.43); Viegas, Tencer et al. "
-                          "(load transfer characteristics of the wrist): scaphoid/lunate fossa contact-area "
-                          "ratio 1.47"),
-    "sl_gap_growth_mm": ("Haug et al. 2021, Arch Orthop Trauma Surg 141:341-347 (8 axially loaded cadaver wrists: "
-                         "SL gap 6.6 +- 1.6 mm after SLIL transection); a gap > 3 mm is clinical SL dissociation"),
-    "rs_mean_pressure_mpa": ("Andreassen et al. preprint, Figure 3 / Table 5 scale (a no-regression band: Table 5's "
-                             "normalizer, mean RS pressure 0.65 MPa; cadaveric radiocarpal pressures of a few MPa, "
-                             "Hara 1992: peak 2.4 MPa on the scaphoid fossa under 10 kg)"),
-    "slil_force_30ext_n": ("Dimitris et al. 2015, J Hand Surg Am 40:1525-1533 (total SLIL force in active wrist "
-                           "motion ~20 N, 20.0 +- 3.3 N at 30 deg extension; the preprint's ref. 63)"),
+    "rs_rl_force_ratio": (
+        "Hara et al. 1992, J Hand Surg Am 17:339-347 (neutral wrist: 50 % of the load through the "
+        "scaphoid fossa, 35 % through the lunate fossa, ratio 1.43); Viegas, Tencer et al. "
+        "(load transfer characteristics of the wrist): scaphoid/lunate fossa contact-area "
+        "ratio 1.47"
+    ),
+    "sl_gap_growth_mm": (
+        "Haug et al. 2021, Arch Orthop Trauma Surg 141:341-347 (8 axially loaded cadaver wrists: "
+        "SL gap 6.6 +- 1.6 mm after SLIL transection); a gap > 3 mm is clinical SL dissociation"
+    ),
+    "rs_mean_pressure_mpa": (
+        "Andreassen et al. preprint, Figure 3 / Table 5 scale (a no-regression band: Table 5's "
+        "normalizer, mean RS pressure 0.65 MPa; cadaveric radiocarpal pressures of a few MPa, "
+        "Hara 1992: peak 2.4 MPa on the scaphoid fossa under 10 kg)"
+    ),
+    "slil_force_30ext_n": (
+        "Dimitris et al. 2015, J Hand Surg Am 40:1525-1533 (total SLIL force in active wrist "
+        "motion ~20 N, 20.0 +- 3.3 N at 30 deg extension; the preprint's ref. 63)"
+    ),
 }
 
 
@@ -63,9 +73,15 @@ class Check:
     passed: bool
 
     def to_dict(self) -> dict:
-        return {"id": self.id, "description": self.description, "value": _num(self.value),
-                "band": [_num(self.band[0]), _num(self.band[1])], "unit": self.unit, "source": self.source,
-                "passed": bool(self.passed)}
+        return {
+            "id": self.id,
+            "description": self.description,
+            "value": _num(self.value),
+            "band": [_num(self.band[0]), _num(self.band[1])],
+            "unit": self.unit,
+            "source": self.source,
+            "passed": bool(self.passed),
+        }
 
 
 @dataclass(frozen=True)
@@ -88,11 +104,15 @@ class Report:
 
     def to_dict(self) -> dict:
         """Strict JSON: NaN and ±inf become None (a None band edge means unbounded)."""
-        return {"participant": self.participant, "design": "population", "conditions": self.conditions,
-                "passed": self.passed,
-                "checks": [r.to_dict() for r in self.rows],
-                "series": {k: (v if isinstance(v, str) else _list(v)) for k, v in self.series.items()},
-                "wall_seconds": _num(round(self.wall_seconds, 3))}
+        return {
+            "participant": self.participant,
+            "design": "population",
+            "conditions": self.conditions,
+            "passed": self.passed,
+            "checks": [r.to_dict() for r in self.rows],
+            "series": {k: (v if isinstance(v, str) else _list(v)) for k, v in self.series.items()},
+            "wall_seconds": _num(round(self.wall_seconds, 3)),
+        }
 
 
 def _num(x):
@@ -105,6 +125,7 @@ def _list(a):
 
 
 # -- measures ------------------------------------------------------------------------------------------------
+
 
 def slope(x, y) -> float:
     """Least-squares slope of y against x over the finite pairs; NaN if x does not vary."""
@@ -127,16 +148,20 @@ def surface_gap_mm(a_mesh, b_mesh, a_poses, b_poses) -> np.ndarray:
     """
     import igl
 
-    meshes = [(np.ascontiguousarray(v, dtype=np.float64), np.ascontiguousarray(f, dtype=np.int64))
-              for v, f in (a_mesh, b_mesh)]
+    meshes = [
+        (np.ascontiguousarray(v, dtype=np.float64), np.ascontiguousarray(f, dtype=np.int64))
+        for v, f in (a_mesh, b_mesh)
+    ]
     a_poses, b_poses = np.asarray(a_poses, dtype=np.float64), np.asarray(b_poses, dtype=np.float64)
     out = np.full(len(a_poses), np.nan)
     for k, (Ta, Tb) in enumerate(zip(a_poses, b_poses)):
         if not (np.isfinite(Ta).all() and np.isfinite(Tb).all()):
             continue
         best = np.inf
-        for (pv, _), (qv, qf), rel in ((meshes[0], meshes[1], np.linalg.solve(Tb, Ta)),
-                                       (meshes[1], meshes[0], np.linalg.solve(Ta, Tb))):
+        for (pv, _), (qv, qf), rel in (
+            (meshes[0], meshes[1], np.linalg.solve(Tb, Ta)),
+            (meshes[1], meshes[0], np.linalg.solve(Ta, Tb)),
+        ):
             points = np.ascontiguousarray(pv @ rel[:3, :3].T + rel[:3, 3])
             sq, _, _ = igl.point_mesh_squared_distance(points, qv, qf)
             best = min(best, float(np.sqrt(sq.min())))
@@ -170,6 +195,7 @@ def at_angle(angle_deg, values, target_deg: float) -> float:
 
 # -- the checks ----------------------------------------------------------------------------------------------
 
+
 def _row(check_id, description, value, band, unit, failed=None) -> Check:
     if failed:
         description = f"{description} [not measured: {failed}]"
@@ -183,8 +209,15 @@ def _failure(label, result) -> str | None:
     return None if result.ok else f"{label} run {result.message}"
 
 
-def validate(name: str, *, model=None, d: design_mod.Design | None = None, n_frames: int = 17, params=None,
-             load_n: float = IDEALIZED_LOAD_N) -> Report:
+def validate(
+    name: str,
+    *,
+    model=None,
+    d: design_mod.Design | None = None,
+    n_frames: int = 17,
+    params=None,
+    load_n: float = IDEALIZED_LOAD_N,
+) -> Report:
     """Run the published-measurement checks on participant `name` (population design by default).
 
     params: build parameters (`BuildParams`; the anatomy variant), default the default build.
@@ -212,38 +245,96 @@ def validate(name: str, *, model=None, d: design_mod.Design | None = None, n_fra
     gap_intact, gap_torn = sl_gap_mm(model, intact.poses), sl_gap_mm(model, torn.poses)
     slil = [design_mod.LIGAMENT_NAMES.index(n) for n in SLIL]
     slil_total = intact.bundle_force[:, slil].sum(axis=1)
-    fail_i, fail_t, fail_n = _failure("intact sweep", intact), _failure("SLIL-torn sweep", torn), \
-        _failure("neutral", neutral)
+    fail_i, fail_t, fail_n = (
+        _failure("intact sweep", intact),
+        _failure("SLIL-torn sweep", torn),
+        _failure("neutral", neutral),
+    )
     inf = float("inf")
     with np.errstate(divide="ignore", invalid="ignore"):
         rs_rl = float(neutral.contact[0, rs, 3] / neutral.contact[0, rl, 3])
     rows = (
-        _row("scaphoid_slope", "scaphoid flexion per degree of capitate flexion (least squares, idealized +-40 deg "
-             "sweep)", s_slope, (0.55, 0.95), "deg/deg", fail_i),
-        _row("lunate_slope", "lunate flexion per degree of capitate flexion (least squares, idealized +-40 deg "
-             "sweep)", l_slope, (0.30, 0.75), "deg/deg", fail_i),
-        _row("scaphoid_above_lunate", "scaphoid slope minus lunate slope", s_slope - l_slope, (0.0, inf),
-             "deg/deg", fail_i),
-        _row("rs_rl_force_ratio", f"radioscaphoid / radiolunate contact force, capitate held at neutral under "
-             f"{NEUTRAL_LOAD_N:g} N", rs_rl, (1.1, 2.0), "ratio",
-             fail_n),
-        _row("sl_gap_growth_mm", "SL gap at full extension (last frame), all three SLIL bundles torn minus intact",
-             gap_torn[-1] - gap_intact[-1], (SL_DISSOCIATION_MM, inf), "mm", fail_i or fail_t),
-        _row("rs_mean_pressure_mpa", "radioscaphoid mean contact pressure, mean over the sweep's frames",
-             np.nanmean(intact.contact[:, rs, 0]) if intact.ok else np.nan, (0.2, 3.0), "MPa", fail_i),
-        _row("slil_force_30ext_n", "total SLIL force (SLIL_v + SLIL_p + SLIL_d) at 30 deg extension",
-             at_angle(intact.angle_deg, slil_total, EXTENSION_30_DEG), (10.0, 40.0), "N", fail_i),
+        _row(
+            "scaphoid_slope",
+            "scaphoid flexion per degree of capitate flexion (least squares, idealized +-40 deg sweep)",
+            s_slope,
+            (0.55, 0.95),
+            "deg/deg",
+            fail_i,
+        ),
+        _row(
+            "lunate_slope",
+            "lunate flexion per degree of capitate flexion (least squares, idealized +-40 deg sweep)",
+            l_slope,
+            (0.30, 0.75),
+            "deg/deg",
+            fail_i,
+        ),
+        _row(
+            "scaphoid_above_lunate",
+            "scaphoid slope minus lunate slope",
+            s_slope - l_slope,
+            (0.0, inf),
+            "deg/deg",
+            fail_i,
+        ),
+        _row(
+            "rs_rl_force_ratio",
+            f"radioscaphoid / radiolunate contact force, capitate held at neutral under {NEUTRAL_LOAD_N:g} N",
+            rs_rl,
+            (1.1, 2.0),
+            "ratio",
+            fail_n,
+        ),
+        _row(
+            "sl_gap_growth_mm",
+            "SL gap at full extension (last frame), all three SLIL bundles torn minus intact",
+            gap_torn[-1] - gap_intact[-1],
+            (SL_DISSOCIATION_MM, inf),
+            "mm",
+            fail_i or fail_t,
+        ),
+        _row(
+            "rs_mean_pressure_mpa",
+            "radioscaphoid mean contact pressure, mean over the sweep's frames",
+            np.nanmean(intact.contact[:, rs, 0]) if intact.ok else np.nan,
+            (0.2, 3.0),
+            "MPa",
+            fail_i,
+        ),
+        _row(
+            "slil_force_30ext_n",
+            "total SLIL force (SLIL_v + SLIL_p + SLIL_d) at 30 deg extension",
+            at_angle(intact.angle_deg, slil_total, EXTENSION_30_DEG),
+            (10.0, 40.0),
+            "N",
+            fail_i,
+        ),
     )
-    series = {"capitate_angle_deg": intact.angle_deg, "capitate_flexion_deg": cap, "scaphoid_flexion_deg": sca,
-              "lunate_flexion_deg": lun, "sl_gap_intact_mm": gap_intact, "sl_gap_slil_torn_mm": gap_torn,
-              "slil_force_intact_n": slil_total, "rs_mean_pressure_intact_mpa": intact.contact[:, rs, 0],
-              "intact_status": intact.message, "slil_torn_status": torn.message, "neutral_status": neutral.message}
-    conditions = {"fossa_sweep_deg": list(params.anatomy[0]), "distal_row": params.anatomy[1],
-                  "fixed_ligaments": bool(params.fixed_ligaments and params.distal_row), "load_n": float(load_n)}
+    series = {
+        "capitate_angle_deg": intact.angle_deg,
+        "capitate_flexion_deg": cap,
+        "scaphoid_flexion_deg": sca,
+        "lunate_flexion_deg": lun,
+        "sl_gap_intact_mm": gap_intact,
+        "sl_gap_slil_torn_mm": gap_torn,
+        "slil_force_intact_n": slil_total,
+        "rs_mean_pressure_intact_mpa": intact.contact[:, rs, 0],
+        "intact_status": intact.message,
+        "slil_torn_status": torn.message,
+        "neutral_status": neutral.message,
+    }
+    conditions = {
+        "fossa_sweep_deg": list(params.anatomy[0]),
+        "distal_row": params.anatomy[1],
+        "fixed_ligaments": bool(params.fixed_ligaments and params.distal_row),
+        "load_n": float(load_n),
+    }
     return Report(model.name, rows, series, time.perf_counter() - start, conditions)
 
 
 # -- output --------------------------------------------------------------------------------------------------
+
 
 def _fmt(x: float) -> str:
     return f"{x:.3g}" if math.isfinite(x) else str(x)
@@ -252,14 +343,22 @@ def _fmt(x: float) -> str:
 def format_table(report: Report) -> str:
     """The checks as a plain-text table: check, value, band, unit, pass/FAIL, source."""
     c = report.conditions
-    lines = [f"{report.participant}, population design: the model against published measurements"
-             + (f" (fossa sweep ±{c['fossa_sweep_deg']} deg, distal row {'on' if c['distal_row'] else 'off'}, "
-                f"TC/TH {'on' if c.get('fixed_ligaments') else 'off'}, sweep load {c['load_n']:g} N)" if c else ""),
-             f"{'check':<22} {'value':>8}  {'band':<13} {'unit':<8} {'result':<6}  source"]
+    lines = [
+        f"{report.participant}, population design: the model against published measurements"
+        + (
+            f" (fossa sweep ±{c['fossa_sweep_deg']} deg, distal row {'on' if c['distal_row'] else 'off'}, "
+            f"TC/TH {'on' if c.get('fixed_ligaments') else 'off'}, sweep load {c['load_n']:g} N)"
+            if c
+            else ""
+        ),
+        f"{'check':<22} {'value':>8}  {'band':<13} {'unit':<8} {'result':<6}  source",
+    ]
     for r in report.rows:
         band = f"{_fmt(r.band[0])}-{_fmt(r.band[1])}" if math.isfinite(r.band[1]) else f"> {_fmt(r.band[0])}"
-        lines.append(f"{r.id:<22} {_fmt(r.value):>8}  {band:<13} {r.unit:<8} {'pass' if r.passed else 'FAIL':<6}  "
-                     f"{r.source.split(' (')[0]}")
+        lines.append(
+            f"{r.id:<22} {_fmt(r.value):>8}  {band:<13} {r.unit:<8} {'pass' if r.passed else 'FAIL':<6}  "
+            f"{r.source.split(' (')[0]}"
+        )
     for r in report.rows:
         if "[not measured" in r.description:
             lines.append(f"{r.id}: {r.description}")
@@ -287,7 +386,10 @@ def validation_figure(report: Report, out: Path | None = None) -> Path:
     fig, (left, right) = plt.subplots(1, 2, figsize=(13, 5.6), gridspec_kw=dict(width_ratios=(1.1, 1)))
     lim = float(np.nanmax(np.abs(angle))) + 3
     xs = np.array([-lim, lim])
-    for bone, check, ref in (("scaphoid", "scaphoid_slope", RAINBOW_SCAPHOID), ("lunate", "lunate_slope", RAINBOW_LUNATE)):
+    for bone, check, ref in (
+        ("scaphoid", "scaphoid_slope", RAINBOW_SCAPHOID),
+        ("lunate", "lunate_slope", RAINBOW_LUNATE),
+    ):
         y = np.asarray(s[f"{bone}_flexion_deg"], dtype=float)
         k = report.row(check).value
         left.plot(cap, y, "o", color=colours[bone], ms=4, label=f"{bone}, model")
@@ -295,8 +397,9 @@ def validation_figure(report: Report, out: Path | None = None) -> Path:
             ok = np.isfinite(cap) & np.isfinite(y)
             b0 = float(np.mean(y[ok]) - k * np.mean(cap[ok]))
             left.plot(xs, k * xs + b0, "-", color=colours[bone], lw=1.5, label=f"{bone}, model slope {k:.2f}")
-        left.plot(xs, ref * xs, "--", color=colours[bone], lw=1.2, alpha=0.7,
-                  label=f"{bone}, Rainbow 2013 ratio {ref:.2f}")
+        left.plot(
+            xs, ref * xs, "--", color=colours[bone], lw=1.2, alpha=0.7, label=f"{bone}, Rainbow 2013 ratio {ref:.2f}"
+        )
     left.plot(xs, xs, ":", color="0.6", lw=1, label="identity (moves with the capitate)")
     left.axhline(0, color="0.85", lw=0.8, zorder=0)
     left.axvline(0, color="0.85", lw=0.8, zorder=0)
@@ -312,14 +415,25 @@ def validation_figure(report: Report, out: Path | None = None) -> Path:
     right.plot(angle, g_i, "o-", color="0.2", ms=4, label="intact")
     right.plot(angle, g_t, "s-", color="#d62728", ms=4, label="SLIL_v + SLIL_p + SLIL_d torn")
     right.axhline(SL_DISSOCIATION_MM, color="#ff7f0e", ls="--", lw=1.2, label="3 mm gap: clinical SL dissociation")
-    right.axhspan(6.6 - 1.6, 6.6 + 1.6, color="#ff7f0e", alpha=0.12, lw=0,
-                  label="Haug 2021: 6.6 ± 1.6 mm after SLIL transection")
+    right.axhspan(
+        6.6 - 1.6, 6.6 + 1.6, color="#ff7f0e", alpha=0.12, lw=0, label="Haug 2021: 6.6 ± 1.6 mm after SLIL transection"
+    )
     growth = report.row("sl_gap_growth_mm")
-    notes = [f"check: torn − intact at full extension {_fmt(growth.value)} mm "
-             f"(band > {_fmt(growth.band[0])} mm): {'pass' if growth.passed else 'FAIL'}"]
+    notes = [
+        f"check: torn − intact at full extension {_fmt(growth.value)} mm "
+        f"(band > {_fmt(growth.band[0])} mm): {'pass' if growth.passed else 'FAIL'}"
+    ]
     notes += [f"{k}: {s[k]}" for k in ("intact_status", "slil_torn_status") if s.get(k) != "ok"]
-    right.text(0.98, 0.37, "\n".join(notes), transform=right.transAxes, ha="right", va="center", fontsize=9,
-               bbox=dict(boxstyle="round", fc="white", ec="0.8"))
+    right.text(
+        0.98,
+        0.37,
+        "\n".join(notes),
+        transform=right.transAxes,
+        ha="right",
+        va="center",
+        fontsize=9,
+        bbox=dict(boxstyle="round", fc="white", ec="0.8"),
+    )
     right.set_xlim(lim, -lim)  # flexion on the left, extension on the right: the sweep's direction
     top = np.nanmax(np.concatenate([g_i, g_t, [9.5]]))
     right.set_ylim(0, float(top) * 1.12)
@@ -328,13 +442,24 @@ def validation_figure(report: Report, out: Path | None = None) -> Path:
     right.set_title("SL gap over the idealized sweep")
     right.legend(loc="upper left", fontsize=8)
     n = sum(r.passed for r in report.rows)
-    fig.suptitle(f"{report.participant}, population design: {n}/{len(report.rows)} published-measurement checks pass",
-                 fontsize=12)
+    fig.suptitle(
+        f"{report.participant}, population design: {n}/{len(report.rows)} published-measurement checks pass",
+        fontsize=12,
+    )
     fig.tight_layout()
     fig.savefig(out, dpi=120)
     plt.close(fig)
     return out
 
 
-__all__ = ["Check", "Report", "format_table", "sl_gap_mm", "slope", "surface_gap_mm",
-           "validate", "validation_figure", "with_tears"]
+__all__ = [
+    "Check",
+    "Report",
+    "format_table",
+    "sl_gap_mm",
+    "slope",
+    "surface_gap_mm",
+    "validate",
+    "validation_figure",
+    "with_tears",
+]

@@ -59,7 +59,9 @@ def test_rebuilt_fossae_are_fine_watertight_and_congruent(template):
 
     for art in ("radioscaphoid", "radiolunate"):
         _, bone, _, mask = ann.coverage[art]
-        d2 = igl.point_mesh_squared_distance(template.bones[bone].vertices[mask], cap.vertices, cap.faces.astype(np.int64))[0]
+        d2 = igl.point_mesh_squared_distance(
+            template.bones[bone].vertices[mask], cap.vertices, cap.faces.astype(np.int64)
+        )[0]
         gap = np.sqrt(d2)
         assert np.median(gap) == pytest.approx(JOINT_SPACE_MM, abs=0.15)
         assert gap.min() > 1.0

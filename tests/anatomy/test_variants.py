@@ -37,12 +37,15 @@ def test_distal_row_bodies_are_their_parts_in_order(wrist):
         assert surface.trimesh(solid_only=True).is_watertight or not surface.solid.any()  # closed parts, closed body
 
 
-@pytest.mark.parametrize("bone, partner, most_mm", [
-    ("scaphoid", "trapezoid", 2.0),  # the STT joint: the scaphoid's distal pole against the trapezoid
-    ("scaphoid", "trapezium", 3.0),  # ... and the trapezium
-    ("triquetrum", "hamate", 1.5),  # the triquetrohamate joint
-    ("lunate", "triquetrum", 1.0),  # the lunotriquetral joint
-])
+@pytest.mark.parametrize(
+    "bone, partner, most_mm",
+    [
+        ("scaphoid", "trapezoid", 2.0),  # the STT joint: the scaphoid's distal pole against the trapezoid
+        ("scaphoid", "trapezium", 3.0),  # ... and the trapezium
+        ("triquetrum", "hamate", 1.5),  # the triquetrohamate joint
+        ("lunate", "triquetrum", 1.0),  # the lunotriquetral joint
+    ],
+)
 def test_new_bones_articulate_where_anatomy_puts_them(wrist, bone, partner, most_mm):
     """Each new joint is open (no overlap) and within a joint space of its partner."""
     a, b = wrist.parts[bone], wrist.parts[partner]

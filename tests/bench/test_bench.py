@@ -23,9 +23,20 @@ from wrist_env.errors import StoreError
 
 REPO = Path(wrist_env.__file__).resolve().parent.parent
 TINY = ["random", "lhs"] if "lhs" in optimizers.available() else ["random"]
-LEADERBOARD_FILES = ("README.md", "best_cost.csv", "evals_to_target.csv", "recovery.csv", "heldout.csv",
-                     "table3_rmse_calibrate.csv", "table4_rmse_validate.csv", "dof_improved.csv", "runs.csv",
-                     "targets.csv", "ecdf.png", "convergence.png")
+LEADERBOARD_FILES = (
+    "README.md",
+    "best_cost.csv",
+    "evals_to_target.csv",
+    "recovery.csv",
+    "heldout.csv",
+    "table3_rmse_calibrate.csv",
+    "table4_rmse_validate.csv",
+    "dof_improved.csv",
+    "runs.csv",
+    "targets.csv",
+    "ecdf.png",
+    "convergence.png",
+)
 
 
 @pytest.fixture(scope="module")
@@ -44,7 +55,7 @@ def test_tiny_benchmark_logs_every_evaluation_once_and_writes_the_leaderboard(p1
     rows = RunLog(tmp_path / "runs").read(dedupe=False)
     assert len(rows) == 1 * len(TINY) * 2 * 12
     assert _duplicates(rows) == 0 and np.isfinite(rows.cost).all()
-    for (_, group) in rows.groupby(list(KEY_FIELDS)):
+    for _, group in rows.groupby(list(KEY_FIELDS)):
         assert group["eval"].tolist() == list(range(12))
     path = write_leaderboard(tmp_path / "runs", tmp_path / "lb")
     for name in LEADERBOARD_FILES:
@@ -68,9 +79,25 @@ def test_killed_benchmark_resumes_to_the_same_leaderboard(p1, tmp_path):
 
     out = tmp_path / "killed"
     env = dict(os.environ, PYTHONPATH=str(REPO))
-    proc = subprocess.Popen([sys.executable, "-m", "wrist_env.cli", "benchmark", *args, "--out", str(out),
-                             "--workers", "1", "--no-progress"], env=env, cwd=tmp_path, start_new_session=True,
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "wrist_env.cli",
+            "benchmark",
+            *args,
+            "--out",
+            str(out),
+            "--workers",
+            "1",
+            "--no-progress",
+        ],
+        env=env,
+        cwd=tmp_path,
+        start_new_session=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+    )
     deadline = time.monotonic() + 90
     while time.monotonic() < deadline and proc.poll() is None:
         if list((out / "evals").glob("part-*.parquet")):  # a cell is half done
@@ -84,8 +111,22 @@ def test_killed_benchmark_resumes_to_the_same_leaderboard(p1, tmp_path):
     assert 0 < logged < len(TINY) * 2 * 48
     assert list((out / "evals").glob("part-*.parquet")), "no cell was left half done"
 
-    assert main(["benchmark", *args, "--out", str(out), "--workers", "1", "--no-progress",
-                 "--leaderboard", str(tmp_path / "lb_resumed")]) == 0
+    assert (
+        main(
+            [
+                "benchmark",
+                *args,
+                "--out",
+                str(out),
+                "--workers",
+                "1",
+                "--no-progress",
+                "--leaderboard",
+                str(tmp_path / "lb_resumed"),
+            ]
+        )
+        == 0
+    )
     rows = log.read(dedupe=False)
     assert len(rows) == len(TINY) * 2 * 48 and _duplicates(rows) == 0
     assert sum(s["replayed"] for s in log.summaries()) > 0  # the half-done cell resumed by replay
@@ -97,10 +138,12 @@ def test_dask_local_cluster_gives_the_same_costs_as_local(p1, tmp_path):
     sys_path = os.environ.get("PYTHONPATH")
     os.environ["PYTHONPATH"] = str(REPO)  # the worker processes import this checkout
     try:
-        with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                      dashboard_address=None) as cluster:
-            report = benchmark([p1], ["random"], [0], 16, tmp_path / "dask", scheduler=cluster.scheduler_address,
-                               progress=False)
+        with distributed.LocalCluster(
+            n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+        ) as cluster:
+            report = benchmark(
+                [p1], ["random"], [0], 16, tmp_path / "dask", scheduler=cluster.scheduler_address, progress=False
+            )
     finally:
         if sys_path is None:
             os.environ.pop("PYTHONPATH", None)
@@ -118,8 +161,9 @@ def test_cli_calibrate_json_parses(p1, capsys):
     assert main(["calibrate", p1, "--optimizer", "random", "--budget", "8", "--seed", "0", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["nfev"] == 8 and len(out["history_fun"]) == 8 and out["best_cost"] == min(out["history_fun"])
-    assert len(out["design"]) == 27 and all(out["design"][f"{n}.injury"] == 1.0
-                                             for n in ("SLIL_v", "SLIL_p", "SLIL_d", "RSC", "LRL"))
+    assert len(out["design"]) == 27 and all(
+        out["design"][f"{n}.injury"] == 1.0 for n in ("SLIL_v", "SLIL_p", "SLIL_d", "RSC", "LRL")
+    )
     assert 5 < out["design"]["SLIL_d.stiffness"] < 160  # physical units (N/mm), not normalized
     assert np.isfinite(out["validate"]["cost"]) and out["recovery_z"] > 0
     assert out["calibrate"]["cost"] == pytest.approx(out["best_cost"])
@@ -208,7 +252,7 @@ def test_a_damaged_evaluation_file_is_named_then_resimulated(p1, finished, tmp_p
     runs = _copy_runs(finished, tmp_path)
     path = sorted((runs / "evals").glob("cell-*seed1*.parquet"))[0]
     data = path.read_bytes()
-    path.write_bytes({"truncated": data[:len(data) // 2], "empty": b"", "garbage": b"garbage" * 50}[damage])
+    path.write_bytes({"truncated": data[: len(data) // 2], "empty": b"", "garbage": b"garbage" * 50}[damage])
     with pytest.raises(StoreError, match=re.escape(path.name) + ".*damaged Parquet.*rerun the benchmark"):
         write_leaderboard(runs, tmp_path / "lb")
     with pytest.warns(UserWarning, match=re.escape(path.name)):
@@ -253,11 +297,31 @@ def test_a_truncated_cell_summary_is_named_then_rerun_by_replay(p1, finished, tm
 
 
 def test_two_benchmarks_on_one_folder_at_once_log_every_evaluation_once(p1, tmp_path):
-    args = ["--participants", p1, "--optimizers", "random", "--seeds", "3", "--budget", "24", "--out",
-            str(tmp_path / "runs"), "--workers", "1", "--no-progress"]
+    args = [
+        "--participants",
+        p1,
+        "--optimizers",
+        "random",
+        "--seeds",
+        "3",
+        "--budget",
+        "24",
+        "--out",
+        str(tmp_path / "runs"),
+        "--workers",
+        "1",
+        "--no-progress",
+    ]
     env = dict(os.environ, PYTHONPATH=str(REPO))
-    procs = [subprocess.Popen([sys.executable, "-m", "wrist_env.cli", "benchmark", *args], env=env,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.PIPE) for _ in range(2)]
+    procs = [
+        subprocess.Popen(
+            [sys.executable, "-m", "wrist_env.cli", "benchmark", *args],
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+        )
+        for _ in range(2)
+    ]
     for proc in procs:
         assert proc.wait(timeout=600) == 0, proc.stderr.read().decode()[-2000:]
     log = RunLog(tmp_path / "runs")

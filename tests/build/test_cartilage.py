@@ -40,6 +40,7 @@ def plane_points(spacing=0.5, half=10.0, jitter=0.0, seed=0):
 
 # --- GRNN -------------------------------------------------------------------
 
+
 def test_grnn_returns_a_constant_field_exactly():
     rng = np.random.default_rng(1)
     points = rng.uniform(-5, 5, (400, 3))
@@ -79,6 +80,7 @@ def test_grnn_smooths_vector_values_per_component():
 
 
 # --- thickness ---------------------------------------------------------------
+
 
 def test_gap_between_concentric_spheres_is_the_radial_gap():
     va, fa = sphere()
@@ -129,6 +131,7 @@ def test_thickness_is_clipped_to_its_bounds_and_zero_off_coverage():
 
 # --- displacement and wedges -----------------------------------------------
 
+
 def test_displacement_moves_covered_vertices_outward_by_their_thickness():
     v, f = sphere()
     t = np.where(v[:, 2] > 0, 0.5, 0.0)
@@ -177,6 +180,7 @@ def test_wedges_cover_only_triangles_with_cartilage_on_all_three_vertices():
 
 # --- overclosure -------------------------------------------------------------
 
+
 def two_spheres(gap=1.0, reach=4.0):
     va, fa = sphere()
     u = va[0] / np.linalg.norm(va[0])  # a vertex on the line of centres (the icosphere is point-symmetric)
@@ -189,7 +193,7 @@ def two_spheres(gap=1.0, reach=4.0):
 
 def test_overclosure_removal_separates_two_overlapping_layers():
     v, f, arts, tip_b = two_spheres(gap=1.0)
-    (cover_a, cover_b), = arts.values()
+    ((cover_a, cover_b),) = arts.values()
     t0 = {"a": np.where(cover_a, 0.8, 0.0), "b": np.where(cover_b, 0.8, 0.0)}
     t, report = remove_overclosure(v, f, t0, arts)
     r = report["a-b"]
@@ -207,7 +211,7 @@ def test_overclosure_removal_separates_two_overlapping_layers():
 
 def test_layers_that_fit_are_left_alone():
     v, f, arts, _ = two_spheres(gap=2.0)
-    (cover_a, cover_b), = arts.values()
+    ((cover_a, cover_b),) = arts.values()
     t0 = {"a": np.where(cover_a, 0.8, 0.0), "b": np.where(cover_b, 0.8, 0.0)}
     t, report = remove_overclosure(v, f, t0, arts)
     assert report["a-b"]["vertices_changed"] == 0 and report["a-b"]["overclosure_before_mm"] == 0
@@ -230,6 +234,7 @@ def test_overclosure_ignores_an_open_part_of_the_other_bone():
 
 
 # --- the whole step ---------------------------------------------------------
+
 
 def test_build_cartilage_on_concentric_spheres_reports_plain_numbers():
     va, fa = sphere()
@@ -275,6 +280,7 @@ def test_scapholunate_cartilage_on_the_myo_sim_bones():
 
 
 # --- bad input ----------------------------------------------------------------
+
 
 def test_bad_input_gets_a_clear_error():
     va, fa = sphere()

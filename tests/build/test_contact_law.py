@@ -53,6 +53,7 @@ def test_small_strain_tangent_is_the_confined_modulus():
 
 def test_mooney_rivlin_stress_is_dw_dlambda():
     """Central difference of the strain energy against the closed-form stress."""
+
     def energy(lam):
         i1 = lam ** (-2 / 3) * (2 + lam**2)
         i2 = lam ** (-4 / 3) * (1 + 2 * lam**2)

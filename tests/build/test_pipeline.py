@@ -18,7 +18,9 @@ def test_fibre_counts_match_table_2(built, name):
     counts = np.bincount(model.fibre_ligament, minlength=len(ALL_LIGAMENTS))
     for k, lig in enumerate(ALL_LIGAMENTS):
         assert counts[k] == lig.fibres, lig.name
-    assert model.report["fibres"] == {l.name: l.fibres for l in ALL_LIGAMENTS if l.fibres} | {"RSC": len(model.membrane_connectors)}
+    assert model.report["fibres"] == {l.name: l.fibres for l in ALL_LIGAMENTS if l.fibres} | {
+        "RSC": len(model.membrane_connectors)
+    }
 
 
 @pytest.mark.parametrize("name", PARTICIPANTS)
@@ -39,7 +41,7 @@ def test_no_cartilage_overclosure_remains_in_the_neutral_pose(built, name):
         grid_bone = BONES[PAIR_BONES[p][1]]
         i = BONES.index(grid_bone)
         grid = DistanceGrid(model.grid_origin[i], float(model.grid_spacing[i]), model.grid(grid_bone))
-        pts = model.sample_points[model.sample_offsets[p]:model.sample_offsets[p + 1]]
+        pts = model.sample_points[model.sample_offsets[p] : model.sample_offsets[p + 1]]
         distance, _ = trilinear(grid, pts)
         assert distance.min() > -0.05, (pair, distance.min())  # mm: grid interpolation tolerance
         assert model.report["overclosure_mm"][pair] <= 1e-3
@@ -122,10 +124,13 @@ def test_implausible_joint_spaces_stop_the_build():
     _check_joint_spaces("P1", normal)
     _check_joint_spaces("P1", normal | {"scapholunate": 6.0})
     mirrored = dict(zip(PAIRS, (1.50, 14.39, 15.06, 14.82, 4.21)))  # a right wrist declared left (issue 11)
-    with pytest.raises(BuildError, match=r"participant 'U1': implausible joint spaces in the neutral pose: "
-                                         r"radiolunate 14.39 mm \(plausible 0.3–4 mm\); scapholunate 15.06 mm "
-                                         r"\(plausible 0.3–8 mm\); scaphocapitate 14.82 mm .*; lunocapitate 4.21 mm"
-                                         r".*check `side`"):
+    with pytest.raises(
+        BuildError,
+        match=r"participant 'U1': implausible joint spaces in the neutral pose: "
+        r"radiolunate 14.39 mm \(plausible 0.3–4 mm\); scapholunate 15.06 mm "
+        r"\(plausible 0.3–8 mm\); scaphocapitate 14.82 mm .*; lunocapitate 4.21 mm"
+        r".*check `side`",
+    ):
         _check_joint_spaces("U1", mirrored)
     with pytest.raises(BuildError, match=r"radioscaphoid 0.10 mm .*; radiolunate none \(plausible 0.3–4 mm\)"):
         _check_joint_spaces("U1", normal | {"radioscaphoid": 0.1, "radiolunate": None})

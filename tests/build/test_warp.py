@@ -38,8 +38,9 @@ def test_json_round_trip_is_exact():
 
 
 def test_apply_matches_the_closed_form_for_one_basis_function():
-    warp = Warp(scale=1.1, centre=[1.0, 2.0, 3.0], rbf_centres=[[0.0, 0.0, 0.0]], rbf_weights=[[0.0, 0.0, 2.0]],
-                width_mm=10.0)
+    warp = Warp(
+        scale=1.1, centre=[1.0, 2.0, 3.0], rbf_centres=[[0.0, 0.0, 0.0]], rbf_weights=[[0.0, 0.0, 2.0]], width_mm=10.0
+    )
     x = np.array([[10.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
     bump = 2.0 * np.exp(-np.array([100.0, 0.0]) / 200.0)
     expected = warp.centre + 1.1 * (x - warp.centre + np.outer(bump, [0, 0, 1]))
@@ -65,10 +66,11 @@ def test_jacobian_determinant_is_positive_on_a_grid(seed):
 
 
 def test_pure_scale_gives_the_cube_of_the_scale_in_volume(scaphoid):
-    warp = Warp(scale=1.07, centre=[0.0, 0.0, 0.0], rbf_centres=np.zeros((0, 3)), rbf_weights=np.zeros((0, 3)),
-                width_mm=15.0)
+    warp = Warp(
+        scale=1.07, centre=[0.0, 0.0, 0.0], rbf_centres=np.zeros((0, 3)), rbf_weights=np.zeros((0, 3)), width_mm=15.0
+    )
     warped = trimesh.Trimesh(apply_to_mesh(scaphoid.vertices, scaphoid.faces, warp), scaphoid.faces, process=False)
-    assert warped.volume / scaphoid.volume == pytest.approx(1.07 ** 3, rel=1e-9)
+    assert warped.volume / scaphoid.volume == pytest.approx(1.07**3, rel=1e-9)
 
 
 def test_volume_ratio_is_the_scale_cubed_on_average(scaphoid):
@@ -78,7 +80,7 @@ def test_volume_ratio_is_the_scale_cubed_on_average(scaphoid):
     for seed in range(20):
         warp = Warp.from_dict({**random_warp(seed, amplitude_mm=1.0).as_dict(), "scale": 1.05})
         warped = trimesh.Trimesh(apply_to_mesh(scaphoid.vertices, scaphoid.faces, warp), scaphoid.faces)
-        ratios.append(warped.volume / scaphoid.volume / 1.05 ** 3)
+        ratios.append(warped.volume / scaphoid.volume / 1.05**3)
     assert np.mean(ratios) == pytest.approx(1.0, abs=0.02)
     assert np.abs(np.array(ratios) - 1.0).max() < 0.1
 
@@ -91,9 +93,10 @@ def test_warped_volume_is_the_integrated_jacobian(scaphoid, seed):
     lo, hi = scaphoid.bounds
     axes = [np.arange(lo[i], hi[i], 0.5) + 0.25 for i in range(3)]
     cells = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    winding = igl.fast_winding_number(np.asarray(scaphoid.vertices, dtype=np.float64),
-                                      np.asarray(scaphoid.faces, dtype=np.int64), cells)
-    integral = warp.jacobian_det(cells[winding > 0.5]).sum() * 0.5 ** 3
+    winding = igl.fast_winding_number(
+        np.asarray(scaphoid.vertices, dtype=np.float64), np.asarray(scaphoid.faces, dtype=np.int64), cells
+    )
+    integral = warp.jacobian_det(cells[winding > 0.5]).sum() * 0.5**3
     assert warped.volume == pytest.approx(integral, rel=0.01)
 
 

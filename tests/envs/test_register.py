@@ -98,12 +98,16 @@ def _no_capitate(t):
     return t[t.bone != "capitate"]
 
 
-@pytest.mark.parametrize("edit, message", [
-    (_nan, "finite.*bone 'lunate' frame 3 has m01=nan"),
-    (_non_orthonormal, "orthonormal.*bone 'scaphoid' frame 4"),
-    (_no_capitate, r"\['capitate'\] are missing"),
-    ("frames", "n_frames=12 frames, but has 15"),
-], ids=["nan", "non_orthonormal", "missing_bone", "frames"])
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (_nan, "finite.*bone 'lunate' frame 3 has m01=nan"),
+        (_non_orthonormal, "orthonormal.*bone 'scaphoid' frame 4"),
+        (_no_capitate, r"\['capitate'\] are missing"),
+        ("frames", "n_frames=12 frames, but has 15"),
+    ],
+    ids=["nan", "non_orthonormal", "missing_bone", "frames"],
+)
 def test_bad_trial_is_rejected_naming_the_file(tmp_path, calibrate_only, edit, message):
     """test_trial.py checks these rules on read_trial_csv; here they reach register_participant."""
     folder = shutil.copytree(calibrate_only, tmp_path / "bad")

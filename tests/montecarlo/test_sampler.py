@@ -12,13 +12,13 @@ from wrist_env.montecarlo.study import StudyConfig, _chunks, _plan
 
 def test_tear_rate_is_0_3_and_tears_are_independent():
     a = sampler.block_actions(0, "P1", 0, 2000)
-    torn = a[:, design.N_MATERIAL:] < 0
-    assert set(np.unique(a[:, design.N_MATERIAL:])) == {sampler.TORN_ACTION, sampler.INTACT_ACTION}
+    torn = a[:, design.N_MATERIAL :] < 0
+    assert set(np.unique(a[:, design.N_MATERIAL :])) == {sampler.TORN_ACTION, sampler.INTACT_ACTION}
     assert np.all(np.abs(torn.mean(axis=0) - 0.3) <= 0.02), torn.mean(axis=0)
     for i in range(5):
         for j in range(i + 1, 5):
             assert abs((torn[:, i] & torn[:, j]).mean() - 0.09) <= 0.02
-    assert abs((~torn).all(axis=1).mean() - 0.7 ** 5) <= 0.02  # all intact
+    assert abs((~torn).all(axis=1).mean() - 0.7**5) <= 0.02  # all intact
 
 
 def test_each_latin_hypercube_stratum_is_hit_once_per_dimension():
@@ -29,28 +29,31 @@ def test_each_latin_hypercube_stratum_is_hit_once_per_dimension():
         assert np.array_equal(np.sort(np.floor(u[:, k] * n).astype(int)), np.arange(n))
     # the same strata survive the truncated-normal inverse CDF, in the actions of a block
     a = sampler.block_actions(7, "P2", 3, n)
-    back = sps.truncnorm.cdf(a[:, :design.N_MATERIAL] * design.SPAN_SD, -3, 3)
+    back = sps.truncnorm.cdf(a[:, : design.N_MATERIAL] * design.SPAN_SD, -3, 3)
     for k in range(design.N_MATERIAL):
         assert np.array_equal(np.sort(np.floor(back[:, k] * n + 1e-9).astype(int)), np.arange(n))
 
 
 def test_materials_follow_table2_normals_truncated_at_3_sd():
     a = sampler.block_actions(1, "P1", 0, 2000)
-    m = a[:, :design.N_MATERIAL]
+    m = a[:, : design.N_MATERIAL]
     assert m.min() >= -1.0 and m.max() <= 1.0
     for k in range(design.N_MATERIAL):
         assert sps.kstest(m[:, k] * design.SPAN_SD, sps.truncnorm(-3, 3).cdf).pvalue > 0.05
     physical = np.stack([design.from_action(x).vector for x in a[:50]])
-    z = (physical[:, :design.N_MATERIAL] - design.MEAN[:design.N_MATERIAL]) / design.SD[:design.N_MATERIAL]
+    z = (physical[:, : design.N_MATERIAL] - design.MEAN[: design.N_MATERIAL]) / design.SD[: design.N_MATERIAL]
     assert np.allclose(z, m[:50] * design.SPAN_SD)
 
 
 def test_blocks_are_seeded_by_seed_participant_and_block():
     a = sampler.block_actions(0, "P1", 0, 40)
     assert np.array_equal(a, sampler.block_actions(0, "P1", 0, 40))
-    for other in (sampler.block_actions(1, "P1", 0, 40), sampler.block_actions(0, "P2", 0, 40),
-                  sampler.block_actions(0, "P1", 1, 40)):
-        assert not np.array_equal(a[:, :design.N_MATERIAL], other[:, :design.N_MATERIAL])
+    for other in (
+        sampler.block_actions(1, "P1", 0, 40),
+        sampler.block_actions(0, "P2", 0, 40),
+        sampler.block_actions(0, "P1", 1, 40),
+    ):
+        assert not np.array_equal(a[:, : design.N_MATERIAL], other[:, : design.N_MATERIAL])
     with pytest.raises(ValueError):
         sampler.block_seed(-1, "P1", 0)
 

@@ -11,8 +11,15 @@ from wrist_env.montecarlo import stats
 ANGLES = np.linspace(40.0, -40.0, 17)
 PRESSURE_TEARS = {"SLIL_v": 0.0, "SLIL_p": 0.1, "SLIL_d": 0.8, "RSC": 0.3, "LRL": -0.05}  # MPa
 SPLINE = (1.3, -1.8, -0.3)  # intercept (full extension), s1, s2, MPa
-SLIL_TRUTH = {"Intercept": 27.8, "s1": -42.6, "s2": -6.6, "proximal": -25.7, "volar": -1.6,
-              "s1:proximal": 44.8, "s2:proximal": 4.6}  # the preprint's Table 6, N
+SLIL_TRUTH = {
+    "Intercept": 27.8,
+    "s1": -42.6,
+    "s2": -6.6,
+    "proximal": -25.7,
+    "volar": -1.6,
+    "s1:proximal": 44.8,
+    "s2:proximal": 4.6,
+}  # the preprint's Table 6, N
 
 
 def synthetic_runs(n_runs=800, seed=0) -> pa.Table:
@@ -25,11 +32,18 @@ def synthetic_runs(n_runs=800, seed=0) -> pa.Table:
     pressure = curve + shift[:, None] + rng.normal(0, 0.4, (n_runs, 1)) + rng.normal(0, 0.15, (n_runs, 17))
     t = SLIL_TRUTH
     dorsal = t["Intercept"] + b @ np.array([t["s1"], t["s2"]])
-    bundles = {"SLIL_d": dorsal, "SLIL_v": dorsal + t["volar"],
-               "SLIL_p": dorsal + t["proximal"] + b @ np.array([t["s1:proximal"], t["s2:proximal"]])}
+    bundles = {
+        "SLIL_d": dorsal,
+        "SLIL_v": dorsal + t["volar"],
+        "SLIL_p": dorsal + t["proximal"] + b @ np.array([t["s1:proximal"], t["s2:proximal"]]),
+    }
     u = rng.normal(0, 3.0, (n_runs, 1))
-    cols = {"participant": np.where(np.arange(n_runs) % 2, "P2", "P1"), "sample_id": np.arange(n_runs) // 2,
-            "ok": np.ones(n_runs, bool), "excluded": np.zeros(n_runs, bool)}
+    cols = {
+        "participant": np.where(np.arange(n_runs) % 2, "P2", "P1"),
+        "sample_id": np.arange(n_runs) // 2,
+        "ok": np.ones(n_runs, bool),
+        "excluded": np.zeros(n_runs, bool),
+    }
     cols["excluded"][:5] = True  # excluded runs are left out of the fits
     for i, lig in enumerate(INJURABLE):
         cols[f"{lig}.torn"] = torn[:, i]
@@ -80,7 +94,10 @@ def test_pressure_model_recovers_planted_tear_effects(frames):
     # a documented subsample fits on fewer runs and still finds the big effect
     sub = stats.fit_pressure(frames, max_runs=200, seed=1)
     assert sub.runs == 200 and sub.rows == 200 * 17
-    assert abs(sub.table.set_index("term").loc["SLIL_d", "estimate"] - 0.8) < 3 * sub.table.set_index("term").loc["SLIL_d", "se"]
+    assert (
+        abs(sub.table.set_index("term").loc["SLIL_d", "estimate"] - 0.8)
+        < 3 * sub.table.set_index("term").loc["SLIL_d", "se"]
+    )
 
 
 def test_slil_model_recovers_planted_bundle_differences(frames):

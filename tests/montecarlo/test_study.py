@@ -62,8 +62,9 @@ def test_seeded_log_is_identical_twice_with_another_batch_size(reference, tmp_pa
 def test_seeded_log_is_identical_on_a_local_cluster(reference, tmp_path):
     from distributed import LocalCluster
 
-    with LocalCluster(n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None,
-                      processes=True) as cluster:
+    with LocalCluster(
+        n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None, processes=True
+    ) as cluster:
         summary = run_study(CONFIG, tmp_path, batch=8, scheduler=cluster.scheduler_address)
     assert summary.done
     assert read_runs(tmp_path).equals(reference[1])
@@ -75,8 +76,22 @@ def test_seeded_log_is_identical_on_local_worker_processes(reference, tmp_path):
 
 
 def test_killed_study_resumes_with_no_run_lost_or_repeated(reference, tmp_path):
-    cmd = [sys.executable, "-m", "wrist_env.cli", "montecarlo", "P1", "--n", "40", "--seed", "3", "--batch", "2",
-           "--out", str(tmp_path), "--no-progress"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "wrist_env.cli",
+        "montecarlo",
+        "P1",
+        "--n",
+        "40",
+        "--seed",
+        "3",
+        "--batch",
+        "2",
+        "--out",
+        str(tmp_path),
+        "--no-progress",
+    ]
     proc = subprocess.Popen(cmd, env=dict(os.environ), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     runs = tmp_path / "runs"
     deadline = time.monotonic() + 120
@@ -97,8 +112,24 @@ def test_killed_study_resumes_with_no_run_lost_or_repeated(reference, tmp_path):
 
 
 def _start_cli_study(out, batch=2, workers=0):
-    cmd = [sys.executable, "-m", "wrist_env.cli", "montecarlo", "P1", "--n", "40", "--seed", "3", "--batch",
-           str(batch), "--workers", str(workers), "--out", str(out), "--no-progress"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "wrist_env.cli",
+        "montecarlo",
+        "P1",
+        "--n",
+        "40",
+        "--seed",
+        "3",
+        "--batch",
+        str(batch),
+        "--workers",
+        str(workers),
+        "--out",
+        str(out),
+        "--no-progress",
+    ]
     return subprocess.Popen(cmd, env=dict(os.environ), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
 
 
@@ -130,7 +161,7 @@ def test_a_damaged_part_is_named_then_resimulated(reference, tmp_path, damage):
     shutil.copytree(reference[0], tmp_path, dirs_exist_ok=True)
     part = sorted((tmp_path / "runs").glob("*.parquet"))[2]
     data = part.read_bytes()
-    part.write_bytes({"truncated": data[:len(data) // 2], "empty": b"", "garbage": b"not parquet" * 10}[damage])
+    part.write_bytes({"truncated": data[: len(data) // 2], "empty": b"", "garbage": b"not parquet" * 10}[damage])
     with pytest.raises(StoreError, match=re.escape(part.name) + ".*rerun the montecarlo command"):
         read_runs(tmp_path)
     with pytest.warns(UserWarning, match=re.escape(part.name)):
@@ -181,8 +212,17 @@ def test_report_writes_tables_and_figures(reference, tmp_path):
 
     out, _ = reference
     assert cli.main(["montecarlo-report", "--runs", str(out), "--out", str(tmp_path)]) == 0
-    for name in ("table5.md", "table5.csv", "table6.md", "table6.csv", "figure8.png", "figure9.png", "figure10.png",
-                 "summary.json", "report.md"):
+    for name in (
+        "table5.md",
+        "table5.csv",
+        "table6.md",
+        "table6.csv",
+        "figure8.png",
+        "figure9.png",
+        "figure10.png",
+        "summary.json",
+        "report.md",
+    ):
         assert (tmp_path / name).stat().st_size > 100, name
     import pandas as pd
 

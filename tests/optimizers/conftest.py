@@ -34,10 +34,12 @@ def install_third_party_package(root) -> None:
     dist_info = root / "thirdparty_opt-0.1.dist-info"
     dist_info.mkdir()
     (dist_info / "METADATA").write_text("Metadata-Version: 2.1\nName: thirdparty_opt\nVersion: 0.1\n")
-    (dist_info / "entry_points.txt").write_text(textwrap.dedent(f"""\
+    (dist_info / "entry_points.txt").write_text(
+        textwrap.dedent(f"""\
         [wrist_env.optimizers]
         {THIRD_PARTY_NAME} = thirdparty_opt:ThirdPartyRandom
-        """))
+        """)
+    )
 
 
 @pytest.fixture

@@ -34,9 +34,11 @@ def sphere(x):
 
 def test_cmaes_matches_cma():
     # cma directly: the options our adapter documents, seed 0 → cma seed 1
-    es = cma.CMAEvolutionStrategy(np.zeros(DIM).tolist(), 0.3 * 4.0,
-                                  {"bounds": [LOWER.tolist(), UPPER.tolist()], "seed": 1, "popsize": 10,
-                                   "verbose": -9, "maxfevals": BUDGET})
+    es = cma.CMAEvolutionStrategy(
+        np.zeros(DIM).tolist(),
+        0.3 * 4.0,
+        {"bounds": [LOWER.tolist(), UPPER.tolist()], "seed": 1, "popsize": 10, "verbose": -9, "maxfevals": BUDGET},
+    )
     xs, fs = [], []
     while len(fs) < BUDGET:
         assert not es.stop(), es.stop()  # cma would not stop (or restart) before the budget
@@ -78,12 +80,12 @@ def test_cmaes_restarts_with_a_doubled_population():
     opt = optimizers.make("cmaes", dim=2, budget=3000, seed=1)
     result = optimizers.minimize(opt, sphere)
     assert result.nfev == 3000
-    assert opt.restarts >= 1 and opt.popsize == 6 * 2 ** opt.restarts
+    assert opt.restarts >= 1 and opt.popsize == 6 * 2**opt.restarts
     assert result.fun < 1e-12
 
 
 def test_cmaes_truncates_the_last_population():
-    opt = optimizers.make("cmaes", dim=5, budget=20, seed=0)   # popsize 8: batches 8, 8, 4
+    opt = optimizers.make("cmaes", dim=5, budget=20, seed=0)  # popsize 8: batches 8, 8, 4
     sizes = []
     while not opt.done:
         x = opt.ask()
@@ -101,12 +103,18 @@ def test_nelder_mead_matches_scipy():
         evaluated.append(rosenbrock(x))
         return evaluated[-1]
 
-    reference = scipy_minimize(fun, np.zeros(DIM), method="Nelder-Mead", bounds=Bounds(LOWER, UPPER),
-                               options={"maxfev": BUDGET, "initial_simplex": simplex})
+    reference = scipy_minimize(
+        fun,
+        np.zeros(DIM),
+        method="Nelder-Mead",
+        bounds=Bounds(LOWER, UPPER),
+        options={"maxfev": BUDGET, "initial_simplex": simplex},
+    )
     assert reference.nfev == BUDGET and not reference.success  # SciPy's run uses the whole budget
 
-    ours = optimizers.minimize(optimizers.make("nelder-mead", dim=DIM, budget=BUDGET, seed=0,
-                                               lower=LOWER, upper=UPPER), rosenbrock_batch)
+    ours = optimizers.minimize(
+        optimizers.make("nelder-mead", dim=DIM, budget=BUDGET, seed=0, lower=LOWER, upper=UPPER), rosenbrock_batch
+    )
     np.testing.assert_array_equal(ours.history_fun, evaluated)
     assert ours.fun == reference.fun
     np.testing.assert_array_equal(ours.x, reference.x)
@@ -121,8 +129,13 @@ def test_nelder_mead_restarts():
         return evaluated[-1]
 
     lower, upper = -np.ones(2), np.ones(2)
-    reference = scipy_minimize(fun, np.zeros(2), method="Nelder-Mead", bounds=Bounds(lower, upper),
-                               options={"maxfev": 400, "initial_simplex": initial_simplex(np.zeros(2), lower, upper)})
+    reference = scipy_minimize(
+        fun,
+        np.zeros(2),
+        method="Nelder-Mead",
+        bounds=Bounds(lower, upper),
+        options={"maxfev": 400, "initial_simplex": initial_simplex(np.zeros(2), lower, upper)},
+    )
     assert reference.success and reference.nfev < 200
     n = reference.nfev
 

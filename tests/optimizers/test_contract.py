@@ -22,8 +22,8 @@ UPPER = np.array([1.0, 0.5, 3.0, -4.0, 10.5])
 # Budgets are kept small so that each calibrator's share of the test time is
 # small; the Gaussian-process sampler costs ~0.1-1 s per evaluation, hence its
 # own entries.
-SEED_BUDGET = {"optuna-gp": 12}          # same/different seed tests; default 40
-CONVEX_BUDGET = {"optuna-gp": 30}        # convex quadratic; default 200
+SEED_BUDGET = {"optuna-gp": 12}  # same/different seed tests; default 40
+CONVEX_BUDGET = {"optuna-gp": 30}  # convex quadratic; default 200
 EXACT_BUDGETS = (1, 7, 50)
 EXACT_BUDGETS_SLOW = {"optuna-gp": (1, 7, 13)}
 
@@ -31,7 +31,7 @@ EXACT_BUDGETS_SLOW = {"optuna-gp": (1, 7, 13)}
 # uniform random points. Space-filling designs with no feedback (random, LHS)
 # cannot be asked for more than "clearly better than typical" in 5-D with 200
 # points; the methods that learn from the values must reach 10 %.
-CONVEX_FRACTION = {"random": 0.3, "lhs": 0.3, THIRD_PARTY_NAME: 0.3}   # default 0.1
+CONVEX_FRACTION = {"random": 0.3, "lhs": 0.3, THIRD_PARTY_NAME: 0.3}  # default 0.1
 
 # Calibrators whose first run does not depend on the seed: Nelder–Mead starts
 # from the box centre with a fixed simplex; only its restarts are random (tested
@@ -156,6 +156,6 @@ def test_an_unknown_option_is_an_error_listing_the_valid_ones(name, third_party_
 @pytest.mark.parametrize("name", NAMES)
 def test_close_is_safe_before_and_after_use(name, third_party_optimizer):
     opt = optimizers.make(name, dim=5, budget=3, seed=0)
-    optimizers.minimize(opt, lambda x: np.sum(x ** 2, axis=1))
+    optimizers.minimize(opt, lambda x: np.sum(x**2, axis=1))
     opt.close()
     opt.close()

@@ -18,8 +18,15 @@ def sphere(x):
 
 
 def run(name, budget, seed=0, dim=3, fun=sphere, **options):
-    opt = optimizers.make(name, dim, budget, seed=seed, lower=[-1.0, 0.0, 2.0][:dim] + [-1.0] * max(0, dim - 3),
-                          upper=[1.0, 0.5, 3.0][:dim] + [1.0] * max(0, dim - 3), **options)
+    opt = optimizers.make(
+        name,
+        dim,
+        budget,
+        seed=seed,
+        lower=[-1.0, 0.0, 2.0][:dim] + [-1.0] * max(0, dim - 3),
+        upper=[1.0, 0.5, 3.0][:dim] + [1.0] * max(0, dim - 3),
+        **options,
+    )
     sizes = []
     res = optimizers.minimize(opt, fun, callback=lambda x, y: sizes.append(len(x)))
     return opt, res, sizes
@@ -53,8 +60,14 @@ def test_seeded(name):
     assert not np.array_equal(a.history_x, c.history_x)
 
 
-@pytest.mark.parametrize("name, batch", [("optuna-tpe", 8), ("optuna-cmaes", 4 + math.floor(3 * math.log(3))),
-                                         pytest.param("optuna-gp", 1, marks=needs_torch)])
+@pytest.mark.parametrize(
+    "name, batch",
+    [
+        ("optuna-tpe", 8),
+        ("optuna-cmaes", 4 + math.floor(3 * math.log(3))),
+        pytest.param("optuna-gp", 1, marks=needs_torch),
+    ],
+)
 def test_default_batches(name, batch):
     sizes = run(name, 20)[2]
     assert sizes[:-1] == [batch] * (len(sizes) - 1) and 1 <= sizes[-1] <= batch
@@ -106,8 +119,9 @@ def test_journal_file_storage(name, tmp_path):
     path = tmp_path / "studies.log"
     a = run(name, 12, storage=str(path), study_name="P1")[1]
     run(name, 5, storage=path, study_name="P1")
-    study = optuna.load_study(study_name="P1", storage=optuna.storages.JournalStorage(
-        optuna.storages.journal.JournalFileBackend(str(path))))
+    study = optuna.load_study(
+        study_name="P1", storage=optuna.storages.JournalStorage(optuna.storages.journal.JournalFileBackend(str(path)))
+    )
     assert len(study.trials) == 17
     np.testing.assert_array_equal(a.history_x, run(name, 12)[1].history_x)
 

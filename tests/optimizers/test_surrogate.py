@@ -25,8 +25,9 @@ def run(name, fun, dim=5, budget=150, seed=0, lower=-1.0, upper=1.0, **options):
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
-@pytest.mark.parametrize("fun, lower, upper", [(quadratic, -1.0, 1.0), (rosenbrock, -2.0, 2.0)],
-                         ids=["quadratic", "rosenbrock"])
+@pytest.mark.parametrize(
+    "fun, lower, upper", [(quadratic, -1.0, 1.0), (rosenbrock, -2.0, 2.0)], ids=["quadratic", "rosenbrock"]
+)
 def test_beats_random_search(fun, lower, upper, seed):
     _, surrogate, _ = run("surrogate", fun, seed=seed, lower=lower, upper=upper)
     _, random, _ = run("random", fun, seed=seed, lower=lower, upper=upper)
@@ -39,8 +40,9 @@ def test_registered():
     assert optimizers.get("surrogate") is Surrogate
 
 
-@pytest.mark.parametrize("fun, lower, upper", [(quadratic, -1.0, 1.0), (rosenbrock, -2.0, 2.0)],
-                         ids=["quadratic", "rosenbrock"])
+@pytest.mark.parametrize(
+    "fun, lower, upper", [(quadratic, -1.0, 1.0), (rosenbrock, -2.0, 2.0)], ids=["quadratic", "rosenbrock"]
+)
 def test_polish_reduces_the_best_value(fun, lower, upper):
     opt, res, sizes = run("surrogate", fun, lower=lower, upper=upper)
     assert len(opt.polish_log) == 1
@@ -53,8 +55,8 @@ def test_polish_reduces_the_best_value(fun, lower, upper):
     assert polish and set(polish) <= {5, 6}
     assert polish[0] == 5  # starts at the best point, whose value is known
     # and the finite-difference points sit one step (1e-3 box widths) from their centre
-    first = res.history_x[log["nfev_start"]:log["nfev_start"] + 5]
-    centre = res.history_x[int(np.argmin(res.history_fun[:log["nfev_start"]]))]
+    first = res.history_x[log["nfev_start"] : log["nfev_start"] + 5]
+    centre = res.history_x[int(np.argmin(res.history_fun[: log["nfev_start"]]))]
     np.testing.assert_allclose(np.abs(first - centre).sum(axis=1), 1e-3 * (upper - lower), rtol=1e-9)
 
 
@@ -67,8 +69,9 @@ def test_polish_can_be_switched_off():
 @pytest.mark.parametrize("budget", [1, 2, 6, 7, 10, 23, 33, 151])
 def test_budget_exact_bounds_and_no_thread_left(budget):
     before = threading.active_count()
-    opt, res, sizes = run("surrogate", quadratic, dim=5, budget=budget, lower=[-1, -2, 0, 0, 3],
-                          upper=[1, 0, 0.5, 10, 4])
+    opt, res, sizes = run(
+        "surrogate", quadratic, dim=5, budget=budget, lower=[-1, -2, 0, 0, 3], upper=[1, 0, 0.5, 10, 4]
+    )
     assert res.nfev == budget == sum(sizes) == len(res.history_fun)
     assert np.all(res.history_x >= opt.lower) and np.all(res.history_x <= opt.upper)
     assert threading.active_count() == before
@@ -84,6 +87,7 @@ def test_seeded():
 
 def test_failed_evaluations_far_from_the_optimum():
     """NaN (a failed simulation) costs only those points: the surrogate learns to stay away."""
+
     def fails_in_a_corner(x):
         return np.where(x[:, 0] + x[:, 1] < -0.8, np.nan, quadratic(x))
 
@@ -94,13 +98,14 @@ def test_failed_evaluations_far_from_the_optimum():
 
 def test_failed_evaluations_in_the_polish():
     """Failures right past the optimum hit the gradient batches and line search: still a sound run."""
+
     def fails_past_the_optimum(x):
         return np.where(x[:, 0] > 0.305, np.nan, quadratic(x))
 
     opt, res, _ = run("surrogate", fails_past_the_optimum, budget=120)
     log = opt.polish_log[0]
     assert res.nfev == 120 and np.isfinite(res.fun) and log["fun_end"] <= log["fun_start"]
-    assert np.isinf(res.history_fun[log["nfev_start"]:log["nfev_end"]]).any()
+    assert np.isinf(res.history_fun[log["nfev_start"] : log["nfev_end"]]).any()
     random = run("random", fails_past_the_optimum, budget=120)[1]
     assert res.fun < 0.2 * random.fun
 

@@ -18,7 +18,11 @@ from wrist_env.trial import MIRROR, Trial
 
 BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate")
 # carpal ellipsoid semi-axes and centres (mm, RCS: x volar, y proximal, z radial)
-CARPALS = {"scaphoid": ((12, 7, 6), (2, -10, 10)), "lunate": ((9, 7, 8), (0, -10, -2)), "capitate": ((8, 13, 7), (0, -28, 3))}
+CARPALS = {
+    "scaphoid": ((12, 7, 6), (2, -10, 10)),
+    "lunate": ((9, 7, 8), (0, -10, -2)),
+    "capitate": ((8, 13, 7), (0, -28, 3)),
+}
 
 
 def bone_meshes() -> dict:
@@ -138,7 +142,9 @@ def test_left_source_round_trips(tmp_path):
     assert on_disk.bounds[0, 2] == pytest.approx(-16.0, abs=1e-4)  # scaphoid z in [4, 16] mirrored to [-16, -4]
     loaded = load_participant_folder(folder)
     assert_same_triangles(loaded.bones["scaphoid"], source.bones["scaphoid"], atol=1e-5)
-    np.testing.assert_allclose(loaded.trials["unresisted"].transforms, source.trials["unresisted"].transforms, atol=1e-15)
+    np.testing.assert_allclose(
+        loaded.trials["unresisted"].transforms, source.trials["unresisted"].transforms, atol=1e-15
+    )
 
 
 # --- one test per error ---------------------------------------------------------------
@@ -205,7 +211,9 @@ def test_missing_bone_entry(folder):
 
 def test_missing_bone_file(folder):
     (folder / "bones" / "lunate.stl").unlink()
-    with raises(ParticipantError, folder / "participant.toml", "bones.lunate = 'bones/lunate.stl', but .*does not exist"):
+    with raises(
+        ParticipantError, folder / "participant.toml", "bones.lunate = 'bones/lunate.stl', but .*does not exist"
+    ):
         load_participant_folder(folder)
 
 
@@ -221,8 +229,12 @@ def test_listed_files_must_stay_inside_the_folder(folder, tmp_path, how):
     """A bone or trial path that leaves the folder (`..`, absolute, a link out, /proc) is refused
     before it is read: the message names participant.toml and never carries the file's content."""
     secret = _outside(tmp_path)
-    entry = {"dotdot": "../outside/secret.stl", "absolute": str(secret), "symlink": "bones/link.stl",
-             "proc": "../../../../../../../../proc/self/environ"}[how]
+    entry = {
+        "dotdot": "../outside/secret.stl",
+        "absolute": str(secret),
+        "symlink": "bones/link.stl",
+        "proc": "../../../../../../../../proc/self/environ",
+    }[how]
     if how == "symlink":
         (folder / "bones" / "link.stl").symlink_to(secret)
     key = '"trials/unresisted.csv"' if how == "proc" else '"bones/lunate.stl"'
@@ -267,14 +279,20 @@ def test_mesh_in_metres(folder):
     replace_mesh(folder, "lunate", vertices / 1000, faces)
     diagonal = np.linalg.norm(np.ptp(vertices / 1000, axis=0))
     assert 0.02 < diagonal < 0.04
-    with raises(MeshError, folder / "bones" / "lunate.stl", rf"looks like metres: bounding-box diagonal {diagonal:.3g}; convert to mm \(×1000\)"):
+    with raises(
+        MeshError,
+        folder / "bones" / "lunate.stl",
+        rf"looks like metres: bounding-box diagonal {diagonal:.3g}; convert to mm \(×1000\)",
+    ):
         load_participant_folder(folder)
 
 
 def test_carpal_mesh_too_large(folder):
     vertices, faces = bone_meshes()["capitate"]
     replace_mesh(folder, "capitate", vertices * 10, faces)
-    with raises(MeshError, folder / "bones" / "capitate.stl", "looks like the wrong unit: bounding-box diagonal 3[0-9]{2}"):
+    with raises(
+        MeshError, folder / "bones" / "capitate.stl", "looks like the wrong unit: bounding-box diagonal 3[0-9]{2}"
+    ):
         load_participant_folder(folder)
 
 
@@ -288,7 +306,9 @@ def test_radius_mesh_too_large(folder):
 def test_carpal_mesh_in_centimetres(folder):
     vertices, faces = bone_meshes()["scaphoid"]
     replace_mesh(folder, "scaphoid", vertices / 10, faces)
-    with raises(MeshError, folder / "bones" / "scaphoid.stl", r"wrong unit: bounding-box diagonal 3\.[0-9]+, expected 5–100 mm"):
+    with raises(
+        MeshError, folder / "bones" / "scaphoid.stl", r"wrong unit: bounding-box diagonal 3\.[0-9]+, expected 5–100 mm"
+    ):
         load_participant_folder(folder)
 
 
@@ -302,7 +322,11 @@ def test_non_watertight_mesh(folder):
 def test_zero_area_faces(folder):
     vertices, faces = bone_meshes()["lunate"]
     replace_mesh(folder, "lunate", vertices, np.vstack([faces, [[0, 0, 1], [2, 2, 3]]]))
-    with raises(MeshError, folder / "bones" / "lunate.stl", r"has 2 degenerate faces \(zero area or slivers.*face 320 = \[(\d+), \1, \d+\], area 0 mm²"):
+    with raises(
+        MeshError,
+        folder / "bones" / "lunate.stl",
+        r"has 2 degenerate faces \(zero area or slivers.*face 320 = \[(\d+), \1, \d+\], area 0 mm²",
+    ):
         load_participant_folder(folder)
 
 
@@ -406,8 +430,12 @@ def pillow_lunate(n: int = 12):
     i, j = (a.ravel() for a in np.meshgrid(np.arange(n - 1), np.arange(n - 1), indexing="ij"))
     p00, p01, p10, p11 = ((i + di) * n + j + dj for di, dj in ((0, 0), (0, 1), (1, 0), (1, 1)))
     towards_centre = ((i < (n - 1) / 2) == (j < (n - 1) / 2))[:, None]  # so no face has three rim vertices
-    cells = np.vstack([np.where(towards_centre, np.column_stack([p00, p10, p11]), np.column_stack([p00, p10, p01])),
-                       np.where(towards_centre, np.column_stack([p00, p11, p01]), np.column_stack([p10, p11, p01]))])
+    cells = np.vstack(
+        [
+            np.where(towards_centre, np.column_stack([p00, p10, p11]), np.column_stack([p00, p10, p01])),
+            np.where(towards_centre, np.column_stack([p00, p11, p01]), np.column_stack([p10, p11, p01])),
+        ]
+    )
     return vertices, np.vstack([cells, lower[cells][:, ::-1]])
 
 
@@ -428,18 +456,42 @@ NAN_FACE = int(np.flatnonzero((bone_meshes()["lunate"][1] == 5).any(axis=1))[0])
 NAN_CORNER = int(np.flatnonzero(bone_meshes()["lunate"][1][NAN_FACE] == 5)[0])
 
 BAD_MESHES = {  # case: (bone, mesh, file suffix, message after the file name)
-    "sliver": ("lunate", sliver_lunate, "stl",
-               r"1 degenerate faces \(zero area or slivers: least height below 1e-06 × its diagonal = 2.8e-05 mm\) "
-               r"\(first: face 321 = \[\d+, \d+, 162\], area [0-9.]+e-07 mm², height [0-9.]+e-07 mm\)"),
+    "sliver": (
+        "lunate",
+        sliver_lunate,
+        "stl",
+        r"1 degenerate faces \(zero area or slivers: least height below 1e-06 × its diagonal = 2.8e-05 mm\) "
+        r"\(first: face 321 = \[\d+, \d+, 162\], area [0-9.]+e-07 mm², height [0-9.]+e-07 mm\)",
+    ),
     "flat": ("lunate", flat_lunate, "stl", "is flat: its vertices lie within 0 mm of one plane"),
-    "no volume": ("lunate", pillow_lunate, "stl", r"encloses almost no volume: 0.3\d+ mm³ inside 86\d.\d mm² of surface \(a flat or folded sheet"),
-    "NaN, STL": ("lunate", nan_lunate, "stl", rf"5 triangle corners are not \(first: triangle {NAN_FACE}, corner "
-                                               rf"{NAN_CORNER} = \[0.0, nan, [0-9.]+\]; indices 0-based, in file order\)"),
-    "NaN, OBJ": ("lunate", nan_lunate, "obj", r"1 vertices are not \(first: vertex 5 = \[0.0, nan, [0-9.]+\], used by "
-                                               r"faces \[\d+, \d+, \d+\]; indices 0-based, in file order\)"),
+    "no volume": (
+        "lunate",
+        pillow_lunate,
+        "stl",
+        r"encloses almost no volume: 0.3\d+ mm³ inside 86\d.\d mm² of surface \(a flat or folded sheet",
+    ),
+    "NaN, STL": (
+        "lunate",
+        nan_lunate,
+        "stl",
+        rf"5 triangle corners are not \(first: triangle {NAN_FACE}, corner "
+        rf"{NAN_CORNER} = \[0.0, nan, [0-9.]+\]; indices 0-based, in file order\)",
+    ),
+    "NaN, OBJ": (
+        "lunate",
+        nan_lunate,
+        "obj",
+        r"1 vertices are not \(first: vertex 5 = \[0.0, nan, [0-9.]+\], used by "
+        r"faces \[\d+, \d+, \d+\]; indices 0-based, in file order\)",
+    ),
     "NaN, PLY": ("lunate", nan_lunate, "ply", r"1 vertices are not \(first: vertex 5 = \[0.0, nan, [0-9.]+\], used by"),
-    "open radius": ("radius", open_radius, "stl", r"the radius mesh must have a closed \(watertight\) part, its "
-                                                  r"articular solid.*spans 0 mm \(it has 3 boundary edges"),
+    "open radius": (
+        "radius",
+        open_radius,
+        "stl",
+        r"the radius mesh must have a closed \(watertight\) part, its "
+        r"articular solid.*spans 0 mm \(it has 3 boundary edges",
+    ),
 }
 
 
@@ -473,10 +525,17 @@ def test_a_mesh_with_too_many_faces_is_refused(folder, monkeypatch, suffix):
         replace_mesh(folder, "lunate", vertices, faces, name=f"lunate.{suffix}")
     if suffix != "off":  # trimesh must not be asked to read it
         load = trimesh.load_mesh
-        monkeypatch.setattr(folder_module.trimesh, "load_mesh",
-                            lambda file, **kw: pytest.fail("read") if Path(file) == path else load(file, **kw))
-    with raises(MeshError, path, r"the lunate mesh has 1,280 faces, more than the 1,000 a carpal mesh may have.*"
-                                 r"decimate it to at most 1,000 faces"):
+        monkeypatch.setattr(
+            folder_module.trimesh,
+            "load_mesh",
+            lambda file, **kw: pytest.fail("read") if Path(file) == path else load(file, **kw),
+        )
+    with raises(
+        MeshError,
+        path,
+        r"the lunate mesh has 1,280 faces, more than the 1,000 a carpal mesh may have.*"
+        r"decimate it to at most 1,000 faces",
+    ):
         load_participant_folder(folder)
 
 

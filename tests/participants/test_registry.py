@@ -62,7 +62,10 @@ def test_a_right_wrist_declared_left_is_refused_by_the_build(tmp_path):
     toml = folder / "participant.toml"
     toml.write_text(toml.read_text().replace('side = "right"', 'side = "left"'))
     registry.add_folder(folder)
-    with pytest.raises(BuildError, match=rf"(?s){re.escape(str(toml))}: participant 'U2': implausible joint spaces "
-                                         r"in the neutral pose: .*radiolunate 1\d\.\d\d mm \(plausible 0.3–4 mm\).*"
-                                         r"check `side` in participant.toml"):
+    with pytest.raises(
+        BuildError,
+        match=rf"(?s){re.escape(str(toml))}: participant 'U2': implausible joint spaces "
+        r"in the neutral pose: .*radiolunate 1\d\.\d\d mm \(plausible 0.3–4 mm\).*"
+        r"check `side` in participant.toml",
+    ):
         registry.load_model("U2", BuildParams(distal_row=False), cache=False)  # 5 bones to morph, not 9

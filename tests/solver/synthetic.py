@@ -65,7 +65,7 @@ def square_patch(centre, half_width: float, spacing: float, thickness: float, no
     u = -half_width + spacing * (np.arange(n) + 0.5)
     x, z = np.meshgrid(u, u, indexing="ij")
     points = np.asarray(centre, float) + np.stack([x.ravel(), np.zeros(x.size), z.ravel()], axis=1)
-    return _patch(points, np.tile(np.asarray(normal, float), (len(points), 1)), spacing ** 2, thickness)
+    return _patch(points, np.tile(np.asarray(normal, float), (len(points), 1)), spacing**2, thickness)
 
 
 def spherical_cap(apex, radius: float, cap_radius: float, spacing: float, thickness: float) -> Patch:
@@ -78,11 +78,11 @@ def spherical_cap(apex, radius: float, cap_radius: float, spacing: float, thickn
     n = int(np.floor(cap_radius / spacing))
     u = spacing * np.arange(-n, n + 1)
     x, z = (a.ravel() for a in np.meshgrid(u, u, indexing="ij"))
-    keep = x ** 2 + z ** 2 <= cap_radius ** 2
+    keep = x**2 + z**2 <= cap_radius**2
     x, z = x[keep], z[keep]
     centre = np.asarray(apex, float) - [0.0, radius, 0.0]
-    points = centre + np.stack([x, np.sqrt(radius ** 2 - x ** 2 - z ** 2), z], axis=1)
-    return _patch(points, (points - centre) / radius, spacing ** 2, thickness)
+    points = centre + np.stack([x, np.sqrt(radius**2 - x**2 - z**2), z], axis=1)
+    return _patch(points, (points - centre) / radius, spacing**2, thickness)
 
 
 def _patch(points, normals, area: float, thickness: float) -> Patch:
@@ -96,8 +96,17 @@ def box_inertia(mass: float, size) -> np.ndarray:
     return mass / 12.0 * np.diag([b + c, a + c, a + b])
 
 
-def model(*, mass, com, inertia, law, grids: dict | None = None, patches: dict | None = None,
-          fibres=(), name: str = "synthetic") -> Model:
+def model(
+    *,
+    mass,
+    com,
+    inertia,
+    law,
+    grids: dict | None = None,
+    patches: dict | None = None,
+    fibres=(),
+    name: str = "synthetic",
+) -> Model:
     """A `Model` from bodies, contact and fibres; everything else empty.
 
     mass (5,) t; com (5, 3) mm; inertia (5, 3, 3) t·mm²; law (5,) tri-linear
@@ -116,17 +125,27 @@ def model(*, mass, com, inertia, law, grids: dict | None = None, patches: dict |
     reference_length = np.bincount(lig, weights=length, minlength=11) / np.maximum(count, 1)
     zero_bones = np.zeros(len(BONES) + 1, np.int64)
     return Model(
-        name=name, source_hash="synthetic",
-        vertices=np.zeros((0, 3)), vertex_offsets=zero_bones, faces=np.zeros((0, 3), np.int64), face_offsets=zero_bones,
-        vertex_part=np.zeros(0, np.int64), thickness=np.zeros(0),
-        mass=np.asarray(mass, float), com=np.asarray(com, float), inertia=np.asarray(inertia, float),
+        name=name,
+        source_hash="synthetic",
+        vertices=np.zeros((0, 3)),
+        vertex_offsets=zero_bones,
+        faces=np.zeros((0, 3), np.int64),
+        face_offsets=zero_bones,
+        vertex_part=np.zeros(0, np.int64),
+        thickness=np.zeros(0),
+        mass=np.asarray(mass, float),
+        com=np.asarray(com, float),
+        inertia=np.asarray(inertia, float),
         centroid=np.asarray(com, float),
-        grid_origin=np.array([x.origin for x in g], float), grid_spacing=np.array([x.spacing for x in g], float),
+        grid_origin=np.array([x.origin for x in g], float),
+        grid_spacing=np.array([x.spacing for x in g], float),
         grid_shape=np.array([x.values.shape for x in g], np.int64),
         grid_values=np.concatenate([x.values.ravel() for x in g]).astype(np.float32),
         grid_offsets=offsets([x.values.size for x in g]),
-        sample_points=np.concatenate([x.points for x in p]), sample_normals=np.concatenate([x.normals for x in p]),
-        sample_area=np.concatenate([x.area for x in p]), sample_thickness=np.concatenate([x.thickness for x in p]),
+        sample_points=np.concatenate([x.points for x in p]),
+        sample_normals=np.concatenate([x.normals for x in p]),
+        sample_area=np.concatenate([x.area for x in p]),
+        sample_thickness=np.concatenate([x.thickness for x in p]),
         sample_offsets=offsets([len(x.points) for x in p]),
         contact_law=np.asarray(law, float),
         fibre_ligament=lig,
@@ -134,8 +153,10 @@ def model(*, mass, com, inertia, law, grids: dict | None = None, patches: dict |
         fibre_origin=np.array([f.origin for f in fib], float).reshape(-1, 3),
         fibre_insertion=np.array([f.insertion for f in fib], float).reshape(-1, 3),
         reference_length=reference_length,
-        membrane_nodes=np.zeros((0, 3)), membrane_bone=np.zeros(0, np.int64),
-        membrane_connectors=np.zeros((0, 2), np.int64), membrane_kind=np.zeros(0, np.int64),
+        membrane_nodes=np.zeros((0, 3)),
+        membrane_bone=np.zeros(0, np.int64),
+        membrane_connectors=np.zeros((0, 2), np.int64),
+        membrane_kind=np.zeros(0, np.int64),
         membrane_length=np.zeros(0),
     )
 
@@ -159,7 +180,9 @@ def transformed(model: Model, Q, t) -> Model:
     """
     Q = np.asarray(Q, float)
     t = np.asarray(t, float)
-    if not (np.all(np.isin(Q, (-1.0, 0.0, 1.0))) and np.allclose(Q @ Q.T, np.eye(3)) and np.isclose(np.linalg.det(Q), 1.0)):
+    if not (
+        np.all(np.isin(Q, (-1.0, 0.0, 1.0))) and np.allclose(Q @ Q.T, np.eye(3)) and np.isclose(np.linalg.det(Q), 1.0)
+    ):
         raise ValueError(f"Q must be a proper signed permutation matrix, got {Q.tolist()}")
     perm = np.argmax(np.abs(Q), axis=1)  # new axis m is old axis perm[m] ...
     sign = Q[np.arange(3), perm]  # ... times sign[m]
@@ -173,14 +196,17 @@ def transformed(model: Model, Q, t) -> Model:
     origin, shape, values = [], [], []
     for b in range(len(BONES)):
         n = model.grid_shape[b]
-        g = model.grid_values[model.grid_offsets[b]:model.grid_offsets[b + 1]].reshape(n)
+        g = model.grid_values[model.grid_offsets[b] : model.grid_offsets[b + 1]].reshape(n)
         g = np.transpose(g, perm)
         g = np.flip(g, axis=tuple(int(m) for m in np.flatnonzero(sign < 0)))
         o = np.empty(3)
         for m in range(3):
             k = perm[m]
-            o[m] = t[m] + (model.grid_origin[b, k] if sign[m] > 0
-                           else -(model.grid_origin[b, k] + model.grid_spacing[b] * (n[k] - 1)))
+            o[m] = t[m] + (
+                model.grid_origin[b, k]
+                if sign[m] > 0
+                else -(model.grid_origin[b, k] + model.grid_spacing[b] * (n[k] - 1))
+            )
         origin.append(o if g.size else model.grid_origin[b])
         shape.append(g.shape)
         values.append(np.ascontiguousarray(g).ravel())

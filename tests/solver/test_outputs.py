@@ -44,8 +44,14 @@ def test_pressure_map_is_zero_exactly_out_of_contact(p1, sweep):
             s = pair_slice(p1, pair)
             world = p1.sample_points[s] @ poses[a, :3, :3].T + poses[a, :3, 3]
             local = (world - poses[b, :3, 3]) @ poses[b, :3, :3]  # inverse pose of the grid bone
-            d = np.array([sdf_lookup(p1.grid_values, p1.grid_offsets[b], p1.grid_shape[b], p1.grid_origin[b],
-                                     p1.grid_spacing[b], q)[0] for q in local])
+            d = np.array(
+                [
+                    sdf_lookup(
+                        p1.grid_values, p1.grid_offsets[b], p1.grid_shape[b], p1.grid_origin[b], p1.grid_spacing[b], q
+                    )[0]
+                    for q in local
+                ]
+            )
             np.testing.assert_array_equal(p[s] > 0, d < 0, err_msg=f"frame {f}, {pair}")
     assert (pressure_map(p1, sweep.poses[4])[pair_slice(p1, "radioscaphoid")] > 0).sum() >= 5
 
@@ -61,8 +67,9 @@ def test_pressure_map_sums_to_the_solver_contact_force_at_the_same_state(p1, swe
         stats = np.zeros((len(PAIRS), 3))
         active = np.arange(n, dtype=np.int64)
         n_active = np.diff(p1.sample_offsets).astype(np.int64)
-        forces.contact_forces(R, x, np.ascontiguousarray(p1.com), grids, law, active, n_active,
-                              np.zeros((5, 3)), np.zeros((5, 3)), stats)
+        forces.contact_forces(
+            R, x, np.ascontiguousarray(p1.com), grids, law, active, n_active, np.zeros((5, 3)), np.zeros((5, 3)), stats
+        )
         p = pressure_map(p1, sweep.poses[f])
         for k, pair in enumerate(PAIRS):
             s = pair_slice(p1, pair)
@@ -103,8 +110,9 @@ def test_result_to_dict_is_strict_json_with_every_output(p1, sweep):
     assert frame["rotation_deg"]["capitate"][0] == pytest.approx(-40.0, abs=1e-6)
     assert set(frame["contact"]) == set(PAIRS)
     rs = frame["contact"]["radioscaphoid"]
-    assert rs == pytest.approx(dict(zip(("mean_pressure_mpa", "peak_pressure_mpa", "area_mm2", "force_n"),
-                                        sweep.contact[4, RS])))
+    assert rs == pytest.approx(
+        dict(zip(("mean_pressure_mpa", "peak_pressure_mpa", "area_mm2", "force_n"), sweep.contact[4, RS]))
+    )
     assert set(frame["ligament_force_n"]) == set(design.ALL_LIGAMENT_NAMES)
     for key in ("kinetic_energy_nmm", "internal_energy_nmm"):
         assert np.isfinite(frame[key])
@@ -113,8 +121,17 @@ def test_result_to_dict_is_strict_json_with_every_output(p1, sweep):
 
 def test_result_to_dict_of_a_failed_run_has_nulls(p1, sweep):
     nan = lambda a: np.full_like(a, np.nan)  # noqa: E731
-    failed = Result(nan(sweep.poses), nan(sweep.contact), nan(sweep.bundle_force), nan(sweep.energy),
-                    nan(sweep.residual), sweep.steps, np.full(5, np.nan), 1, "failed: NaN in the state")
+    failed = Result(
+        nan(sweep.poses),
+        nan(sweep.contact),
+        nan(sweep.bundle_force),
+        nan(sweep.energy),
+        nan(sweep.residual),
+        sweep.steps,
+        np.full(5, np.nan),
+        1,
+        "failed: NaN in the state",
+    )
     out = json.loads(json.dumps(result_to_dict(failed, p1), allow_nan=False))
     assert not out["ok"] and out["status"] == 1
     frame = out["frames"][0]

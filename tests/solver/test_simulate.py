@@ -65,8 +65,14 @@ def test_halving_the_time_step_changes_little(p1, sweep):
     for bone in (SCAPHOID, LUNATE):
         a, b = sweep.poses[:, bone], finer.poses[:, bone]
         com = p1.com[bone]
-        shift = np.linalg.norm(np.einsum("fij,j->fi", a[:, :3, :3] - b[:, :3, :3], com) + a[:, :3, 3] - b[:, :3, 3], axis=1)
-        turn = np.degrees(np.linalg.norm(Rotation.from_matrix(np.einsum("fji,fjk->fik", a[:, :3, :3], b[:, :3, :3])).as_rotvec(), axis=1))
+        shift = np.linalg.norm(
+            np.einsum("fij,j->fi", a[:, :3, :3] - b[:, :3, :3], com) + a[:, :3, 3] - b[:, :3, 3], axis=1
+        )
+        turn = np.degrees(
+            np.linalg.norm(
+                Rotation.from_matrix(np.einsum("fji,fjk->fik", a[:, :3, :3], b[:, :3, :3])).as_rotvec(), axis=1
+            )
+        )
         assert shift.max() < 0.1 and turn.max() < 0.5, (BONES[bone], shift.max(), turn.max())
 
 
@@ -116,7 +122,8 @@ def test_prepared_arrays_give_the_same_run_and_refuse_another_mode(p1, sweep):
     prepared = prepare(p1, None, driver.mode)
     again = simulate(p1, design.population(), driver, prepared=prepared)
     np.testing.assert_array_equal(again.poses, sweep.poses)
-    np.testing.assert_array_equal(simulate_batch(p1, [design.population()], driver, prepared=prepared)[0].poses,
-                                  sweep.poses)
+    np.testing.assert_array_equal(
+        simulate_batch(p1, [design.population()], driver, prepared=prepared)[0].poses, sweep.poses
+    )
     with pytest.raises(ValueError, match="driver mode"):
         simulate(p1, design.population(), driver, prepared=prepare(p1, None, EXPERIMENTAL))

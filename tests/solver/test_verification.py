@@ -41,6 +41,7 @@ _FIELDS = {f.name for f in fields(SolverSettings)}
 
 # --------------------------------------------------------------------------- helpers
 
+
 def blankevoort(K, strain):
     """Tension (N) of a fibre of scale K = k·l0 (N per unit strain), Blankevoort 1991 as in DESIGN.md."""
     if strain <= 0.0:
@@ -139,8 +140,13 @@ def oscillator(fibres):
     com = np.array([[0, 0, 0], [40, 0, 0], CENTRE, [-40, 0, 0], [0, 40, 0]], float)
     mass = np.array([0.0, 0.0, MASS_T, 2e-6, 4e-6])
     inertia = np.array([syn.box_inertia(2e-6, (8, 8, 8))] * 5)
-    return syn.model(mass=mass, com=com, inertia=inertia, law=[0.1, 0.2, 10, 20, 30],
-                     fibres=[syn.Fibre(lig, RADIUS, SCAPHOID, CENTRE + a * AXIS, CENTRE) for lig, a in fibres])
+    return syn.model(
+        mass=mass,
+        com=com,
+        inertia=inertia,
+        law=[0.1, 0.2, 10, 20, 30],
+        fibres=[syn.Fibre(lig, RADIUS, SCAPHOID, CENTRE + a * AXIS, CENTRE) for lig, a in fibres],
+    )
 
 
 @pytest.mark.parametrize("mass_scale", [1.0, 10.0])
@@ -175,13 +181,16 @@ def test_fibres_oscillate_as_solve_ivp_predicts(case, mass_scale):
 
     # time scale: the stiffest linear stretch and the slack coasting, ~1500 steps per period
     omega = np.sqrt(np.sum(K / l0) / m)
-    energy = sum(Ki * l0i * (2 * EPSILON_L ** 2 / 3 + 0.5 * (r - 1) ** 2 - EPSILON_L * (r - 1))
-                 for Ki, l0i, r in zip(K, l0, [materials[g][1] for g, _ in fib]))
+    energy = sum(
+        Ki * l0i * (2 * EPSILON_L**2 / 3 + 0.5 * (r - 1) ** 2 - EPSILON_L * (r - 1))
+        for Ki, l0i, r in zip(K, l0, [materials[g][1] for g, _ in fib])
+    )
     coast = 2 * l0.min() / np.sqrt(2 * energy / m) if len(fib) == 1 else 0.0
     period_guess = 2 * np.pi / omega + 2 * coast
     dt = period_guess / 1500
-    settings = sampled_every(replace(undamped(SolverSettings()), dt_s=dt, mass_scale=mass_scale,
-                                     inertia_scale=1.0, max_disp_mm=1e3), 4)
+    settings = sampled_every(
+        replace(undamped(SolverSettings()), dt_s=dt, mass_scale=mass_scale, inertia_scale=1.0, max_disp_mm=1e3), 4
+    )
     n_frames = int(3.2 * period_guess / (4 * dt))
     result = simulate(model, dsg, experimental(model, np.tile(np.eye(4), (n_frames, 1, 1))), settings)
     assert result.ok, result.message
@@ -202,9 +211,11 @@ def test_fibres_oscillate_as_solve_ivp_predicts(case, mass_scale):
     track = np.abs(y - ref.sol(t)[0]).max() / amp_ref
 
     period_err, amp_err = period / period_ref - 1.0, amp / amp_ref - 1.0
-    summary = (f"{case}, mass_scale {mass_scale}: period {period * 1e3:.5f} ms vs {period_ref * 1e3:.5f} ms "
-               f"({100 * period_err:+.4f} %), amplitude {amp:.5f} vs {amp_ref:.5f} mm ({100 * amp_err:+.4f} %), "
-               f"track {100 * track:.3f} %, off line {off_line:.1e} mm, turn {turn:.1e}°")
+    summary = (
+        f"{case}, mass_scale {mass_scale}: period {period * 1e3:.5f} ms vs {period_ref * 1e3:.5f} ms "
+        f"({100 * period_err:+.4f} %), amplitude {amp:.5f} vs {amp_ref:.5f} mm ({100 * amp_err:+.4f} %), "
+        f"track {100 * track:.3f} %, off line {off_line:.1e} mm, turn {turn:.1e}°"
+    )
     print(summary)
     assert abs(period_err) < 0.01, summary
     assert abs(amp_err) < 0.01, summary
@@ -249,8 +260,19 @@ def sphere_force(law, d0):
     F = 2π ∫_0^d0 p(δ/h) (R − d0 + δ) dδ."""
     h, R = THICKNESS_MM, SPHERE_R_MM
     breaks = [h * e for e in law[:2] if h * e < d0]
-    return 2 * np.pi * quad(lambda d: trilinear(law, d / h) * (R - d0 + d), 0.0, d0, points=breaks or None,
-                            epsabs=0.0, epsrel=1e-13, limit=200)[0]
+    return (
+        2
+        * np.pi
+        * quad(
+            lambda d: trilinear(law, d / h) * (R - d0 + d),
+            0.0,
+            d0,
+            points=breaks or None,
+            epsabs=0.0,
+            epsrel=1e-13,
+            limit=200,
+        )[0]
+    )
 
 
 def check(name, got, want, rel):
@@ -352,10 +374,12 @@ def test_moved_model_is_the_same_geometry(p1, move):
     moved = syn.transformed(p1, Q, t)
     rng = np.random.default_rng(0)
     for b in (RADIUS, SCAPHOID, LUNATE, CAPITATE):
+
         def interpolator(m):
             n, o, h = m.grid_shape[b], m.grid_origin[b], m.grid_spacing[b]
             axes = [o[i] + h * np.arange(n[i]) for i in range(3)]
             return RegularGridInterpolator(axes, m.grid(BONES[b]).astype(float)), axes
+
         f, axes = interpolator(p1)
         g, _ = interpolator(moved)
         q = np.stack([rng.uniform(ax[0], ax[-1], 2000) for ax in axes], axis=1)
@@ -390,15 +414,22 @@ def test_rigidly_moved_model_gives_the_same_relative_kinematics(p1, move):
         rel_a = np.linalg.inv(a.poses[:, RADIUS]) @ a.poses[:, bone]
         rel_b = np.linalg.inv(back[:, RADIUS]) @ back[:, bone]
         c = p1.com[bone]
-        shift = np.linalg.norm(np.einsum("fij,j->fi", rel_a[:, :3, :3] - rel_b[:, :3, :3], c)
-                               + rel_a[:, :3, 3] - rel_b[:, :3, 3], axis=1).max()
-        turn = np.degrees(np.linalg.norm(Rotation.from_matrix(
-            np.swapaxes(rel_a[:, :3, :3], 1, 2) @ rel_b[:, :3, :3]).as_rotvec(), axis=1)).max()
+        shift = np.linalg.norm(
+            np.einsum("fij,j->fi", rel_a[:, :3, :3] - rel_b[:, :3, :3], c) + rel_a[:, :3, 3] - rel_b[:, :3, 3], axis=1
+        ).max()
+        turn = np.degrees(
+            np.linalg.norm(
+                Rotation.from_matrix(np.swapaxes(rel_a[:, :3, :3], 1, 2) @ rel_b[:, :3, :3]).as_rotvec(), axis=1
+            )
+        ).max()
         worst[BONES[bone]] = (shift, turn)
     contact = np.abs(a.contact - b.contact).max() / np.abs(a.contact).max()
     bundle = np.abs(a.bundle_force - b.bundle_force).max() / np.abs(a.bundle_force).max()
-    summary = f"{move}: " + ", ".join(f"{k} {s:.1e} mm {r:.1e}°" for k, (s, r) in worst.items()) + \
-        f", contact {contact:.1e}, bundles {bundle:.1e} (relative)"
+    summary = (
+        f"{move}: "
+        + ", ".join(f"{k} {s:.1e} mm {r:.1e}°" for k, (s, r) in worst.items())
+        + f", contact {contact:.1e}, bundles {bundle:.1e} (relative)"
+    )
     if hasattr(a, "steps"):
         summary += f", steps {a.steps.sum()} vs {b.steps.sum()}"
     print(summary)

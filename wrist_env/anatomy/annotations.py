@@ -87,8 +87,11 @@ def resolve(bones: dict, data: dict | None = None) -> Annotations:
         for me, other in ((a, b), (b, a)):
             surface = bones[me].trimesh()
             mask = facing_within(
-                surface.vertices, surface.vertex_normals, solids[other].vertices,
-                solids[other].faces.astype(np.int64), spec["max_gap_mm"],
+                surface.vertices,
+                surface.vertex_normals,
+                solids[other].vertices,
+                solids[other].faces.astype(np.int64),
+                spec["max_gap_mm"],
             )
             masks.append(mask & bones[me].solid)
         coverage[art] = (a, b, masks[0], masks[1])

@@ -82,7 +82,7 @@ def offset_heightfield(footprint, row_points, *, joint_space_mm=1.5, spacing_mm=
 def sphere_centre(points) -> np.ndarray:
     """Centre (3,) mm of the least-squares sphere through `points` (n, 3)."""
     A = np.column_stack([2.0 * points, np.ones(len(points))])
-    b = (points ** 2).sum(axis=1)
+    b = (points**2).sum(axis=1)
     return np.linalg.lstsq(A, b, rcond=None)[0][:3]
 
 
@@ -166,8 +166,17 @@ def extrude_heightfield(xs, zs, height, *, depth_mm=4.0) -> trimesh.Trimesh:
     return mesh
 
 
-def build_radius_cap(row_meshes, radius_mesh, *, joint_space_mm=1.5, spacing_mm=0.4, depth_mm=4.0, sample_mm=0.15,
-                     sweep_deg=(0.0, 0.0), swept_sample_mm=0.25):
+def build_radius_cap(
+    row_meshes,
+    radius_mesh,
+    *,
+    joint_space_mm=1.5,
+    spacing_mm=0.4,
+    depth_mm=4.0,
+    sample_mm=0.15,
+    sweep_deg=(0.0, 0.0),
+    swept_sample_mm=0.25,
+):
     """The rebuilt distal radius articular solid and its articular (top) vertex mask.
 
     row_meshes: the scaphoid and lunate. sweep_deg: (flexion, deviation) half-ranges of the
@@ -183,12 +192,13 @@ def build_radius_cap(row_meshes, radius_mesh, *, joint_space_mm=1.5, spacing_mm=
             points = trimesh.sample.sample_surface_even(mesh, int(mesh.area / (sample_mm * sample_mm)), seed=0)[0]
             row_points.append(points)
             continue
-        points, face = trimesh.sample.sample_surface_even(mesh, int(mesh.area / swept_sample_mm ** 2), seed=0)
+        points, face = trimesh.sample.sample_surface_even(mesh, int(mesh.area / swept_sample_mm**2), seed=0)
         facing = mesh.face_normals[face, 1] > 0.0  # the proximally facing surface
         row_points.append(swept(points[facing], sphere_centre(fossa_points([mesh], radius_mesh)), *sweep_deg))
     row_points += [m.vertices for m in row_meshes]
-    xs, zs, height = offset_heightfield(footprint, np.concatenate(row_points), joint_space_mm=joint_space_mm,
-                                        spacing_mm=spacing_mm)
+    xs, zs, height = offset_heightfield(
+        footprint, np.concatenate(row_points), joint_space_mm=joint_space_mm, spacing_mm=spacing_mm
+    )
     mesh = extrude_heightfield(xs, zs, height, depth_mm=depth_mm)
     articular = mesh.vertices[:, 1] < mesh.vertices[:, 1].max() - 1e-6
     return mesh, articular

@@ -93,10 +93,12 @@ def compose(parts: dict, distal_row: bool = True) -> dict:
         members = [parts[p] for p in (BODY_PARTS[body] if distal_row else BODY_PARTS[body][:1])]
         counts = np.cumsum([0] + [len(m.vertices) for m in members])
         bodies[body] = BoneSurface(
-            body, np.vstack([m.vertices for m in members]),
+            body,
+            np.vstack([m.vertices for m in members]),
             np.vstack([m.faces + c for m, c in zip(members, counts)]).astype(np.int64),
             np.concatenate([m.solid for m in members]),
-            np.concatenate([np.full(len(m.vertices), k, np.int64) for k, m in enumerate(members)]))
+            np.concatenate([np.full(len(m.vertices), k, np.int64) for k, m in enumerate(members)]),
+        )
     return bodies
 
 
@@ -111,8 +113,15 @@ def carry_parts(bodies: dict, template: "Template") -> dict:
             continue
         principal = template.parts[body]
         target = trimesh.Trimesh(bodies[body].vertices, bodies[body].faces, process=False)
-        T, _, _ = trimesh.registration.icp(principal.vertices, target, initial=np.eye(4), threshold=1e-6,
-                                           max_iterations=60, reflection=False, scale=True)
+        T, _, _ = trimesh.registration.icp(
+            principal.vertices,
+            target,
+            initial=np.eye(4),
+            threshold=1e-6,
+            max_iterations=60,
+            reflection=False,
+            scale=True,
+        )
         for p in BODY_PARTS[body][1:]:
             src = template.parts[p]
             parts[p] = BoneSurface(p, src.vertices @ T[:3, :3].T + T[:3, 3], src.faces.copy(), src.solid.copy())
@@ -168,8 +177,12 @@ def load_template(fossa_sweep_deg: tuple = (0.0, 0.0), distal_row: bool = False)
     to_rcs = np.eye(4)
     to_rcs[:3, 3] = -origin
     if tuple(fossa_sweep_deg) != (0.0, 0.0):
-        cap, _ = build_radius_cap([m[b] for b in ROW], m["radius"], joint_space_mm=JOINT_SPACE_MM,
-                                  sweep_deg=tuple(float(a) for a in fossa_sweep_deg))
+        cap, _ = build_radius_cap(
+            [m[b] for b in ROW],
+            m["radius"],
+            joint_space_mm=JOINT_SPACE_MM,
+            sweep_deg=tuple(float(a) for a in fossa_sweep_deg),
+        )
     rcs_from_myosim = to_rcs @ oriented
     m = {b: _transform(mesh, to_rcs) for b, mesh in m.items()}
     cap = _transform(cap, to_rcs)
@@ -182,7 +195,9 @@ def load_template(fossa_sweep_deg: tuple = (0.0, 0.0), distal_row: bool = False)
     ulna = _distal_part(m["ulna"], y_cut)
     bones = {
         "radius": BoneSurface("radius", radius_vertices, radius_faces.astype(np.int64), radius_solid),
-        "ulna": BoneSurface("ulna", ulna.vertices.copy(), ulna.faces.astype(np.int64), np.zeros(len(ulna.vertices), bool)),
+        "ulna": BoneSurface(
+            "ulna", ulna.vertices.copy(), ulna.faces.astype(np.int64), np.zeros(len(ulna.vertices), bool)
+        ),
     }
     for b in PARTS[2:]:
         bones[b] = BoneSurface(b, m[b].vertices.copy(), m[b].faces.astype(np.int64), np.ones(len(m[b].vertices), bool))

@@ -14,5 +14,14 @@ def write_leaderboard(runs, out, **kwargs):
     return write(runs, out, **kwargs)
 
 
-__all__ = ["BenchmarkReport", "CalibrationRun", "DuplicateEvaluationError", "ResumeError", "RunKey", "RunLog",
-           "benchmark", "calibrate", "write_leaderboard"]
+__all__ = [
+    "BenchmarkReport",
+    "CalibrationRun",
+    "DuplicateEvaluationError",
+    "ResumeError",
+    "RunKey",
+    "RunLog",
+    "benchmark",
+    "calibrate",
+    "write_leaderboard",
+]

@@ -46,14 +46,16 @@ def action(x) -> np.ndarray:
 def rmse_vector(info: dict) -> np.ndarray:
     """The 12 per-DOF RMSE of an evaluation's info, in `RMSE_COLUMNS` order (NaN when missing)."""
     rmse = info.get("rmse") or {}
-    return np.array([np.nan if rmse.get(b, {}).get(d) is None else rmse[b][d] for b in COST_BONES for d in DOF_NAMES],
-                    dtype=np.float64)
+    return np.array(
+        [np.nan if rmse.get(b, {}).get(d) is None else rmse[b][d] for b in COST_BONES for d in DOF_NAMES],
+        dtype=np.float64,
+    )
 
 
 def recovery_error(calibrated: Design, truth: Design) -> float:
     """Parameter-recovery error: RMS over the 22 materials of z(calibrated) − z(truth), Table 2 SD units."""
     dz = design_vars.z_scores(calibrated) - design_vars.z_scores(truth)
-    return float(np.sqrt(np.mean(dz ** 2)))
+    return float(np.sqrt(np.mean(dz**2)))
 
 
 def accepts_storage(cls) -> bool:
@@ -126,17 +128,27 @@ class CalibrationRun:
         """JSON-ready summary (what the run log keeps per finished cell)."""
         r = self.result
         out = dict(self.key.as_dict())
-        out.update({
-            "nfev": int(r.nfev), "success": bool(r.success), "message": r.message,
-            "best_eval": self.best_eval, "best_cost": float(r.fun),
-            "x": [float(v) for v in r.x],
-            "design": self.design.as_dict(),
-            "z_scores": dict(zip(design_vars.NAMES[:N_MATERIAL], design_vars.z_scores(self.design).tolist())),
-            "calibrate": self.calibrate, "validate": self.validate,
-            "recovery_z": self.recovery_z, "recovery_z_population": self.recovery_z_population,
-            "replayed": self.replayed, "wall_seconds": round(self.wall_seconds, 3),
-            "options": {k: v for k, v in self.options.items() if isinstance(v, (str, int, float, bool, type(None)))},
-        })
+        out.update(
+            {
+                "nfev": int(r.nfev),
+                "success": bool(r.success),
+                "message": r.message,
+                "best_eval": self.best_eval,
+                "best_cost": float(r.fun),
+                "x": [float(v) for v in r.x],
+                "design": self.design.as_dict(),
+                "z_scores": dict(zip(design_vars.NAMES[:N_MATERIAL], design_vars.z_scores(self.design).tolist())),
+                "calibrate": self.calibrate,
+                "validate": self.validate,
+                "recovery_z": self.recovery_z,
+                "recovery_z_population": self.recovery_z_population,
+                "replayed": self.replayed,
+                "wall_seconds": round(self.wall_seconds, 3),
+                "options": {
+                    k: v for k, v in self.options.items() if isinstance(v, (str, int, float, bool, type(None)))
+                },
+            }
+        )
         if history:
             out["history_fun"] = [float(v) for v in r.history_fun]
         return out
@@ -144,12 +156,25 @@ class CalibrationRun:
 
 def _score(evaluation) -> dict:
     info = evaluation.info
-    return {"cost": float(evaluation.cost), "failed": bool(evaluation.failed),
-            "rmse": info.get("rmse"), "error_p75": info.get("error_p75")}
+    return {
+        "cost": float(evaluation.cost),
+        "failed": bool(evaluation.failed),
+        "rmse": info.get("rmse"),
+        "error_p75": info.get("error_p75"),
+    }
 
 
-def calibrate(participant: str, optimizer_name: str, budget: int, seed: int, *, log=None, storage=None,
-              options: dict | None = None, callback=None) -> CalibrationRun:
+def calibrate(
+    participant: str,
+    optimizer_name: str,
+    budget: int,
+    seed: int,
+    *,
+    log=None,
+    storage=None,
+    options: dict | None = None,
+    callback=None,
+) -> CalibrationRun:
     """Calibrate the 22 materials of `participant` with the calibrator `optimizer_name`.
 
     log: a `RunLog` or its directory: every batch is logged as it finishes and a cell cut short
@@ -190,17 +215,21 @@ def calibrate(participant: str, optimizer_name: str, budget: int, seed: int, *, 
     def fun_batch(x):
         n, k = state["nfev"], len(x)
         if n < len(logged_x):
-            if n + k > len(logged_x) or np.max(np.abs(x - logged_x[n:n + k])) > REPLAY_TOLERANCE:
+            if n + k > len(logged_x) or np.max(np.abs(x - logged_x[n : n + k])) > REPLAY_TOLERANCE:
                 raise ResumeError(
                     f"{key.name}: on resume the calibrator asked for evaluations {n}…{n + k - 1} differently than "
                     f"logged ({len(logged_x)} logged); it is not deterministic for a seed, so this cell cannot "
-                    f"resume: delete its files from the run log to start it over")
+                    f"resume: delete its files from the run log to start it over"
+                )
             state["new"] = False
-            return logged_y[n:n + k]
+            return logged_y[n : n + k]
         evaluations = calibration.evaluate_batch([design_vars.from_action(a) for a in action(x)])
         y = np.array([e.cost for e in evaluations], dtype=np.float64)
         state["new"] = True
-        state["pending"] = (np.array([e.failed for e in evaluations]), np.stack([rmse_vector(e.info) for e in evaluations]))
+        state["pending"] = (
+            np.array([e.failed for e in evaluations]),
+            np.stack([rmse_vector(e.info) for e in evaluations]),
+        )
         return y
 
     def after_batch(x, y):
@@ -223,8 +252,9 @@ def calibrate(participant: str, optimizer_name: str, budget: int, seed: int, *, 
     finally:
         optimizer.close()
     if state["nfev"] < len(logged_x):
-        raise ResumeError(f"{key.name}: the calibrator stopped after {state['nfev']} evaluations, "
-                          f"but {len(logged_x)} are logged")
+        raise ResumeError(
+            f"{key.name}: the calibrator stopped after {state['nfev']} evaluations, but {len(logged_x)} are logged"
+        )
 
     best_eval = int(np.argmin(result.history_fun))
     calibrated = design_vars.from_action(action(result.x))
@@ -235,9 +265,19 @@ def calibrate(participant: str, optimizer_name: str, budget: int, seed: int, *, 
         truth = builtin.truth(participant)
         recovery = recovery_error(calibrated, truth)
         recovery_population = recovery_error(design_vars.population(), truth)
-    run = CalibrationRun(key, result, calibrated, at_calibrate, at_validate, recovery, recovery_population,
-                         best_eval, state["replayed"], time.perf_counter() - start_time,
-                         {k: v for k, v in options.items() if k not in ("storage",)})
+    run = CalibrationRun(
+        key,
+        result,
+        calibrated,
+        at_calibrate,
+        at_validate,
+        recovery,
+        recovery_population,
+        best_eval,
+        state["replayed"],
+        time.perf_counter() - start_time,
+        {k: v for k, v in options.items() if k not in ("storage",)},
+    )
     if run_log is not None:
         run_log.compact(key)
         run_log.write_summary(key, run.to_dict(history=False))

@@ -46,8 +46,15 @@ KEY_FIELDS = ("participant", "optimizer", "seed", "budget")
 X_COLUMNS = tuple(f"x.{n}" for n in NAMES[:N_MATERIAL])
 RMSE_COLUMNS = tuple(f"rmse.{bone}.{dof}" for bone in COST_BONES for dof in DOF_NAMES)
 SCHEMA = pa.schema(
-    [("participant", pa.string()), ("optimizer", pa.string()), ("seed", pa.int64()), ("budget", pa.int64()),
-     ("eval", pa.int64()), ("batch", pa.int64()), ("time", pa.float64())]
+    [
+        ("participant", pa.string()),
+        ("optimizer", pa.string()),
+        ("seed", pa.int64()),
+        ("budget", pa.int64()),
+        ("eval", pa.int64()),
+        ("batch", pa.int64()),
+        ("time", pa.float64()),
+    ]
     + [(c, pa.float64()) for c in X_COLUMNS]
     + [("cost", pa.float64()), ("failed", pa.bool_())]
     + [(c, pa.float64()) for c in RMSE_COLUMNS]
@@ -116,14 +123,19 @@ class RunLog:
         if start != logged:
             raise DuplicateEvaluationError(
                 f"{key.name}: batch {batch} starts at evaluation {start}, but {logged} evaluations are logged "
-                f"(evaluations must be logged once, in order)")
+                f"(evaluations must be logged once, in order)"
+            )
         existing = list(self.evals_dir.glob(f"part-{key.name}-b{batch:05d}-*.parquet"))
         if existing:
             raise DuplicateEvaluationError(f"{key.name}: batch {batch} is already logged ({existing[0].name})")
         now = time.time()
         columns = {
-            "participant": [key.participant] * k, "optimizer": [key.optimizer] * k, "seed": [key.seed] * k,
-            "budget": [key.budget] * k, "eval": list(range(start, start + k)), "batch": [batch] * k,
+            "participant": [key.participant] * k,
+            "optimizer": [key.optimizer] * k,
+            "seed": [key.seed] * k,
+            "budget": [key.budget] * k,
+            "eval": list(range(start, start + k)),
+            "batch": [batch] * k,
             "time": [now] * k,
         }
         columns.update({c: x[:, i] for i, c in enumerate(X_COLUMNS)})
@@ -174,21 +186,33 @@ class RunLog:
             first = int(m["start"]) if "start" in m.groupdict() else 0
             for start, p in sorted(by_cell.get(m["cell"], [])):
                 if p == path or start >= first:
-                    moved += self.store.quarantine(
-                        p, "damaged Parquet file, its evaluations are re-simulated" if p == path
-                        else f"follows the damaged {path.name} in its cell, re-simulated") is not None
+                    moved += (
+                        self.store.quarantine(
+                            p,
+                            "damaged Parquet file, its evaluations are re-simulated"
+                            if p == path
+                            else f"follows the damaged {path.name} in its cell, re-simulated",
+                        )
+                        is not None
+                    )
         for name in self.store.record_names():
             path = self.store.record_path(name)
             try:
                 summary = self.store.read_record(name)
                 n = int(summary["nfev"])
             except (StoreError, KeyError, TypeError, ValueError):
-                moved += self.store.quarantine(path, "damaged cell summary, the cell runs again (by replay)") is not None
+                moved += (
+                    self.store.quarantine(path, "damaged cell summary, the cell runs again (by replay)") is not None
+                )
                 continue
             logged = self.progress().get(name, 0)
             if logged < n:
-                moved += self.store.quarantine(path, f"the cell's summary counts {n} evaluations, but {logged} are "
-                                                     f"logged; the cell runs again") is not None
+                moved += (
+                    self.store.quarantine(
+                        path, f"the cell's summary counts {n} evaluations, but {logged} are logged; the cell runs again"
+                    )
+                    is not None
+                )
         return moved
 
     # reading
@@ -225,13 +249,19 @@ class RunLog:
         if not files:
             return None
         frame = self._table(files).to_pandas()
-        frame = frame[(frame.participant == key.participant) & (frame.optimizer == key.optimizer)
-                      & (frame.seed == key.seed) & (frame.budget == key.budget)]
+        frame = frame[
+            (frame.participant == key.participant)
+            & (frame.optimizer == key.optimizer)
+            & (frame.seed == key.seed)
+            & (frame.budget == key.budget)
+        ]
         frame = frame.drop_duplicates(subset=["eval"], keep="first").sort_values("eval", kind="stable")
         frame = frame.reset_index(drop=True)
         if not np.array_equal(frame["eval"].to_numpy(), np.arange(len(frame))):
-            raise StoreError(f"{self.evals_dir}: the logged evaluations of {key.name} are not 0 … n−1 "
-                             f"({frame['eval'].tolist()[:20]}…); {RERUN}")
+            raise StoreError(
+                f"{self.evals_dir}: the logged evaluations of {key.name} are not 0 … n−1 "
+                f"({frame['eval'].tolist()[:20]}…); {RERUN}"
+            )
         return frame
 
     def logged_range(self, key: RunKey) -> int:
@@ -271,7 +301,8 @@ class RunLog:
         if progress.get(name, 0) < n:
             raise IncompleteCellError(
                 f"{self.store.record_path(name)}: the cell finished with {n} evaluations, but "
-                f"{progress.get(name, 0)} are logged in {self.evals_dir}; {RERUN}")
+                f"{progress.get(name, 0)} are logged in {self.evals_dir}; {RERUN}"
+            )
         return summary
 
     def summaries(self) -> list[dict]:

@@ -72,12 +72,19 @@ def cell_storage(storage: str | None, key: RunKey) -> str | None:
         return storage
     url = storage.replace(STORAGE_PER_CELL, key.name)
     if url.startswith("sqlite:///"):
-        Path(url[len("sqlite:///"):]).parent.mkdir(parents=True, exist_ok=True)
+        Path(url[len("sqlite:///") :]).parent.mkdir(parents=True, exist_ok=True)
     return url
 
 
-def run_cell(key: RunKey, out_dir: str, storage: str | None = None, options: dict | None = None,
-             threads: int | None = None, folders: tuple = (), callback=None) -> dict:
+def run_cell(
+    key: RunKey,
+    out_dir: str,
+    storage: str | None = None,
+    options: dict | None = None,
+    threads: int | None = None,
+    folders: tuple = (),
+    callback=None,
+) -> dict:
     """Run (or resume, or skip) one cell; returns {"status": "ran" | "skipped", "summary": {...}}.
 
     The top-level function a local process or a dask worker runs. It holds the
@@ -95,15 +102,34 @@ def run_cell(key: RunKey, out_dir: str, storage: str | None = None, options: dic
         summary = log.summary(key)
         if summary is not None:
             return {"status": "skipped", "summary": summary}
-        run = calibrate(key.participant, key.optimizer, key.budget, key.seed, log=log,
-                        storage=cell_storage(storage, key),
-                        options=(options or {}).get(key.optimizer), callback=callback)
+        run = calibrate(
+            key.participant,
+            key.optimizer,
+            key.budget,
+            key.seed,
+            log=log,
+            storage=cell_storage(storage, key),
+            options=(options or {}).get(key.optimizer),
+            callback=callback,
+        )
         return {"status": "ran", "summary": run.to_dict()}
 
 
-def benchmark(participants, optimizers, seeds, budget: int, out_dir, *, workers: int | None = None,
-              scheduler=None, progress: bool = True, storage: str | None = None, threads: int | None = None,
-              options: dict | None = None, folders=()) -> BenchmarkReport:
+def benchmark(
+    participants,
+    optimizers,
+    seeds,
+    budget: int,
+    out_dir,
+    *,
+    workers: int | None = None,
+    scheduler=None,
+    progress: bool = True,
+    storage: str | None = None,
+    threads: int | None = None,
+    options: dict | None = None,
+    folders=(),
+) -> BenchmarkReport:
     """Run every cell of participants × optimizers × seeds with `budget` evaluations into `out_dir`.
 
     workers: local processes (default: the number of cores; 1 runs the cells in this process).
@@ -174,8 +200,11 @@ def _prepare_storage(cells, storage) -> None:
     import optimizers
     from wrist_env.bench.calibrate import accepts_storage, open_storage
 
-    if isinstance(storage, str) and STORAGE_PER_CELL not in storage and \
-            any(accepts_storage(optimizers.get(name)) for name in {k.optimizer for k in cells}):
+    if (
+        isinstance(storage, str)
+        and STORAGE_PER_CELL not in storage
+        and any(accepts_storage(optimizers.get(name)) for name in {k.optimizer for k in cells})
+    ):
         open_storage(storage)
 
 
@@ -184,8 +213,9 @@ def _bar(progress, total, initial, n_cells, n_done):
         return None
     from tqdm import tqdm
 
-    bar = tqdm(total=total, initial=initial, unit="eval", desc="benchmark", dynamic_ncols=True, smoothing=0.05,
-               mininterval=1.0)
+    bar = tqdm(
+        total=total, initial=initial, unit="eval", desc="benchmark", dynamic_ncols=True, smoothing=0.05, mininterval=1.0
+    )
     bar.set_postfix_str(f"cells {n_done}/{n_cells}", refresh=False)
     return bar
 
@@ -197,12 +227,16 @@ def _update(bar, log: RunLog, cells, report) -> None:
     n = sum(min(progress.get(k.name, 0), k.budget) for k in cells)
     if n > bar.n:
         bar.update(n - bar.n)
-    bar.set_postfix_str(f"cells {len(report.ran) + len(report.skipped)}/{len(cells)}"
-                        + (f", {len(report.failed)} failed" if report.failed else ""), refresh=False)
+    bar.set_postfix_str(
+        f"cells {len(report.ran) + len(report.skipped)}/{len(cells)}"
+        + (f", {len(report.failed)} failed" if report.failed else ""),
+        refresh=False,
+    )
 
 
 def _tick(bar):
     def tick(n_new, nfev):
         if bar is not None and n_new:
             bar.update(n_new)
+
     return tick

@@ -136,8 +136,16 @@ def grnn_smooth(points, values, bandwidth_mm: float, query=None) -> np.ndarray:
     return out
 
 
-def thickness_fields(vertices: dict, faces: dict, articulations: dict, *, share=0.5, bandwidth_mm=1.0,
-                     min_thickness_mm=0.1, max_thickness_mm=1.1) -> dict:
+def thickness_fields(
+    vertices: dict,
+    faces: dict,
+    articulations: dict,
+    *,
+    share=0.5,
+    bandwidth_mm=1.0,
+    min_thickness_mm=0.1,
+    max_thickness_mm=1.1,
+) -> dict:
     """Cartilage thickness per vertex (mm, shape (n,), zero off coverage) of every articulated bone.
 
     Each covered vertex takes `share` of its gap to the opposing covered surface, smoothed over
@@ -146,8 +154,10 @@ def thickness_fields(vertices: dict, faces: dict, articulations: dict, *, share=
     if not 0 < share <= 1:
         raise InputError(f"`0 < share <= 1` must hold, but got {share=}.")
     if not 0 <= min_thickness_mm <= max_thickness_mm:
-        raise InputError(f"`0 <= min_thickness_mm <= max_thickness_mm` must hold, but got "
-                         f"({min_thickness_mm=}, {max_thickness_mm=}).")
+        raise InputError(
+            f"`0 <= min_thickness_mm <= max_thickness_mm` must hold, but got "
+            f"({min_thickness_mm=}, {max_thickness_mm=})."
+        )
     v, f, arts = _articulations(vertices, faces, articulations)
     thickness = {b: np.zeros(len(v[b])) for b in v}
     for (a, b), (mask_a, mask_b) in arts.items():
@@ -189,8 +199,10 @@ def displaced_vertices(vertices, faces, thickness, *, smoothing_mm=NORMAL_SMOOTH
     v = _vertices(vertices, "mesh")
     t = np.asarray(thickness, dtype=np.float64)
     if t.shape != (len(v),) or not np.isfinite(t).all() or (t < 0).any():
-        raise InputError(f"thickness must be finite, >= 0 and of shape ({len(v)},), but got shape {t.shape}, "
-                         f"min {np.min(t, initial=0.0)}.")
+        raise InputError(
+            f"thickness must be finite, >= 0 and of shape ({len(v)},), but got shape {t.shape}, "
+            f"min {np.min(t, initial=0.0)}."
+        )
     return v + t[:, None] * extrusion_directions(v, faces, t > 0, smoothing_mm=smoothing_mm)
 
 
@@ -228,8 +240,9 @@ def _penetration(points, target_vertices, target_faces, target_thickness, reach_
     return s, tri, np.where(np.isfinite(there), there, target_thickness[tri].mean(axis=1))  # degenerate faces
 
 
-def remove_overclosure(vertices: dict, faces: dict, thickness: dict, articulations: dict, *,
-                       clearance_mm=0.0, max_iter=20) -> tuple[dict, dict]:
+def remove_overclosure(
+    vertices: dict, faces: dict, thickness: dict, articulations: dict, *, clearance_mm=0.0, max_iter=20
+) -> tuple[dict, dict]:
     """Thinner cartilage so that no articulation's bone-plus-cartilage surfaces interpenetrate (neutral pose).
 
     Each cartilage vertex of one bone is checked against the watertight part of the other bone's
@@ -243,8 +256,10 @@ def remove_overclosure(vertices: dict, faces: dict, thickness: dict, articulatio
     for b in v:
         t[b] = np.array(thickness.get(b, np.zeros(len(v[b]))), dtype=np.float64)
         if t[b].shape != (len(v[b]),) or not np.isfinite(t[b]).all() or (t[b] < 0).any():
-            raise InputError(f"thickness of {b} must be finite, >= 0 and of shape ({len(v[b])},), but got shape "
-                             f"{t[b].shape}, min {np.min(t[b], initial=0.0)}.")
+            raise InputError(
+                f"thickness of {b} must be finite, >= 0 and of shape ({len(v[b])},), but got shape "
+                f"{t[b].shape}, min {np.min(t[b], initial=0.0)}."
+            )
     solid = {b: closed_faces(f[b]) for b in v}
     report = {}
     for a, b in arts:
@@ -339,8 +354,18 @@ def cartilage_layer(bone: str, vertices, faces, thickness) -> CartilageLayer:
     return CartilageLayer(bone=bone, thickness=t, vertex_ids=ids, nodes=nodes, wedges=wedges)
 
 
-def build_cartilage(vertices: dict, faces: dict, articulations: dict, *, share=0.5, bandwidth_mm=1.0,
-                    min_thickness_mm=0.1, max_thickness_mm=1.1, clearance_mm=0.0, max_iter=20) -> tuple[dict, dict]:
+def build_cartilage(
+    vertices: dict,
+    faces: dict,
+    articulations: dict,
+    *,
+    share=0.5,
+    bandwidth_mm=1.0,
+    min_thickness_mm=0.1,
+    max_thickness_mm=1.1,
+    clearance_mm=0.0,
+    max_iter=20,
+) -> tuple[dict, dict]:
     """Thickness fields, overclosure removal and wedge meshes of every articulated bone.
 
     Returns thickness (mm, shape (n,)) per bone and a JSON-able report {"cartilage": ...}: per
@@ -348,17 +373,30 @@ def build_cartilage(vertices: dict, faces: dict, articulations: dict, *, share=0
     over covered vertices, mm), overclosure before and after (mm); per bone the wedge quality.
     """
     v, f, arts = _articulations(vertices, faces, articulations)
-    first = thickness_fields(v, f, arts, share=share, bandwidth_mm=bandwidth_mm,
-                             min_thickness_mm=min_thickness_mm, max_thickness_mm=max_thickness_mm)
+    first = thickness_fields(
+        v,
+        f,
+        arts,
+        share=share,
+        bandwidth_mm=bandwidth_mm,
+        min_thickness_mm=min_thickness_mm,
+        max_thickness_mm=max_thickness_mm,
+    )
     thickness, overclosure = remove_overclosure(v, f, first, arts, clearance_mm=clearance_mm, max_iter=max_iter)
     per_articulation = {}
     for (a, b), (mask_a, mask_b) in arts.items():
-        gaps = np.concatenate([gap_to(v[a], mask_a, v[b], f[b], mask_b)[0] if mask_a.any() else [],
-                               gap_to(v[b], mask_b, v[a], f[a], mask_a)[0] if mask_b.any() else []])
+        gaps = np.concatenate(
+            [
+                gap_to(v[a], mask_a, v[b], f[b], mask_b)[0] if mask_a.any() else [],
+                gap_to(v[b], mask_b, v[a], f[a], mask_a)[0] if mask_b.any() else [],
+            ]
+        )
         sides = {x: thickness[x][m] for x, m in ((a, mask_a), (b, mask_b))}
         per_articulation[f"{a}-{b}"] = {
-            "thickness_mm": {x: {"min": _r(s.min()), "mean": _r(s.mean()), "max": _r(s.max())} if s.size else None
-                             for x, s in sides.items()},
+            "thickness_mm": {
+                x: {"min": _r(s.min()), "mean": _r(s.mean()), "max": _r(s.max())} if s.size else None
+                for x, s in sides.items()
+            },
             "joint_space_mm": _r(np.median(gaps)) if gaps.size else None,
             **overclosure[f"{a}-{b}"],
         }

@@ -23,8 +23,9 @@ C01_MPA = 0.41
 D1_PER_MPA = 0.0475
 
 
-def mooney_rivlin_confined_pressure(strain, c10: float = C10_MPA, c01: float = C01_MPA,
-                                    d1: float = D1_PER_MPA) -> np.ndarray:
+def mooney_rivlin_confined_pressure(
+    strain, c10: float = C10_MPA, c01: float = C01_MPA, d1: float = D1_PER_MPA
+) -> np.ndarray:
     """Nominal compressive stress (MPa, positive in compression) of a confined Mooney–Rivlin layer.
 
     strain: nominal compressive strain, scalar or array, each < 1 (axial stretch
@@ -102,9 +103,7 @@ def _trilinear(strain, e1, e2, k1, k2, k3) -> np.ndarray:
     e = np.asarray(strain, dtype=np.float64)
     p1 = k1 * e1
     p2 = p1 + k2 * (e2 - e1)
-    return np.where(e <= 0, 0.0,
-                    np.where(e <= e1, k1 * e,
-                             np.where(e <= e2, p1 + k2 * (e - e1), p2 + k3 * (e - e2))))
+    return np.where(e <= 0, 0.0, np.where(e <= e1, k1 * e, np.where(e <= e2, p1 + k2 * (e - e1), p2 + k3 * (e - e2))))
 
 
 def _law(x, max_strain):
@@ -113,8 +112,9 @@ def _law(x, max_strain):
     return e1, e1 + x[1] * (max_strain - e1), x[2], x[3], x[4]
 
 
-def fit_contact_law(max_strain: float = 0.35, n: int = 200, c10: float = C10_MPA, c01: float = C01_MPA,
-                    d1: float = D1_PER_MPA) -> ContactLawFit:
+def fit_contact_law(
+    max_strain: float = 0.35, n: int = 200, c10: float = C10_MPA, c01: float = C01_MPA, d1: float = D1_PER_MPA
+) -> ContactLawFit:
     """Least-squares tri-linear fit (slopes > 0) to the confined Mooney–Rivlin curve on [0, max_strain].
 
     max_strain: largest fitted strain (0 < max_strain < 1). n: number of strains (>= 10).
@@ -135,8 +135,12 @@ def fit_contact_law(max_strain: float = 0.35, n: int = 200, c10: float = C10_MPA
     secants = np.diff(np.concatenate([[0.0], third])) / (max_strain / 3)
     x0 = np.concatenate([[1 / 3, 0.5], np.maximum(secants, 1e-3)])
     tiny = 1e-6
-    fit = least_squares(residual, x0, bounds=([tiny, tiny, tiny, tiny, tiny], [1 - tiny, 1 - tiny, np.inf, np.inf, np.inf]),
-                        x_scale="jac")
+    fit = least_squares(
+        residual,
+        x0,
+        bounds=([tiny, tiny, tiny, tiny, tiny], [1 - tiny, 1 - tiny, np.inf, np.inf, np.inf]),
+        x_scale="jac",
+    )
     try:
         law = TrilinearLaw(*map(float, _law(fit.x, max_strain)))
     except InputError as err:
@@ -146,4 +150,3 @@ def fit_contact_law(max_strain: float = 0.35, n: int = 200, c10: float = C10_MPA
     strain.setflags(write=False)
     target.setflags(write=False)
     return ContactLawFit(law=law, r2=1.0 - ss_res / ss_tot, strain=strain, pressure=target)
-

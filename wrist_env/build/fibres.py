@@ -125,8 +125,15 @@ def pair_fibres(origins, insertions) -> np.ndarray:
     return perm
 
 
-def build_bundle(name: str, origin_points, insertion_points, n_fibres: int, seed: int | None,
-                 origin_vertex_ids=None, insertion_vertex_ids=None) -> Bundle:
+def build_bundle(
+    name: str,
+    origin_points,
+    insertion_points,
+    n_fibres: int,
+    seed: int | None,
+    origin_vertex_ids=None,
+    insertion_vertex_ids=None,
+) -> Bundle:
     """A bundle of n_fibres fibres between two attachment patches.
 
     origin_points, insertion_points: arrays of shape (m, 3), mm, patch points.
@@ -135,8 +142,10 @@ def build_bundle(name: str, origin_points, insertion_points, n_fibres: int, seed
     """
     ends = []
     seeds = np.random.default_rng(seed).integers(2**31 - 1, size=2)
-    for points, ids, what, s in ((origin_points, origin_vertex_ids, "origin", int(seeds[0])),
-                                 (insertion_points, insertion_vertex_ids, "insertion", int(seeds[1]))):
+    for points, ids, what, s in (
+        (origin_points, origin_vertex_ids, "origin", int(seeds[0])),
+        (insertion_points, insertion_vertex_ids, "insertion", int(seeds[1])),
+    ):
         try:
             pts, idx = fibre_endpoints(points, n_fibres, s)
         except InputError as err:
@@ -144,8 +153,10 @@ def build_bundle(name: str, origin_points, insertion_points, n_fibres: int, seed
         if ids is not None:
             ids = np.asarray(ids, dtype=np.int64)
             if ids.shape != (len(np.asarray(points)),):
-                raise InputError(f"ligament {name}: {what}_vertex_ids must have shape ({len(np.asarray(points))},), "
-                                 f"but got {ids.shape}.")
+                raise InputError(
+                    f"ligament {name}: {what}_vertex_ids must have shape ({len(np.asarray(points))},), "
+                    f"but got {ids.shape}."
+                )
             idx = ids[idx]
         ends.append((pts, idx))
     (o, oi), (ins, ii) = ends
@@ -166,8 +177,9 @@ def _ordered_across(points: np.ndarray, n: int) -> np.ndarray:
 
 def _outward(mesh: trimesh.Trimesh, points: np.ndarray):
     """Signed distance (m,) mm (negative inside), closest points (m, 3) and outward unit directions (m, 3)."""
-    s, face, closest, _ = igl.signed_distance(points, np.asarray(mesh.vertices, np.float64),
-                                              np.asarray(mesh.faces, np.int64))
+    s, face, closest, _ = igl.signed_distance(
+        points, np.asarray(mesh.vertices, np.float64), np.asarray(mesh.faces, np.int64)
+    )
     d = points - closest
     norm = np.linalg.norm(d, axis=1)
     away = np.where(s < 0, -1.0, 1.0)[:, None] * d / np.maximum(norm, 1e-300)[:, None]
@@ -175,8 +187,14 @@ def _outward(mesh: trimesh.Trimesh, points: np.ndarray):
     return s, closest, direction
 
 
-def build_membrane(radius_points, capitate_points, scaphoid_mesh: trimesh.Trimesh,
-                   n_along: int = 9, n_across: int = 5, lift_mm: float = 0.5) -> Membrane:
+def build_membrane(
+    radius_points,
+    capitate_points,
+    scaphoid_mesh: trimesh.Trimesh,
+    n_along: int = 9,
+    n_across: int = 5,
+    lift_mm: float = 0.5,
+) -> Membrane:
     """The RSC membrane from the radius patch over the scaphoid waist to the capitate patch.
 
     radius_points, capitate_points: arrays of shape (m, 3), mm, attachment patches.
@@ -229,6 +247,12 @@ def build_membrane(radius_points, capitate_points, scaphoid_mesh: trimesh.Trimes
     if (length <= 0).any():
         raise BuildError(f"RSC membrane has {int((length <= 0).sum())} zero-length connectors.")
     row = ids // n_across
-    return Membrane(nodes=nodes, shape=(int(n_along), int(n_across)), radius_nodes=(row == 0).ravel(),
-                    capitate_nodes=(row == n_along - 1).ravel(), connectors=connectors, connector_kind=kind,
-                    reference_length_mm=length)
+    return Membrane(
+        nodes=nodes,
+        shape=(int(n_along), int(n_across)),
+        radius_nodes=(row == 0).ravel(),
+        capitate_nodes=(row == n_along - 1).ravel(),
+        connectors=connectors,
+        connector_kind=kind,
+        reference_length_mm=length,
+    )

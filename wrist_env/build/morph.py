@@ -53,9 +53,14 @@ class MorphResult:
     def __eq__(self, other) -> bool:
         if not isinstance(other, MorphResult):
             return NotImplemented
-        return (self.error_mean_mm == other.error_mean_mm and self.error_max_mm == other.error_max_mm
-                and all(np.array_equal(getattr(self, k), getattr(other, k))
-                        for k in ("vertices", "surface_error_mm", "alignment")))
+        return (
+            self.error_mean_mm == other.error_mean_mm
+            and self.error_max_mm == other.error_max_mm
+            and all(
+                np.array_equal(getattr(self, k), getattr(other, k))
+                for k in ("vertices", "surface_error_mm", "alignment")
+            )
+        )
 
     __hash__ = None
 
@@ -71,8 +76,10 @@ def _mesh(vertices, faces, name: str) -> tuple[np.ndarray, np.ndarray]:
         raise MeshError(f"the {name} mesh must have vertices and faces, but got {len(v)} vertices and {len(f)} faces.")
     if not np.isfinite(v).all():
         bad = np.flatnonzero(~np.isfinite(v).all(axis=1))
-        raise MeshError(f"`{name}_vertices` must be finite, but vertex {bad[0]} is {v[bad[0]].tolist()} "
-                        f"({len(bad)} non-finite vertices).")
+        raise MeshError(
+            f"`{name}_vertices` must be finite, but vertex {bad[0]} is {v[bad[0]].tolist()} "
+            f"({len(bad)} non-finite vertices)."
+        )
     if f.min() < 0 or f.max() >= len(v):
         raise MeshError(f"`{name}_faces` must index vertices 0..{len(v) - 1}, but got indices {f.min()}..{f.max()}.")
     return v, f.astype(np.int64)
@@ -85,13 +92,15 @@ def _similarity(template: trimesh.Trimesh, target: trimesh.Trimesh, seed: int | 
     sample = template.vertices[np.sort(rng.choice(n, min(n, ICP_SAMPLES), replace=False))]
     initial = np.eye(4)
     initial[:3, 3] = target.centroid - template.centroid
-    matrix, _, _ = trimesh.registration.icp(sample, target, initial=initial, threshold=1e-9, max_iterations=200,
-                                            scale=True, reflection=False)
+    matrix, _, _ = trimesh.registration.icp(
+        sample, target, initial=initial, threshold=1e-9, max_iterations=200, scale=True, reflection=False
+    )
     return matrix
 
 
-def morph(template_vertices, template_faces, target_vertices, target_faces, *, steps=None,
-          seed: int | None = 0) -> MorphResult:
+def morph(
+    template_vertices, template_faces, target_vertices, target_faces, *, steps=None, seed: int | None = 0
+) -> MorphResult:
     """Register the template bone onto the target bone (both in mm).
 
     template_vertices: array of shape (n, 3), mm; template_faces: (m, 3) int.
@@ -106,9 +115,11 @@ def morph(template_vertices, template_faces, target_vertices, target_faces, *, s
     target = trimesh.Trimesh(pv, pf, process=False)
     ratio = target.scale / template.scale
     if not SIZE_RATIO[0] <= ratio <= SIZE_RATIO[1]:
-        raise MeshError(f"the target must be the template's bone in mm: its size (bounding-box diagonal) must be "
-                        f"{SIZE_RATIO[0]}–{SIZE_RATIO[1]} times the template's, but got {ratio:.4g} "
-                        f"({target.scale:.4g} vs {template.scale:.4g}).")
+        raise MeshError(
+            f"the target must be the template's bone in mm: its size (bounding-box diagonal) must be "
+            f"{SIZE_RATIO[0]}–{SIZE_RATIO[1]} times the template's, but got {ratio:.4g} "
+            f"({target.scale:.4g} vs {template.scale:.4g})."
+        )
     alignment = _similarity(template, target, seed)
     aligned = trimesh.Trimesh(trimesh.transform_points(tv, alignment), tf, process=False)
     stages = [list(s) for s in (STEPS if steps is None else steps)]
@@ -117,8 +128,14 @@ def morph(template_vertices, template_faces, target_vertices, target_faces, *, s
     vertices.setflags(write=False)
     error.setflags(write=False)
     alignment.setflags(write=False)
-    return MorphResult(vertices=vertices, surface_error_mm=error, error_mean_mm=float(error.mean()),
-                       error_max_mm=float(error.max()), alignment=alignment, seconds=time.perf_counter() - start)
+    return MorphResult(
+        vertices=vertices,
+        surface_error_mm=error,
+        error_mean_mm=float(error.mean()),
+        error_max_mm=float(error.max()),
+        alignment=alignment,
+        seconds=time.perf_counter() - start,
+    )
 
 
 def transfer_mask(result: MorphResult, template_mask, target_vertices) -> np.ndarray:
@@ -128,12 +145,16 @@ def transfer_mask(result: MorphResult, template_mask, target_vertices) -> np.nda
     """
     mask = np.asarray(template_mask)
     if mask.shape != (len(result.vertices),) or mask.dtype != bool:
-        raise InputError(f"`template_mask` must be bool of shape ({len(result.vertices)},), "
-                         f"but got {mask.dtype} of shape {mask.shape}.")
+        raise InputError(
+            f"`template_mask` must be bool of shape ({len(result.vertices)},), "
+            f"but got {mask.dtype} of shape {mask.shape}."
+        )
     p = np.asarray(target_vertices, dtype=np.float64)
     if p.ndim != 2 or p.shape[1] != 3 or not np.isfinite(p).all():
-        raise InputError(f"`target_vertices` must be finite with shape (p, 3), but got shape {p.shape}"
-                         f"{'' if p.ndim != 2 or p.shape[1] != 3 else ' with non-finite values'}.")
+        raise InputError(
+            f"`target_vertices` must be finite with shape (p, 3), but got shape {p.shape}"
+            f"{'' if p.ndim != 2 or p.shape[1] != 3 else ' with non-finite values'}."
+        )
     _, nearest = cKDTree(result.vertices).query(p)
     return mask[nearest]
 
@@ -143,8 +164,9 @@ def transfer_points(result: MorphResult, template_vertex_ids) -> np.ndarray:
     ids = np.asarray(template_vertex_ids)
     n = len(result.vertices)
     if ids.ndim != 1 or (ids.size and not np.issubdtype(ids.dtype, np.integer)):
-        raise InputError(f"`template_vertex_ids` must be integers of shape (k,), but got {ids.dtype} "
-                         f"of shape {ids.shape}.")
+        raise InputError(
+            f"`template_vertex_ids` must be integers of shape (k,), but got {ids.dtype} of shape {ids.shape}."
+        )
     if ids.size and (ids.min() < 0 or ids.max() >= n):
         raise InputError(f"`template_vertex_ids` must lie in 0..{n - 1}, but got {ids.min()}..{ids.max()}.")
     return result.vertices[ids.astype(np.int64)]

@@ -71,21 +71,38 @@ class BuildParams:
 def add_anatomy_arguments(parser) -> None:
     """Add the anatomy-variant options (`--fossa-sweep`, `--no-distal-row`) to an argparse parser."""
     d = BuildParams()
-    parser.add_argument("--fossa-sweep", nargs=2, type=float, default=d.fossa_sweep_deg, metavar=("FLEXION", "DEVIATION"),
-                        help="anatomy variant: radius fossae as the envelope of the row swept +-these angles (deg); "
-                             f"0 0 moulds them to the neutral row (default {d.fossa_sweep_deg[0]:g} "
-                             f"{d.fossa_sweep_deg[1]:g})")
-    parser.add_argument("--no-distal-row", dest="distal_row", action="store_false",
-                        help="anatomy variant: the five principal bones alone (no triquetrum, trapezium, trapezoid, "
-                             "hamate; no TC/TH ligaments)")
-    parser.add_argument("--no-fixed-ligaments", dest="fixed_ligaments", action="store_false",
-                        help="anatomy variant: the distal row without the TC and TH ligaments")
+    parser.add_argument(
+        "--fossa-sweep",
+        nargs=2,
+        type=float,
+        default=d.fossa_sweep_deg,
+        metavar=("FLEXION", "DEVIATION"),
+        help="anatomy variant: radius fossae as the envelope of the row swept +-these angles (deg); "
+        f"0 0 moulds them to the neutral row (default {d.fossa_sweep_deg[0]:g} "
+        f"{d.fossa_sweep_deg[1]:g})",
+    )
+    parser.add_argument(
+        "--no-distal-row",
+        dest="distal_row",
+        action="store_false",
+        help="anatomy variant: the five principal bones alone (no triquetrum, trapezium, trapezoid, "
+        "hamate; no TC/TH ligaments)",
+    )
+    parser.add_argument(
+        "--no-fixed-ligaments",
+        dest="fixed_ligaments",
+        action="store_false",
+        help="anatomy variant: the distal row without the TC and TH ligaments",
+    )
 
 
 def anatomy_params(args) -> BuildParams:
     """The `BuildParams` of parsed `add_anatomy_arguments` options."""
-    return BuildParams(fossa_sweep_deg=tuple(float(a) for a in args.fossa_sweep), distal_row=bool(args.distal_row),
-                       fixed_ligaments=bool(args.fixed_ligaments))
+    return BuildParams(
+        fossa_sweep_deg=tuple(float(a) for a in args.fossa_sweep),
+        distal_row=bool(args.distal_row),
+        fixed_ligaments=bool(args.fixed_ligaments),
+    )
 
 
 def source_hash(name: str, bones: dict, params: BuildParams) -> str:
@@ -135,9 +152,12 @@ def _transfer(morphs: dict, bones: dict, params: BuildParams) -> tuple[dict, dic
     ann = template_annotations(*params.anatomy)
     coverage = {}
     for art, (a, b, ma, mb) in ann.coverage.items():
-        coverage[art] = (a, b,
-                         morph.transfer_mask(morphs[a], ma, bones[a].vertices) & bones[a].solid,
-                         morph.transfer_mask(morphs[b], mb, bones[b].vertices) & bones[b].solid)
+        coverage[art] = (
+            a,
+            b,
+            morph.transfer_mask(morphs[a], ma, bones[a].vertices) & bones[a].solid,
+            morph.transfer_mask(morphs[b], mb, bones[b].vertices) & bones[b].solid,
+        )
     sites, relocated = {}, []
     for lig, (o, i) in ann.sites.items():
         pair = []
@@ -163,12 +183,30 @@ def _ligaments(bones: dict, sites: dict, params: BuildParams):
         (ob, om), (ib, im) = sites[lig.name]
         if lig.fibres == 0:
             scaphoid = trimesh.Trimesh(bones["scaphoid"].vertices, bones["scaphoid"].faces, process=False)
-            membrane = fibres.build_membrane(bones[ob].vertices[om], bones[ib].vertices[im], scaphoid,
-                                             n_along=params.membrane_along, n_across=params.membrane_across)
+            membrane = fibres.build_membrane(
+                bones[ob].vertices[om],
+                bones[ib].vertices[im],
+                scaphoid,
+                n_along=params.membrane_along,
+                n_across=params.membrane_across,
+            )
             continue
-        bundles.append((k, ob, ib, fibres.build_bundle(
-            lig.name, bones[ob].vertices[om], bones[ib].vertices[im], lig.fibres, params.seed + k,
-            origin_vertex_ids=np.flatnonzero(om), insertion_vertex_ids=np.flatnonzero(im))))
+        bundles.append(
+            (
+                k,
+                ob,
+                ib,
+                fibres.build_bundle(
+                    lig.name,
+                    bones[ob].vertices[om],
+                    bones[ib].vertices[im],
+                    lig.fibres,
+                    params.seed + k,
+                    origin_vertex_ids=np.flatnonzero(om),
+                    insertion_vertex_ids=np.flatnonzero(im),
+                ),
+            )
+        )
     return bundles, membrane
 
 
@@ -263,7 +301,8 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None, *, wo
     verts = {b: bones[b].vertices for b in BONES}
     faces = {b: bones[b].faces for b in BONES}
     thickness, cart_report = cartilage.build_cartilage(
-        verts, faces, articulations, bandwidth_mm=params.grnn_bandwidth_mm, max_thickness_mm=params.max_thickness_mm)
+        verts, faces, articulations, bandwidth_mm=params.grnn_bandwidth_mm, max_thickness_mm=params.max_thickness_mm
+    )
     thickness = {b: thickness.get(b, np.zeros(len(verts[b]))) for b in BONES}
     summary = _articulation_summary(cart_report["cartilage"]["articulations"])
     _check_joint_spaces(name, summary["joint_space_mm"])
@@ -276,17 +315,26 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None, *, wo
     grids = {}
     for b in GRID_BONES:
         f = bones[b].faces[bones[b].solid[bones[b].faces].all(axis=1)]
-        grids[b] = sdf.signed_distance_grid(displaced[b], f, spacing_mm=params.grid_spacing_mm, margin_mm=params.grid_margin_mm)
+        grids[b] = sdf.signed_distance_grid(
+            displaced[b], f, spacing_mm=params.grid_spacing_mm, margin_mm=params.grid_margin_mm
+        )
     s_pts, seated = _seat_samples(s_pts, s_nrm, s_off, grids)
     lap("grids")
-    masses = [mass.mass_properties(*_solid(bones[b])) if bones[b].solid.any() else (0.0, np.zeros(3), np.zeros((3, 3))) for b in BONES]
-    centroids = [mass.mass_properties(*_solid(bones[b], part=0))[1] if bones[b].part.any() else m[1]
-                 for b, m in zip(BONES, masses)]  # a body of one bone: its centre of mass
+    masses = [
+        mass.mass_properties(*_solid(bones[b])) if bones[b].solid.any() else (0.0, np.zeros(3), np.zeros((3, 3)))
+        for b in BONES
+    ]
+    centroids = [
+        mass.mass_properties(*_solid(bones[b], part=0))[1] if bones[b].part.any() else m[1]
+        for b, m in zip(BONES, masses)
+    ]  # a body of one bone: its centre of mass
     lap("mass")
 
     empty = np.zeros((0, 0, 0), np.float32)
     grid_list = [grids.get(b) for b in BONES]
-    ref_len = np.array([next((bd.reference_length_mm for k2, _, _, bd in bundles if k2 == k), np.nan) for k in range(len(LIGAMENTS))])
+    ref_len = np.array(
+        [next((bd.reference_length_mm for k2, _, _, bd in bundles if k2 == k), np.nan) for k in range(len(LIGAMENTS))]
+    )
     along = membrane.connector_kind == 0
     ref_len[RSC_INDEX] = float(np.sum(membrane.reference_length_mm[along]) / membrane.shape[1])  # mean chain length
     membrane_bone = np.full(len(membrane.nodes), -1, np.int64)
@@ -298,7 +346,8 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None, *, wo
         "build_seconds": round(sum(timings.values()), 2),
         "timings_s": timings,
         "morph_error_mm": morph_report,
-        "fibres": {ALL_LIGAMENTS[k].name: int(len(bd.origin)) for k, _, _, bd in bundles} | {"RSC": int(len(membrane.connectors))},
+        "fibres": {ALL_LIGAMENTS[k].name: int(len(bd.origin)) for k, _, _, bd in bundles}
+        | {"RSC": int(len(membrane.connectors))},
         "reference_length_mm": {n: round(float(x), 3) for n, x in zip(LIGAMENT_NAMES, ref_len)},
         "contact_law_r2": round(float(law.r2), 5),
         "sites_relocated": relocated,
@@ -332,7 +381,9 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None, *, wo
         sample_offsets=s_off,
         contact_law=law.law.as_array(),
         fibre_ligament=np.concatenate([np.full(len(bd.origin), k) for k, _, _, bd in bundles]).astype(np.int64),
-        fibre_bones=np.concatenate([np.tile([BONES.index(o), BONES.index(i)], (len(bd.origin), 1)) for _, o, i, bd in bundles]).astype(np.int64),
+        fibre_bones=np.concatenate(
+            [np.tile([BONES.index(o), BONES.index(i)], (len(bd.origin), 1)) for _, o, i, bd in bundles]
+        ).astype(np.int64),
         fibre_origin=np.vstack([bd.origin for *_, bd in bundles]),
         fibre_insertion=np.vstack([bd.insertion for *_, bd in bundles]),
         reference_length=ref_len,
@@ -347,12 +398,17 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None, *, wo
 
 def _articulation_summary(articulations: dict) -> dict:
     """Per articulation (`PAIRS` names): cartilage thickness over both layers and the joint space (mm)."""
-    names = dict(zip(("radius-scaphoid", "radius-lunate", "scaphoid-lunate", "scaphoid-capitate", "lunate-capitate"), PAIRS))
+    names = dict(
+        zip(("radius-scaphoid", "radius-lunate", "scaphoid-lunate", "scaphoid-capitate", "lunate-capitate"), PAIRS)
+    )
     thickness, space, overclosure = {}, {}, {}
     for key, art in articulations.items():
         sides = [v for v in art["thickness_mm"].values() if v]
-        thickness[names[key]] = {"min": min(v["min"] for v in sides), "mean": round(float(np.mean([v["mean"] for v in sides])), 4),
-                                 "max": max(v["max"] for v in sides)}
+        thickness[names[key]] = {
+            "min": min(v["min"] for v in sides),
+            "mean": round(float(np.mean([v["mean"] for v in sides])), 4),
+            "max": max(v["max"] for v in sides),
+        }
         space[names[key]] = art["joint_space_mm"]
         overclosure[names[key]] = art["overclosure_after_mm"]
     return {"cartilage_thickness_mm": thickness, "joint_space_mm": space, "overclosure_mm": overclosure}
@@ -360,14 +416,20 @@ def _articulation_summary(articulations: dict) -> dict:
 
 def _check_joint_spaces(name: str, spaces: dict) -> None:
     """BuildError unless every articulation's neutral joint space (mm) is within `JOINT_SPACE_MM`."""
-    bad = {art: gap for art, gap in spaces.items()
-           if gap is None or not JOINT_SPACE_MM[art][0] <= gap <= JOINT_SPACE_MM[art][1]}
+    bad = {
+        art: gap
+        for art, gap in spaces.items()
+        if gap is None or not JOINT_SPACE_MM[art][0] <= gap <= JOINT_SPACE_MM[art][1]
+    }
     if bad:
-        listed = "; ".join(f"{art} {'none' if gap is None else f'{gap:.2f} mm'} (plausible "
-                           f"{JOINT_SPACE_MM[art][0]:g}–{JOINT_SPACE_MM[art][1]:g} mm)" for art, gap in bad.items())
+        listed = "; ".join(
+            f"{art} {'none' if gap is None else f'{gap:.2f} mm'} (plausible "
+            f"{JOINT_SPACE_MM[art][0]:g}–{JOINT_SPACE_MM[art][1]:g} mm)"
+            for art, gap in bad.items()
+        )
         raise BuildError(
             f"participant {name!r}: implausible joint spaces in the neutral pose: {listed}. The bones do not sit "
-            f"as the template's do: check `side` in participant.toml (right-hand meshes declared \"left\" are "
+            f'as the template\'s do: check `side` in participant.toml (right-hand meshes declared "left" are '
             f"mirrored, and the reverse), and that the meshes are in the RCS, mm, neutral pose."
         )
 

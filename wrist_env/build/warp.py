@@ -31,8 +31,9 @@ def _points(points, name: str = "points") -> np.ndarray:
         raise InputError(f"`{name}` must have shape (n, 3), but got shape {p.shape}.")
     if not np.isfinite(p).all():
         bad = np.flatnonzero(~np.isfinite(p).all(axis=1))
-        raise InputError(f"`{name}` must be finite, but row {bad[0]} is {p[bad[0]].tolist()} "
-                         f"({len(bad)} non-finite rows).")
+        raise InputError(
+            f"`{name}` must be finite, but row {bad[0]} is {p[bad[0]].tolist()} ({len(bad)} non-finite rows)."
+        )
     return p
 
 
@@ -70,12 +71,15 @@ class Warp:
             raise InputError(f"`centre` must be 3 finite numbers, but got {np.asarray(self.centre).tolist()}.")
         c, w = _points(self.rbf_centres, "rbf_centres"), _points(self.rbf_weights, "rbf_weights")
         if c.shape != w.shape:
-            raise InputError(f"`rbf_centres` and `rbf_weights` must have the same shape, "
-                             f"but got {c.shape} and {w.shape}.")
+            raise InputError(
+                f"`rbf_centres` and `rbf_weights` must have the same shape, but got {c.shape} and {w.shape}."
+            )
         bound = float(np.linalg.norm(w, axis=1).sum()) * _GRADIENT_PEAK / width
         if bound >= 1.0:
-            raise InputError(f"the warp must be a diffeomorphism: `sum |w| · exp(-1/2) / width_mm < 1` must hold, "
-                             f"but got {bound:.3f} (width_mm={width}).")
+            raise InputError(
+                f"the warp must be a diffeomorphism: `sum |w| · exp(-1/2) / width_mm < 1` must hold, "
+                f"but got {bound:.3f} (width_mm={width})."
+            )
         object.__setattr__(self, "scale", scale)
         object.__setattr__(self, "width_mm", width)
         object.__setattr__(self, "centre", _frozen(centre))
@@ -85,9 +89,13 @@ class Warp:
     def __eq__(self, other) -> bool:
         if not isinstance(other, Warp):
             return NotImplemented
-        return (self.scale == other.scale and self.width_mm == other.width_mm
-                and all(np.array_equal(getattr(self, k), getattr(other, k))
-                        for k in ("centre", "rbf_centres", "rbf_weights")))
+        return (
+            self.scale == other.scale
+            and self.width_mm == other.width_mm
+            and all(
+                np.array_equal(getattr(self, k), getattr(other, k)) for k in ("centre", "rbf_centres", "rbf_weights")
+            )
+        )
 
     __hash__ = None
 
@@ -107,7 +115,7 @@ class Warp:
         p = _points(points)
         g = self._gaussians(p)
         diff = p[:, None, :] - self.rbf_centres[None, :, :]  # (n, k, 3)
-        grad_g = -g[:, :, None] * diff / self.width_mm ** 2  # (n, k, 3): d g_j / d x
+        grad_g = -g[:, :, None] * diff / self.width_mm**2  # (n, k, 3): d g_j / d x
         grad_d = np.einsum("ka,nkb->nab", self.rbf_weights, grad_g)  # d d_a / d x_b
         return self.scale * (np.eye(3) + grad_d)
 
@@ -117,8 +125,13 @@ class Warp:
 
     def as_dict(self) -> dict:
         """JSON-able parameters (lists of floats)."""
-        return {"scale": self.scale, "centre": self.centre.tolist(), "rbf_centres": self.rbf_centres.tolist(),
-                "rbf_weights": self.rbf_weights.tolist(), "width_mm": self.width_mm}
+        return {
+            "scale": self.scale,
+            "centre": self.centre.tolist(),
+            "rbf_centres": self.rbf_centres.tolist(),
+            "rbf_weights": self.rbf_weights.tolist(),
+            "width_mm": self.width_mm,
+        }
 
     @classmethod
     def from_dict(cls, data: dict) -> Warp:
@@ -131,11 +144,19 @@ class Warp:
 
     def _gaussians(self, p: np.ndarray) -> np.ndarray:
         d2 = ((p[:, None, :] - self.rbf_centres[None, :, :]) ** 2).sum(axis=-1)
-        return np.exp(-d2 / (2.0 * self.width_mm ** 2))
+        return np.exp(-d2 / (2.0 * self.width_mm**2))
 
 
-def random_warp(seed: int | None, *, scale_sd=0.05, amplitude_mm=1.0, width_mm=15.0, centre=(0.0, 0.0, 0.0),
-                n_centres=6, extent_mm=30.0) -> Warp:
+def random_warp(
+    seed: int | None,
+    *,
+    scale_sd=0.05,
+    amplitude_mm=1.0,
+    width_mm=15.0,
+    centre=(0.0, 0.0, 0.0),
+    n_centres=6,
+    extent_mm=30.0,
+) -> Warp:
     """A random warp, deterministic for a seed.
 
     scale = exp(N(0, scale_sd)); `n_centres` RBF centres uniform in the cube
@@ -153,8 +174,9 @@ def random_warp(seed: int | None, *, scale_sd=0.05, amplitude_mm=1.0, width_mm=1
     rbf_centres = centre + rng.uniform(-extent_mm, extent_mm, size=(int(n_centres), 3))
     direction = rng.standard_normal((int(n_centres), 3))
     direction /= np.linalg.norm(direction, axis=1, keepdims=True)
-    return Warp(scale=scale, centre=centre, rbf_centres=rbf_centres, rbf_weights=amplitude_mm * direction,
-                width_mm=width_mm)
+    return Warp(
+        scale=scale, centre=centre, rbf_centres=rbf_centres, rbf_weights=amplitude_mm * direction, width_mm=width_mm
+    )
 
 
 def apply_to_mesh(vertices, faces, warp: Warp) -> np.ndarray:

@@ -22,9 +22,12 @@ def register_ids(participant: str, motions=tuple(MOTION_PREFIX)) -> tuple[str, .
     for motion in motions:
         i = env_id(participant, motion)
         if i not in gym.registry:
-            gym.register(i, entry_point="wrist_env.envs.wrist:WristEnv",
-                         vector_entry_point="wrist_env.envs.wrist:WristVectorEnv",
-                         kwargs={"participant": participant, "motion": motion})
+            gym.register(
+                i,
+                entry_point="wrist_env.envs.wrist:WristEnv",
+                vector_entry_point="wrist_env.envs.wrist:WristVectorEnv",
+                kwargs={"participant": participant, "motion": motion},
+            )
         ids.append(i)
     return tuple(ids)
 

@@ -40,8 +40,14 @@ class Task:
     trial) or "idealized" (flexion–extension sweep; reference = the hidden truth's
     sweep for built-in participants, none for user participants → reward 0)."""
 
-    def __init__(self, participant: str, motion: str = "calibrate", *, settings: SolverSettings | None = None,
-                 weights: CostWeights | None = None):
+    def __init__(
+        self,
+        participant: str,
+        motion: str = "calibrate",
+        *,
+        settings: SolverSettings | None = None,
+        weights: CostWeights | None = None,
+    ):
         if motion not in MOTIONS:
             raise ValueError(f"motion must be one of {MOTIONS}, but got {motion!r}")
         self.participant, self.motion = participant, motion
@@ -79,8 +85,9 @@ class Task:
         if self.reference is None:
             cost, report = 0.0, None
         else:
-            report = kinematic_cost(_cost_poses(result.poses), self.reference, reference_points=self.reference_points,
-                                    weights=self.weights)
+            report = kinematic_cost(
+                _cost_poses(result.poses), self.reference, reference_points=self.reference_points, weights=self.weights
+            )
             cost = float(report.total)
         failed = not result.ok or (report is not None and report.failed)
         return Evaluation(-cost, cost, failed, outputs(result, report), result)
@@ -93,6 +100,7 @@ def _cost_poses(poses: np.ndarray) -> np.ndarray:
 
 def outputs(result: Result, report=None) -> dict:
     """JSON-ready, NaN-free per-frame outputs (a failed run's arrays are zeros, `failed` True)."""
+
     def clean(a):
         return np.nan_to_num(np.asarray(a, dtype=np.float64), nan=0.0)
 
@@ -101,8 +109,9 @@ def outputs(result: Result, report=None) -> dict:
         "failed": not result.ok,
         "status": result.message,
         "poses": clean(result.poses),
-        "contact": {pair: {field: contact[:, p, k] for k, field in enumerate(CONTACT_FIELDS)}
-                    for p, pair in enumerate(PAIRS)},
+        "contact": {
+            pair: {field: contact[:, p, k] for k, field in enumerate(CONTACT_FIELDS)} for p, pair in enumerate(PAIRS)
+        },
         "bundle_force_n": {lig: bundle[:, i] for i, lig in enumerate(ALL_LIGAMENT_NAMES)},
         "kinetic_energy_nmm": energy[:, 0],
         "internal_energy_nmm": energy[:, 1],

@@ -17,7 +17,13 @@ from wrist_env.design import ALL_LIGAMENT_NAMES  # noqa: E402
 FIGURES = Path(os.environ.get("WRIST_ENV_FIGURES", Path("experiments") / "figures"))
 """Default folder of every figure: `$WRIST_ENV_FIGURES`, else experiments/figures under the working
 directory (the repository's, where the README's figures live)."""
-BONE_COLOUR = {"radius": "#d9cfc1", "ulna": "#d9cfc1", "scaphoid": "#e8dcc8", "lunate": "#e3d5bd", "capitate": "#eadfcf"}
+BONE_COLOUR = {
+    "radius": "#d9cfc1",
+    "ulna": "#d9cfc1",
+    "scaphoid": "#e8dcc8",
+    "lunate": "#e3d5bd",
+    "capitate": "#eadfcf",
+}
 VIEWS = (("volar view", 0, 0), ("radial view", 0, 90), ("oblique", 25, 40))
 LIGAMENT_COLOURS = dict(zip(ALL_LIGAMENT_NAMES, plt.get_cmap("tab10").colors + ("#000000", "#7a5195", "#ef5675")))
 
@@ -30,8 +36,14 @@ def to_plot(p):
 
 def add_mesh(ax, vertices, faces, colour, alpha=1.0, facecolors=None):
     tris = to_plot(vertices[faces])
-    coll = Poly3DCollection(tris, facecolors=facecolors if facecolors is not None else colour,
-                            linewidths=0, alpha=alpha, shade=True, lightsource=matplotlib.colors.LightSource(45, 45))
+    coll = Poly3DCollection(
+        tris,
+        facecolors=facecolors if facecolors is not None else colour,
+        linewidths=0,
+        alpha=alpha,
+        shade=True,
+        lightsource=matplotlib.colors.LightSource(45, 45),
+    )
     ax.add_collection3d(coll)
 
 
@@ -50,4 +62,3 @@ def frame_axes(ax, points, title):
 
 def crop(vertices, faces, y_max):
     return faces[(vertices[faces][:, :, 1] < y_max).all(axis=1)]
-

@@ -56,19 +56,33 @@ def model_figure(name: str, out: Path | None = None) -> Path:
     fig.subplots_adjust(left=0.0, right=0.93, wspace=0.0, top=0.93, bottom=0.08)
     for k, (title, elev, azim) in enumerate(MODEL_PANELS):
         ax = fig.add_subplot(1, 3, k + 1, projection="3d", computed_zorder=False)
-        ax.add_collection3d(Poly3DCollection(draw.to_plot(tris), facecolors=colours, linewidths=0, shade=True,
-                                             lightsource=matplotlib.colors.LightSource(45, 45), zorder=1))
+        ax.add_collection3d(
+            Poly3DCollection(
+                draw.to_plot(tris),
+                facecolors=colours,
+                linewidths=0,
+                shade=True,
+                lightsource=matplotlib.colors.LightSource(45, 45),
+                zorder=1,
+            )
+        )
         ax.add_collection3d(Line3DCollection(draw.to_plot(fibres), colors=fibre_colours, linewidths=2.0, zorder=3))
-        ax.add_collection3d(Line3DCollection(draw.to_plot(membrane), colors=draw.LIGAMENT_COLOURS["RSC"], linewidths=1.0, zorder=3))
+        ax.add_collection3d(
+            Line3DCollection(draw.to_plot(membrane), colors=draw.LIGAMENT_COLOURS["RSC"], linewidths=1.0, zorder=3)
+        )
         ax.view_init(elev=elev, azim=azim - 90)
         draw.frame_axes(ax, tris.reshape(-1, 3), title)
-    handles = [plt.Line2D([], [], color=draw.LIGAMENT_COLOURS[n], lw=2, label=n + (" (membrane)" if n == "RSC" else ""))
-               for n in ALL_LIGAMENT_NAMES]
+    handles = [
+        plt.Line2D([], [], color=draw.LIGAMENT_COLOURS[n], lw=2, label=n + (" (membrane)" if n == "RSC" else ""))
+        for n in ALL_LIGAMENT_NAMES
+    ]
     fig.legend(handles=handles, loc="lower center", ncol=13, frameon=False)
     sm = plt.cm.ScalarMappable(norm=norm, cmap=cmap)
     fig.colorbar(sm, ax=fig.axes, shrink=0.45, label="cartilage thickness (mm)", location="right")
-    fig.suptitle(f"{name}: bones, cartilage coloured by thickness, ligament fibres (drawn on top) "
-                 "and the RSC membrane; RCS, neutral pose")
+    fig.suptitle(
+        f"{name}: bones, cartilage coloured by thickness, ligament fibres (drawn on top) "
+        "and the RSC membrane; RCS, neutral pose"
+    )
     out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(out, dpi=110)
     plt.close(fig)
@@ -117,7 +131,9 @@ def annotations_figure(out: Path | None = None) -> Path:
         ax.view_init(elev=elev, azim=azim - 90)
         draw.frame_axes(ax, np.vstack([bones[b].vertices[bones[b].vertices[:, 1] < 14.0] for b in shown]), title)
     handles = [plt.Line2D([], [], color=c, lw=6, label=a) for a, c in art_colours.items()]
-    handles += [plt.Line2D([], [], color=draw.LIGAMENT_COLOURS[n], marker="o", lw=0, label=n) for n in ALL_LIGAMENT_NAMES]
+    handles += [
+        plt.Line2D([], [], color=draw.LIGAMENT_COLOURS[n], marker="o", lw=0, label=n) for n in ALL_LIGAMENT_NAMES
+    ]
     fig.legend(handles=handles, loc="lower center", ncol=8, frameon=False)
     fig.suptitle("Template annotations: cartilage coverage per articulation (patches) and ligament sites (dots), RCS")
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -38,10 +38,18 @@ def _world(poses_frame, bone_index, points):
 
 PRESSURE_PANELS = (
     # title, pairs, bones pressed on (filled, with their cartilage), bones pressing (dashed outlines)
-    ("radiocarpal: scaphoid and lunate samples on the radius", ("radioscaphoid", "radiolunate"),
-     ("radius", "ulna"), ("scaphoid", "lunate")),
-    ("midcarpal: capitate-head samples on the scaphoid and lunate", ("scaphocapitate", "lunocapitate"),
-     ("scaphoid", "lunate"), ("capitate",)),
+    (
+        "radiocarpal: scaphoid and lunate samples on the radius",
+        ("radioscaphoid", "radiolunate"),
+        ("radius", "ulna"),
+        ("scaphoid", "lunate"),
+    ),
+    (
+        "midcarpal: capitate-head samples on the scaphoid and lunate",
+        ("scaphocapitate", "lunocapitate"),
+        ("scaphoid", "lunate"),
+        ("capitate",),
+    ),
 )
 _BONE_FILL, _CARTILAGE_FILL, _OUTLINE = "#e6e1d8", "#c9d3de", "#4d4d4d"
 _DISTAL_CROP_MM = 12.0  # radius and ulna: only the distal end (RCS y below this)
@@ -74,9 +82,11 @@ def pressure_figure(name: str, out: Path | None = None, *, static: bool = False)
         driver = simulate.idealized(model)
         frame = int(np.argmin(np.abs(driver.angle_deg)))
         load = getattr(driver, "load_n", None)
-        how = (f"the {driver.angle_deg[frame]:.0f}° frame of the idealized sweep "
-               f"(+{driver.angle_deg[0]:.0f}° → {driver.angle_deg[-1]:.0f}°; capitate rotation prescribed, "
-               f"translations free under a {10.0 if load is None else float(load[frame]):g} N compressive load)")
+        how = (
+            f"the {driver.angle_deg[frame]:.0f}° frame of the idealized sweep "
+            f"(+{driver.angle_deg[0]:.0f}° → {driver.angle_deg[-1]:.0f}°; capitate rotation prescribed, "
+            f"translations free under a {10.0 if load is None else float(load[frame]):g} N compressive load)"
+        )
     result = simulate.simulate(model, design.population(), driver)
     if not result.ok:
         raise RuntimeError(f"{name}: simulation failed: {result.message}")
@@ -91,8 +101,16 @@ def pressure_figure(name: str, out: Path | None = None, *, static: bool = False)
         return np.column_stack([world[:, 2], world[:, 0]])
 
     def label(ax, text, at, **kw):
-        ax.text(at[0], at[1], text, ha="center", va="center", zorder=6, **kw,
-                bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.75))
+        ax.text(
+            at[0],
+            at[1],
+            text,
+            ha="center",
+            va="center",
+            zorder=6,
+            **kw,
+            bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.75),
+        )
 
     fig, axes = plt.subplots(1, 2, figsize=(15, 7.4))
     fig.subplots_adjust(left=0.05, right=0.9, top=0.83, bottom=0.1, wspace=0.16)
@@ -107,7 +125,9 @@ def pressure_figure(name: str, out: Path | None = None, *, static: bool = False)
             drawn.append((bone, xz(w[keep])))
             met = [pair_slice(model, p) for p in pairs if PAIR_BONES[PAIRS.index(p)][1] == b]
             if met:  # cartilage vertices within 3 mm of the samples that meet this bone (neutral pose, RCS)
-                near, _ = cKDTree(np.concatenate([model.sample_points[s] for s in met])).query(v, distance_upper_bound=3.0)
+                near, _ = cKDTree(np.concatenate([model.sample_points[s] for s in met])).query(
+                    v, distance_upper_bound=3.0
+                )
                 cart = keep & (model.bone_thickness(bone) > 0) & np.isfinite(near)
                 if cart.sum() > 3:
                     _silhouette(ax, xz(w[cart]), _CARTILAGE_FILL, filled=True, zorder=0.5)
@@ -131,8 +151,17 @@ def pressure_figure(name: str, out: Path | None = None, *, static: bool = False)
             on = p > 0
             ax.scatter(w[~on, 0], w[~on, 1], s=10, facecolors="none", edgecolors="#9a9a9a", linewidths=0.5, zorder=2)
             order = np.argsort(p[on])
-            ax.scatter(w[on][order, 0], w[on][order, 1], s=42, c=p[on][order], cmap=cmap, norm=norm,
-                       edgecolors="k", linewidths=0.35, zorder=4)
+            ax.scatter(
+                w[on][order, 0],
+                w[on][order, 1],
+                s=42,
+                c=p[on][order],
+                cmap=cmap,
+                norm=norm,
+                edgecolors="k",
+                linewidths=0.35,
+                zorder=4,
+            )
             c = result.contact[frame, k]
             lines.append(f"{pair}: mean {_mpa(c[0])}, peak {_mpa(c[1])}, {c[2]:.0f} mm², {c[3]:.2g} N")
         ax.set_title(title + "\n" + "\n".join(lines), fontsize=10)
@@ -140,32 +169,52 @@ def pressure_figure(name: str, out: Path | None = None, *, static: bool = False)
         ax.invert_yaxis()  # volar (+x) down
         ax.set_xlabel("RCS z (mm), radial →")
         ax.set_ylabel("RCS x (mm), volar ↓")
-        for text, xy, ha, va, rot in (("radial", (0.985, 0.5), "right", "center", 90),
-                                      ("ulnar", (0.015, 0.5), "left", "center", 90),
-                                      ("volar", (0.5, 0.015), "center", "bottom", 0),
-                                      ("dorsal", (0.5, 0.985), "center", "top", 0)):
-            ax.text(*xy, text, transform=ax.transAxes, fontsize=12, fontweight="bold", color="#1f3b73",
-                    ha=ha, va=va, rotation=rot, zorder=7,
-                    bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8))
+        for text, xy, ha, va, rot in (
+            ("radial", (0.985, 0.5), "right", "center", 90),
+            ("ulnar", (0.015, 0.5), "left", "center", 90),
+            ("volar", (0.5, 0.015), "center", "bottom", 0),
+            ("dorsal", (0.5, 0.985), "center", "top", 0),
+        ):
+            ax.text(
+                *xy,
+                text,
+                transform=ax.transAxes,
+                fontsize=12,
+                fontweight="bold",
+                color="#1f3b73",
+                ha=ha,
+                va=va,
+                rotation=rot,
+                zorder=7,
+                bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8),
+            )
     cax = fig.add_axes([0.915, 0.17, 0.014, 0.6])
     fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), cax=cax, label="contact pressure (MPa)")
-    handles = [plt.Line2D([], [], marker="o", lw=0, ms=9, mfc=cmap(0.6), mec="k", label="contact sample (pressure)"),
-               plt.Line2D([], [], marker="o", lw=0, mfc="none", mec="#9a9a9a", label="sample out of contact"),
-               plt.Line2D([], [], lw=1.3, ls="--", color=_OUTLINE, label="outline of the bone pressing"),
-               matplotlib.patches.Patch(color=_BONE_FILL, label="bone pressed on"),
-               matplotlib.patches.Patch(color=_CARTILAGE_FILL, label="its articular cartilage")]
+    handles = [
+        plt.Line2D([], [], marker="o", lw=0, ms=9, mfc=cmap(0.6), mec="k", label="contact sample (pressure)"),
+        plt.Line2D([], [], marker="o", lw=0, mfc="none", mec="#9a9a9a", label="sample out of contact"),
+        plt.Line2D([], [], lw=1.3, ls="--", color=_OUTLINE, label="outline of the bone pressing"),
+        matplotlib.patches.Patch(color=_BONE_FILL, label="bone pressed on"),
+        matplotlib.patches.Patch(color=_CARTILAGE_FILL, label="its articular cartilage"),
+    ]
     fig.legend(handles=handles, loc="lower center", ncol=5, frameon=False)
     rs = result.contact[frame, PAIRS.index("radioscaphoid")]
-    fig.suptitle(f"{name}, population design: contact pressure at the neutral pose, viewed from distal "
-                 f"(radioscaphoid mean {_mpa(rs[0])}, peak {_mpa(rs[1])})\n{how}", fontsize=12)
+    fig.suptitle(
+        f"{name}, population design: contact pressure at the neutral pose, viewed from distal "
+        f"(radioscaphoid mean {_mpa(rs[0])}, peak {_mpa(rs[1])})\n{how}",
+        fontsize=12,
+    )
     out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(out, dpi=110)
     plt.close(fig)
     return out
 
 
-KINEMATIC_ANGLES = ("Flex/Ext: flexion (+) about z", "UlnD/RadD: ulnar deviation (+) about x'",
-                    "Pro/Sup: pronation (+) about y'' (long axis)")
+KINEMATIC_ANGLES = (
+    "Flex/Ext: flexion (+) about z",
+    "UlnD/RadD: ulnar deviation (+) about x'",
+    "Pro/Sup: pronation (+) about y'' (long axis)",
+)
 
 
 def kinematics_figure(name: str, out: Path | None = None, *, n_frames: int = 17) -> Path:
@@ -186,8 +235,9 @@ def kinematics_figure(name: str, out: Path | None = None, *, n_frames: int = 17)
         runs.append(("hidden truth", builtin.truth(name), "--"))
     colours = {"scaphoid": "#1f77b4", "lunate": "#d62728"}
     fig = plt.figure(figsize=(13, 6.6))
-    gs = fig.add_gridspec(2, 2, width_ratios=(1.5, 1), left=0.07, right=0.98, top=0.88, bottom=0.1, hspace=0.35,
-                          wspace=0.22)
+    gs = fig.add_gridspec(
+        2, 2, width_ratios=(1.5, 1), left=0.07, right=0.98, top=0.88, bottom=0.1, hspace=0.35, wspace=0.22
+    )
     main = fig.add_subplot(gs[:, 0])
     small = [fig.add_subplot(gs[0, 1]), fig.add_subplot(gs[1, 1])]
     lim = float(np.abs(driver.angle_deg).max())
@@ -203,8 +253,10 @@ def kinematics_figure(name: str, out: Path | None = None, *, n_frames: int = 17)
             a = angles[:, BONES.index(bone)]
             kw = dict(color=colours[bone], ls=style, marker="o", ms=3.5)
             main.plot(driver.angle_deg, a[:, 0], label=f"{bone}, {label}", **kw)
-            ends.append(f"{bone[:8]:<8} {label:<12} {a[0, 0]:+6.1f}° at {driver.angle_deg[0]:+.0f}°, "
-                        f"{a[-1, 0]:+6.1f}° at {driver.angle_deg[-1]:+.0f}°")
+            ends.append(
+                f"{bone[:8]:<8} {label:<12} {a[0, 0]:+6.1f}° at {driver.angle_deg[0]:+.0f}°, "
+                f"{a[-1, 0]:+6.1f}° at {driver.angle_deg[-1]:+.0f}°"
+            )
             for ax, k in zip(small, (1, 2)):
                 ax.plot(driver.angle_deg, a[:, k], **kw)
     main.axhline(0, color="0.85", lw=0.8, zorder=0)
@@ -217,16 +269,28 @@ def kinematics_figure(name: str, out: Path | None = None, *, n_frames: int = 17)
     main.set_aspect("equal")
     main.legend(loc="upper left", fontsize=9)
     if ends:
-        main.text(0.98, 0.03, "\n".join(ends), transform=main.transAxes, ha="right", va="bottom", fontsize=9,
-                  family="monospace", bbox=dict(boxstyle="round", fc="white", ec="0.8"))
+        main.text(
+            0.98,
+            0.03,
+            "\n".join(ends),
+            transform=main.transAxes,
+            ha="right",
+            va="bottom",
+            fontsize=9,
+            family="monospace",
+            bbox=dict(boxstyle="round", fc="white", ec="0.8"),
+        )
     for ax, k in zip(small, (1, 2)):
         ax.set_title(KINEMATIC_ANGLES[k], fontsize=10)
         ax.set_ylabel("deg")
         ax.axhline(0, color="0.85", lw=0.8, zorder=0)
         ax.set_xlim(-lim - 3, lim + 3)
     small[1].set_xlabel("capitate angle (deg)")
-    fig.suptitle(f"{name}: carpal kinematics over the idealized flexion–extension sweep "
-                 f"(Cardan Z-X-Y angles, RCS, neutral = 0)" + ("\n" + "; ".join(notes) if notes else ""), fontsize=12)
+    fig.suptitle(
+        f"{name}: carpal kinematics over the idealized flexion–extension sweep "
+        f"(Cardan Z-X-Y angles, RCS, neutral = 0)" + ("\n" + "; ".join(notes) if notes else ""),
+        fontsize=12,
+    )
     out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(out, dpi=110)
     plt.close(fig)

@@ -53,8 +53,12 @@ def _angle_axis(ax):
 
 def figure8(frames: pd.DataFrame, fit: stats.Fit, out) -> Path:
     participants = sorted(frames["participant"].unique())
-    fig, axes = plt.subplots(1, len(participants) + 1, figsize=(4.6 * (len(participants) + 1), 4.4),
-                             gridspec_kw={"width_ratios": [1.0] * len(participants) + [1.1]})
+    fig, axes = plt.subplots(
+        1,
+        len(participants) + 1,
+        figsize=(4.6 * (len(participants) + 1), 4.4),
+        gridspec_kw={"width_ratios": [1.0] * len(participants) + [1.1]},
+    )
     top = float(np.nanpercentile(frames["rs_mean_mpa"], 99.5)) * 1.08
     for ax, name in zip(axes, participants):
         part = frames[frames["participant"] == name]
@@ -76,8 +80,9 @@ def figure8(frames: pd.DataFrame, fit: stats.Fit, out) -> Path:
     angles = np.sort(frames["angle"].unique())
     base = float(np.mean(stats.pressure_curve(fit, angles)))
     table = fit.table.set_index("term")
-    run_mean = frames.groupby("group").agg(rs=("rs_mean_mpa", "mean"), any=("any_injury", "max"),
-                                           **{lig: (lig, "max") for lig in INJURABLE})
+    run_mean = frames.groupby("group").agg(
+        rs=("rs_mean_mpa", "mean"), any=("any_injury", "max"), **{lig: (lig, "max") for lig in INJURABLE}
+    )
     labels = ["Intact"] + [stats.BUNDLE_LABELS[l] for l in INJURABLE]
     for i, key in enumerate([None] + list(INJURABLE)):
         runs = run_mean[run_mean["any"] == 0] if key is None else run_mean[run_mean[key] == 1]
@@ -92,8 +97,10 @@ def figure8(frames: pd.DataFrame, fit: stats.Fit, out) -> Path:
     ax.set_xlim(-0.6, len(labels) - 0.4)
     ax.set_ylim(0.0, float(np.nanpercentile(run_mean["rs"], 99.5)) * 1.1)
     ax.set_ylabel("sweep-average radioscaphoid pressure (MPa)")
-    ax.set_title("(B) mixed-model estimate, ligament torn alone\n(black: estimate ± 95 % CI; dots: runs with the tear)",
-                 fontsize=9)
+    ax.set_title(
+        "(B) mixed-model estimate, ligament torn alone\n(black: estimate ± 95 % CI; dots: runs with the tear)",
+        fontsize=9,
+    )
     ax.grid(True, axis="y", color="0.92")
     fig.tight_layout()
     return _save(fig, out)
@@ -128,26 +135,44 @@ def figure9(frames: pd.DataFrame, out) -> Path:
     width = 0.8 / len(participants)
     for j, name in enumerate(participants):
         part = at[at["participant"] == name]
-        data = [part.loc[part["category"] == g, "rs_mean_mpa"].to_numpy() if g != "Any injury"
-                else part.loc[part["any_injury"] == 1, "rs_mean_mpa"].to_numpy() for g in FIG9_GROUPS]
+        data = [
+            part.loc[part["category"] == g, "rs_mean_mpa"].to_numpy()
+            if g != "Any injury"
+            else part.loc[part["any_injury"] == 1, "rs_mean_mpa"].to_numpy()
+            for g in FIG9_GROUPS
+        ]
         pos = np.arange(len(FIG9_GROUPS)) + (j - (len(participants) - 1) / 2) * width
         keep = [k for k, d in enumerate(data) if len(d)]
-        bp = ax.boxplot([data[k] for k in keep], positions=pos[keep], widths=width * 0.85, patch_artist=True,
-                        showfliers=False, medianprops={"color": "k"})
+        bp = ax.boxplot(
+            [data[k] for k in keep],
+            positions=pos[keep],
+            widths=width * 0.85,
+            patch_artist=True,
+            showfliers=False,
+            medianprops={"color": "k"},
+        )
         for box in bp["boxes"]:
             box.set(facecolor=colors[j % len(colors)], alpha=0.45)
         for k in keep:
             d = data[k]
             d = d if len(d) <= MAX_DOT_RUNS else np.random.default_rng(k).choice(d, MAX_DOT_RUNS, replace=False)
-            ax.scatter(_jitter(np.full(len(d), pos[k]), width * 0.3, k), d, s=3, color=colors[j % len(colors)],
-                       alpha=0.3, lw=0)
+            ax.scatter(
+                _jitter(np.full(len(d), pos[k]), width * 0.3, k), d, s=3, color=colors[j % len(colors)], alpha=0.3, lw=0
+            )
         ax.plot([], [], "s", color=colors[j % len(colors)], alpha=0.6, label=name)
-    counts = [", ".join(f"{n}: {int(((at['participant'] == n) & ((at['category'] == g) if g != 'Any injury' else (at['any_injury'] == 1))).sum())}"
-                        for n in participants) for g in FIG9_GROUPS]
+    counts = [
+        ", ".join(
+            f"{n}: {int(((at['participant'] == n) & ((at['category'] == g) if g != 'Any injury' else (at['any_injury'] == 1))).sum())}"
+            for n in participants
+        )
+        for g in FIG9_GROUPS
+    ]
     ax.set_xticks(range(len(FIG9_GROUPS)), [f"{g}\n({c})" for g, c in zip(FIG9_GROUPS, counts)], fontsize=8)
     ax.set_ylabel("mean radioscaphoid pressure (MPa)")
-    ax.set_title(f"Radioscaphoid pressure at full extension ({-frames['angle'].min():.0f}°); boxes 25–75 %, "
-                 "whiskers 1.5 IQR", fontsize=9)
+    ax.set_title(
+        f"Radioscaphoid pressure at full extension ({-frames['angle'].min():.0f}°); boxes 25–75 %, whiskers 1.5 IQR",
+        fontsize=9,
+    )
     ax.set_ylim(0.0, float(np.nanpercentile(at["rs_mean_mpa"], 99.5)) * 1.1)
     ax.grid(True, axis="y", color="0.92")
     ax.legend(fontsize=8)
@@ -164,11 +189,19 @@ def figure10(frames: pd.DataFrame, out) -> Path:
         part = intact[intact["participant"] == name]
         dots = _dot_runs(part)
         for k, lig in enumerate(stats.SLIL):
-            ax.scatter(_jitter(dots["angle"] + (k - 1) * 1.2, 0.5, k), dots[f"{lig}.force_n"], s=4,
-                       color=BUNDLE_COLORS[lig], alpha=0.3, lw=0)
+            ax.scatter(
+                _jitter(dots["angle"] + (k - 1) * 1.2, 0.5, k),
+                dots[f"{lig}.force_n"],
+                s=4,
+                color=BUNDLE_COLORS[lig],
+                alpha=0.3,
+                lw=0,
+            )
         for lig in stats.SLIL:
             med = part.groupby("angle")[f"{lig}.force_n"].median()
-            ax.plot(med.index, med.to_numpy(), color=BUNDLE_COLORS[lig], lw=2.4, label=f"{stats.BUNDLE_LABELS[lig]} median")
+            ax.plot(
+                med.index, med.to_numpy(), color=BUNDLE_COLORS[lig], lw=2.4, label=f"{stats.BUNDLE_LABELS[lig]} median"
+            )
         ax.set_title(f"{name}: SLIL bundle forces, intact runs (n = {part['group'].nunique()})", fontsize=10)
         _angle_axis(ax)
         ax.set_ylim(0.0, top)

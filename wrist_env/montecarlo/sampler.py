@@ -45,8 +45,7 @@ TORN_ACTION, INTACT_ACTION = -0.5, 1.0
 """Normalized injury scalars the Monte Carlo study gives a torn and an intact ligament."""
 
 
-def monte_carlo_from_unit(u, *, tear_probability: float = TEAR_PROBABILITY,
-                          truncate_sd: float = SPAN_SD) -> np.ndarray:
+def monte_carlo_from_unit(u, *, tear_probability: float = TEAR_PROBABILITY, truncate_sd: float = SPAN_SD) -> np.ndarray:
     """Normalized actions of shape (n, 27) from points `u` of shape (n, 27) in [0, 1).
 
     Materials (the first 22 columns): Table 2's normals truncated at ±`truncate_sd` by
@@ -122,8 +121,9 @@ def block_seed(seed: int, participant: str, block: int) -> np.random.SeedSequenc
     return np.random.SeedSequence(int(seed), spawn_key=(participant_key(participant), int(block)))
 
 
-def block_actions(seed: int, participant: str, block: int, size: int,
-                  tear_probability: float = TEAR_PROBABILITY) -> np.ndarray:
+def block_actions(
+    seed: int, participant: str, block: int, size: int, tear_probability: float = TEAR_PROBABILITY
+) -> np.ndarray:
     """Normalized actions (size, 27) of one block: a Latin hypercube of `size` points."""
     return monte_carlo_actions(size, block_seed(seed, participant, block), tear_probability=tear_probability)
 
@@ -140,8 +140,9 @@ def vector_env(participant: str, num_envs: int):
     key = (participant, int(num_envs))
     if key not in _ENVS:
         register_ids(participant, ("idealized",))
-        env = gym.make_vec(env_id(participant, "idealized"), num_envs=int(num_envs),
-                           vectorization_mode="vector_entry_point")
+        env = gym.make_vec(
+            env_id(participant, "idealized"), num_envs=int(num_envs), vectorization_mode="vector_entry_point"
+        )
         env.reset(seed=0)
         _ENVS[key] = env
     return _ENVS[key]
@@ -152,12 +153,14 @@ def _frames(rows: np.ndarray, missing=None) -> pa.Array:
     rows = np.ascontiguousarray(rows, dtype=np.float64)
     n, f = rows.shape
     mask = None if missing is None else pa.array(np.asarray(missing, dtype=bool))
-    return pa.ListArray.from_arrays(pa.array(np.arange(0, n * f + 1, f, dtype=np.int32)), pa.array(rows.ravel()),
-                                    mask=mask)
+    return pa.ListArray.from_arrays(
+        pa.array(np.arange(0, n * f + 1, f, dtype=np.int32)), pa.array(rows.ravel()), mask=mask
+    )
 
 
-def run_chunk(participant: str, sample_ids, blocks, actions, *, exclude_above_mpa: float = EXCLUDE_ABOVE_MPA,
-              folders=()) -> pa.Table:
+def run_chunk(
+    participant: str, sample_ids, blocks, actions, *, exclude_above_mpa: float = EXCLUDE_ABOVE_MPA, folders=()
+) -> pa.Table:
     """Simulate k runs (actions of shape (k, 27)) in one vector-env step; their log rows (`SCHEMA`).
 
     Runs wherever it is called: in this process, a local worker process or a dask worker
@@ -188,8 +191,11 @@ def run_chunk(participant: str, sample_ids, blocks, actions, *, exclude_above_mp
     rs_mean = frames(contact["mean_pressure_mpa"])
     excluded = ok & np.any(rs_mean > exclude_above_mpa, axis=1)
     physical = np.stack([design.from_action(a).vector for a in actions]) if k else np.zeros((0, len(NAMES)))
-    columns = {"participant": [participant] * k, "sample_id": np.asarray(sample_ids, dtype=np.int64),
-               "block": np.asarray(blocks, dtype=np.int64)}
+    columns = {
+        "participant": [participant] * k,
+        "sample_id": np.asarray(sample_ids, dtype=np.int64),
+        "block": np.asarray(blocks, dtype=np.int64),
+    }
     columns.update({n: physical[:, i] for i, n in enumerate(NAMES)})
     columns.update({c: actions[:, design.N_MATERIAL + i] < 0 for i, c in enumerate(TEAR_COLUMNS)})
     columns["angle_deg"] = _frames(np.tile(angle, (k, 1)))

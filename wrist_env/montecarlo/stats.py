@@ -77,9 +77,13 @@ def frame_table(runs: pa.Table) -> pd.DataFrame:
     frame = np.concatenate([np.arange(k) for k in lengths]) if n else np.zeros(0, int)
     participant = np.asarray(runs["participant"].to_numpy(zero_copy_only=False), dtype=object)
     sample = runs["sample_id"].to_numpy()
-    out = {"participant": participant[parent], "sample_id": sample[parent],
-           "group": (pd.Series(participant, dtype=str) + ":" + pd.Series(sample).astype(str)).to_numpy()[parent],
-           "frame": frame, "angle": _flat(runs, "angle_deg")}
+    out = {
+        "participant": participant[parent],
+        "sample_id": sample[parent],
+        "group": (pd.Series(participant, dtype=str) + ":" + pd.Series(sample).astype(str)).to_numpy()[parent],
+        "frame": frame,
+        "angle": _flat(runs, "angle_deg"),
+    }
     for c in ("rs_mean_mpa", "rs_peak_mpa", "rs_area_mm2"):
         out[c] = _flat(runs, c)
     torn = np.zeros((n, len(INJURABLE)))
@@ -118,10 +122,18 @@ class Fit:
     extra: dict = field(default_factory=dict)
 
     def info(self) -> dict:
-        return {"formula": self.formula, "runs": self.runs, "rows": self.rows, "runs_available": self.runs_available,
-                "mean_response": self.mean_response, "group_variance": self.group_variance,
-                "residual_variance": self.residual_variance, "fit_seconds": round(self.seconds, 2),
-                "converged": self.converged, **self.extra}
+        return {
+            "formula": self.formula,
+            "runs": self.runs,
+            "rows": self.rows,
+            "runs_available": self.runs_available,
+            "mean_response": self.mean_response,
+            "group_variance": self.group_variance,
+            "residual_variance": self.residual_variance,
+            "fit_seconds": round(self.seconds, 2),
+            "converged": self.converged,
+            **self.extra,
+        }
 
 
 def _mixedlm(formula: str, data: pd.DataFrame):
@@ -164,13 +176,26 @@ def fit_pressure(frames: pd.DataFrame, *, max_runs: int | None = None, seed: int
     data, runs, available, bounds = _prepare(frames, max_runs, seed)
     result = _mixedlm(PRESSURE_FORMULA, data)
     mean = float(data["rs_mean_mpa"].mean())
-    rows = [("Angle spline", "Intercept", "Intercept (full extension)"), ("Angle spline", "s1", "Angle spline 1"),
-            ("Angle spline", "s2", "Angle spline 2")]
+    rows = [
+        ("Angle spline", "Intercept", "Intercept (full extension)"),
+        ("Angle spline", "s1", "Angle spline 1"),
+        ("Angle spline", "s2", "Angle spline 2"),
+    ]
     rows += [("Ligament injury", lig, BUNDLE_LABELS[lig]) for lig in INJURABLE]
     table = _table(result, rows, mean)
-    return Fit(table, mean, float(result.cov_re.iloc[0, 0]), float(result.scale), runs, len(data), available,
-               time.perf_counter() - start, bool(result.converged), PRESSURE_FORMULA,
-               {"angle_range_deg": list(bounds), "max_runs": max_runs, "subsample_seed": seed})
+    return Fit(
+        table,
+        mean,
+        float(result.cov_re.iloc[0, 0]),
+        float(result.scale),
+        runs,
+        len(data),
+        available,
+        time.perf_counter() - start,
+        bool(result.converged),
+        PRESSURE_FORMULA,
+        {"angle_range_deg": list(bounds), "max_runs": max_runs, "subsample_seed": seed},
+    )
 
 
 def slil_long(frames: pd.DataFrame) -> pd.DataFrame:
@@ -192,15 +217,29 @@ def fit_slil(frames: pd.DataFrame, *, max_runs: int | None = None, seed: int = 0
     start = time.perf_counter()
     data, runs, available, bounds = _prepare(slil_long(frames), max_runs, seed)
     result = _mixedlm(SLIL_FORMULA, data)
-    rows = [("Angle spline", "Intercept", "Intercept (dorsal SLIL, full extension)"),
-            ("Angle spline", "s1", "Angle spline 1"), ("Angle spline", "s2", "Angle spline 2"),
-            ("Ligament", "proximal", "Proximal SLIL"), ("Ligament", "volar", "Volar SLIL"),
-            ("Ligament", "s1:proximal", "Angle spline 1 × proximal"),
-            ("Ligament", "s2:proximal", "Angle spline 2 × proximal")]
+    rows = [
+        ("Angle spline", "Intercept", "Intercept (dorsal SLIL, full extension)"),
+        ("Angle spline", "s1", "Angle spline 1"),
+        ("Angle spline", "s2", "Angle spline 2"),
+        ("Ligament", "proximal", "Proximal SLIL"),
+        ("Ligament", "volar", "Volar SLIL"),
+        ("Ligament", "s1:proximal", "Angle spline 1 × proximal"),
+        ("Ligament", "s2:proximal", "Angle spline 2 × proximal"),
+    ]
     table = _table(result, rows, None)
-    return Fit(table, float(data["force_n"].mean()), float(result.cov_re.iloc[0, 0]), float(result.scale), runs,
-               len(data), available, time.perf_counter() - start, bool(result.converged), SLIL_FORMULA,
-               {"angle_range_deg": list(bounds), "max_runs": max_runs, "subsample_seed": seed})
+    return Fit(
+        table,
+        float(data["force_n"].mean()),
+        float(result.cov_re.iloc[0, 0]),
+        float(result.scale),
+        runs,
+        len(data),
+        available,
+        time.perf_counter() - start,
+        bool(result.converged),
+        SLIL_FORMULA,
+        {"angle_range_deg": list(bounds), "max_runs": max_runs, "subsample_seed": seed},
+    )
 
 
 def pressure_curve(fit: Fit, angles, torn=()) -> np.ndarray:

@@ -83,8 +83,13 @@ class StudyConfig:
 
     def key(self) -> dict:
         """The fields that must match to resume a study in the same folder."""
-        return {"version": VERSION, "n": int(self.n), "seed": int(self.seed),
-                "tear_probability": float(self.tear_probability), "exclude_above_mpa": float(self.exclude_above_mpa)}
+        return {
+            "version": VERSION,
+            "n": int(self.n),
+            "seed": int(self.seed),
+            "tear_probability": float(self.tear_probability),
+            "exclude_above_mpa": float(self.exclude_above_mpa),
+        }
 
 
 @dataclass
@@ -124,10 +129,14 @@ class StudySummary:
 
     def line(self) -> str:
         rate = self.simulated / self.wall_seconds if self.wall_seconds > 0 else float("nan")
-        per = "; ".join(f"{p} {c.succeeded} ok, {c.excluded} excluded, {c.failed} failed" for p, c in self.counts.items())
-        return (f"wall {self.wall_seconds:.1f} s for {self.simulated} simulations ({rate:.1f}/s); "
-                f"excluded {self.excluded} ({100 * self.excluded / max(self.attempts, 1):.2f} %), "
-                f"failed {self.failed} ({100 * self.failed / max(self.attempts, 1):.2f} %) of {self.attempts} runs; {per}")
+        per = "; ".join(
+            f"{p} {c.succeeded} ok, {c.excluded} excluded, {c.failed} failed" for p, c in self.counts.items()
+        )
+        return (
+            f"wall {self.wall_seconds:.1f} s for {self.simulated} simulations ({rate:.1f}/s); "
+            f"excluded {self.excluded} ({100 * self.excluded / max(self.attempts, 1):.2f} %), "
+            f"failed {self.failed} ({100 * self.failed / max(self.attempts, 1):.2f} %) of {self.attempts} runs; {per}"
+        )
 
 
 # ---------------------------------------------------------------------------- the log
@@ -148,7 +157,9 @@ def repair(out) -> int:
     store.clean(min_age_s=0.0)  # the caller holds the store lock: no live writer
     moved = 0
     for name, _ in store.damaged_parts(sampler.SCHEMA):
-        moved += store.quarantine(store.part_path(name), "damaged Parquet part, its runs are simulated again") is not None
+        moved += (
+            store.quarantine(store.part_path(name), "damaged Parquet part, its runs are simulated again") is not None
+        )
     return moved
 
 
@@ -181,7 +192,9 @@ def _manifest(out: Path, config: StudyConfig) -> None:
         if old_key != key:
             diff = ", ".join(f"{k} {old_key[k]!r} (asked {key[k]!r})" for k in key if old_key[k] != key[k])
             raise StudyError(f"{out} holds another study ({diff}); use another --out or the same settings")
-        participants = list(old.get("participants", [])) + [p for p in participants if p not in old.get("participants", [])]
+        participants = list(old.get("participants", [])) + [
+            p for p in participants if p not in old.get("participants", [])
+        ]
         if participants == old.get("participants"):
             return
     write_json(path, {**key, "participants": participants})
@@ -231,8 +244,10 @@ def _plan(participant: str, config: StudyConfig, outcomes: dict) -> tuple[Round 
             return None, counts
         start, block, size = start + size, block + 1, deficit
         if start + size > config.attempt_limit:
-            raise StudyError(f"{participant}: {counts.attempts} runs gave only {counts.succeeded} of {config.n} "
-                             f"successes ({counts.excluded} excluded, {counts.failed} failed); giving up")
+            raise StudyError(
+                f"{participant}: {counts.attempts} runs gave only {counts.succeeded} of {config.n} "
+                f"successes ({counts.excluded} excluded, {counts.failed} failed); giving up"
+            )
 
 
 def _chunks(ids: tuple[int, ...], batch: int) -> Iterator[tuple[int, ...]]:
@@ -254,8 +269,9 @@ def part_name(participant: str, ids: tuple[int, ...]) -> str:
 # ---------------------------------------------------------------------------- the study
 
 
-def run_study(config: StudyConfig, out, *, batch: int = 64, scheduler=None, workers: int = 0, folders=(),
-              progress: bool = False) -> StudySummary:
+def run_study(
+    config: StudyConfig, out, *, batch: int = 64, scheduler=None, workers: int = 0, folders=(), progress: bool = False
+) -> StudySummary:
     """Run (or resume) a study into the folder `out`; returns the counts and the wall time.
 
     batch: runs per chunk (one vector-env step, one log part). scheduler: a dask.distributed
@@ -283,8 +299,9 @@ def _logged_outcomes(out: Path, participants) -> dict[str, dict[int, tuple[bool,
     return outcomes
 
 
-def _run_locked(config: StudyConfig, out: Path, batch: int, scheduler, workers, folders: tuple,
-                progress: bool) -> StudySummary:
+def _run_locked(
+    config: StudyConfig, out: Path, batch: int, scheduler, workers, folders: tuple, progress: bool
+) -> StudySummary:
     start_time = time.perf_counter()
     _manifest(out, config)
     repair(out)
@@ -323,8 +340,17 @@ def _run_locked(config: StudyConfig, out: Path, batch: int, scheduler, workers, 
                     block = sampler.block_actions(config.seed, p, rnd.block, rnd.size, config.tear_probability)
                     for ids in _chunks(rnd.missing, batch):
                         rows = np.asarray(ids) - rnd.start
-                        tasks.append(ex.submit(sampler.run_chunk, p, ids, [rnd.block] * len(ids), block[rows],
-                                               exclude_above_mpa=config.exclude_above_mpa, folders=folders))
+                        tasks.append(
+                            ex.submit(
+                                sampler.run_chunk,
+                                p,
+                                ids,
+                                [rnd.block] * len(ids),
+                                block[rows],
+                                exclude_above_mpa=config.exclude_above_mpa,
+                                folders=folders,
+                            )
+                        )
                 for _, table, error in ex.results(tasks):
                     if error is not None:
                         raise error
@@ -354,8 +380,9 @@ def _run_locked(config: StudyConfig, out: Path, batch: int, scheduler, workers, 
 def config_of(out, participants=None) -> StudyConfig:
     """The StudyConfig recorded in a study folder (optionally for other participants)."""
     m = read_manifest(out)
-    return StudyConfig(tuple(participants or m["participants"]), m["n"], m["seed"], m["tear_probability"],
-                       m["exclude_above_mpa"])
+    return StudyConfig(
+        tuple(participants or m["participants"]), m["n"], m["seed"], m["tear_probability"], m["exclude_above_mpa"]
+    )
 
 
 def counts(out) -> dict[str, ParticipantCounts]:
@@ -366,5 +393,10 @@ def counts(out) -> dict[str, ParticipantCounts]:
 
 
 def summary_dict(summary: StudySummary) -> dict:
-    return {"config": asdict(summary.config), "counts": {p: asdict(c) for p, c in summary.counts.items()},
-            "simulated": summary.simulated, "wall_seconds": round(summary.wall_seconds, 3), "done": summary.done}
+    return {
+        "config": asdict(summary.config),
+        "counts": {p: asdict(c) for p, c in summary.counts.items()},
+        "simulated": summary.simulated,
+        "wall_seconds": round(summary.wall_seconds, 3),
+        "done": summary.done,
+    }

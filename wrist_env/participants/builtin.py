@@ -62,8 +62,10 @@ def trials(name: str) -> dict:
 
     meta = _data(name, "trials.json")
     root = importlib.resources.files("wrist_env.participants") / "data" / name
-    return {t: read_trial_csv(root / entry["file"], t, entry["role"], n_frames=meta["frames"])
-            for t, entry in meta["trials"].items()}
+    return {
+        t: read_trial_csv(root / entry["file"], t, entry["role"], n_frames=meta["frames"])
+        for t, entry in meta["trials"].items()
+    }
 
 
 @functools.lru_cache(maxsize=4 * len(BUILTIN))
@@ -91,9 +93,16 @@ def source(name: str, fossa_sweep_deg: tuple | None = None):
 
     sweep = BuildParams().fossa_sweep_deg if fossa_sweep_deg is None else fossa_sweep_deg
     facts = info(name)
-    meta = {"side": "right", "sex": facts.sex, "age": facts.age, "facet_type": facts.facet_type,
-            "task": facts.task, "frames": _data(name, "trials.json")["frames"]}
+    meta = {
+        "side": "right",
+        "sex": facts.sex,
+        "age": facts.age,
+        "facet_type": facts.facet_type,
+        "task": facts.task,
+        "frames": _data(name, "trials.json")["frames"],
+    }
     surfaces = bones(name, tuple(float(a) for a in sweep), False)
     root = importlib.resources.files("wrist_env.participants") / "data" / name
-    return ParticipantSource(name, meta, {b: (s.vertices, s.faces) for b, s in surfaces.items()}, trials(name),
-                             Path(str(root)))
+    return ParticipantSource(
+        name, meta, {b: (s.vertices, s.faces) for b, s in surfaces.items()}, trials(name), Path(str(root))
+    )

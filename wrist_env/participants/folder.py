@@ -89,7 +89,9 @@ class ParticipantSource:
             bones[bone] = (vertices, faces)
         mismatched = [k for k, t in self.trials.items() if t.name != k]
         if mismatched:
-            raise ParticipantError(f"participant {self.name!r}: trials must be keyed by their names, but {mismatched=}.")
+            raise ParticipantError(
+                f"participant {self.name!r}: trials must be keyed by their names, but {mismatched=}."
+            )
         object.__setattr__(self, "bones", bones)
         object.__setattr__(self, "meta", dict(self.meta))
         object.__setattr__(self, "trials", dict(self.trials))
@@ -121,7 +123,7 @@ def load_participant_folder(path) -> ParticipantSource:
         raise ParticipantError(f"{toml_path}: name must match {NAME_PATTERN}, but got {name!r}.")
     if config["units"] != "mm":
         raise ParticipantError(
-            f"{toml_path}: units must be \"mm\", but got {config['units']!r}; convert meshes and trials to mm."
+            f'{toml_path}: units must be "mm", but got {config["units"]!r}; convert meshes and trials to mm.'
         )
     if config["side"] not in SIDES:
         raise ParticipantError(f"{toml_path}: side must be one of {SIDES}, but got {config['side']!r}.")
@@ -149,7 +151,7 @@ def load_participant_folder(path) -> ParticipantSource:
         trials[trial_name] = read_trial_csv(file, trial_name, entry["role"], n_frames=meta.get("frames"))
     if not any(t.role == "calibrate" for t in trials.values()):
         roles = {k: t.role for k, t in trials.items()}
-        raise ParticipantError(f"{toml_path}: at least one trial must have role \"calibrate\", but got {roles}.")
+        raise ParticipantError(f'{toml_path}: at least one trial must have role "calibrate", but got {roles}.')
 
     if config["side"] == "left":
         bones = {b: mirror_mesh(*vf) for b, vf in bones.items()}
@@ -179,8 +181,12 @@ def write_participant_folder(source: ParticipantSource, path) -> Path:
         lines.append(f"{bone} = {_toml_value(f'bones/{bone}.stl')}")
     for trial_name, trial in source.trials.items():
         write_trial_csv(mirror_trial(trial) if side == "left" else trial, folder / "trials" / f"{trial_name}.csv")
-        lines += ["", f"[trials.{trial_name}]", f"file = {_toml_value(f'trials/{trial_name}.csv')}",
-                  f"role = {_toml_value(trial.role)}"]
+        lines += [
+            "",
+            f"[trials.{trial_name}]",
+            f"file = {_toml_value(f'trials/{trial_name}.csv')}",
+            f"role = {_toml_value(trial.role)}",
+        ]
     (folder / PARTICIPANT_FILE).write_text("\n".join(lines) + "\n", encoding="utf-8")
     return folder
 
@@ -219,7 +225,9 @@ def validate_bone_mesh(vertices: np.ndarray, faces: np.ndarray, bone: str, sourc
         raise MeshError(f"{source}: the {bone} mesh must have at least {MIN_FACES} faces, but has {len(faces)}.")
     _check_face_count(len(faces), bone, source)
     if faces.min() < 0 or faces.max() >= len(vertices):
-        raise MeshError(f"{source}: face indices must be in [0, {len(vertices)}), but got [{faces.min()}, {faces.max()}].")
+        raise MeshError(
+            f"{source}: face indices must be in [0, {len(vertices)}), but got [{faces.min()}, {faces.max()}]."
+        )
     diagonal = float(np.linalg.norm(np.ptp(vertices, axis=0)))
     low, high = CARPAL_DIAGONAL_MM if bone in CARPALS else FOREARM_DIAGONAL_MM
     if diagonal < METRES_DIAGONAL_MM:
@@ -293,7 +301,7 @@ def _count_token(path: Path, token: bytes, chunk: int = 1 << 24) -> int:
         while block := f.read(chunk):
             data = tail + block
             count += data.count(token)
-            tail = data[-(len(token) - 1):]
+            tail = data[-(len(token) - 1) :]
     return count
 
 
@@ -415,8 +423,10 @@ def _listed_file(folder: Path, relative, where: str, toml_path: Path) -> Path:
     file = folder / relative
     root = folder.resolve()
     if not file.resolve().is_relative_to(root):
-        raise ParticipantError(f"{toml_path}: {where} = {relative!r} resolves outside the participant folder "
-                               f"{root} (through '..' or a link); refused, not read.")
+        raise ParticipantError(
+            f"{toml_path}: {where} = {relative!r} resolves outside the participant folder "
+            f"{root} (through '..' or a link); refused, not read."
+        )
     if not file.is_file():
         raise ParticipantError(f"{toml_path}: {where} = {relative!r}, but {file} does not exist.")
     return file

@@ -34,8 +34,10 @@ def require(*names: str) -> None:
     """`ParticipantError` listing the known participants unless every name is one."""
     unknown = [n for n in names if n not in participants()]
     if unknown:
-        raise ParticipantError(f"unknown participant{'s' if len(unknown) > 1 else ''} "
-                               f"{unknown if len(unknown) > 1 else repr(unknown[0])}; known: {list(participants())}")
+        raise ParticipantError(
+            f"unknown participant{'s' if len(unknown) > 1 else ''} "
+            f"{unknown if len(unknown) > 1 else repr(unknown[0])}; known: {list(participants())}"
+        )
 
 
 def folder(name: str) -> Path:
@@ -52,7 +54,9 @@ def add_folder(folder) -> str:
 
     source = load_participant_folder(folder)
     if source.name in builtin.BUILTIN:
-        raise ParticipantError(f"{Path(folder) / 'participant.toml'}: name {source.name!r} is taken by a built-in participant")
+        raise ParticipantError(
+            f"{Path(folder) / 'participant.toml'}: name {source.name!r} is taken by a built-in participant"
+        )
     _FOLDERS[source.name] = Path(folder)
     return source.name
 
@@ -85,8 +89,10 @@ def trial(name: str, role: str):
     """The participant's first trial with `role` ("calibrate" or "validate")."""
     found = [t for t in trials(name).values() if t.role == role]
     if not found:
-        raise ParticipantError(f"participant {name!r} has no trial with role {role!r}; its trials: "
-                               f"{ {k: t.role for k, t in trials(name).items()} }")
+        raise ParticipantError(
+            f"participant {name!r} has no trial with role {role!r}; its trials: "
+            f"{ {k: t.role for k, t in trials(name).items()} }"
+        )
     return found[0]
 
 
@@ -100,8 +106,9 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
         try:
             model = Model.load(path)
             if model.name != name or model.source_hash != digest:
-                raise StoreError(f"{path.with_suffix('.json')} holds {model.name!r} {model.source_hash}, "
-                                 f"not {name!r} {digest}")
+                raise StoreError(
+                    f"{path.with_suffix('.json')} holds {model.name!r} {model.source_hash}, not {name!r} {digest}"
+                )
             return model
         except StoreError as e:
             warnings.warn(f"rebuilding a damaged cached model: {e}", stacklevel=2)
@@ -116,5 +123,15 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
     return model
 
 
-__all__ = ["BONES", "add_folder", "bones", "cache_dir", "folder", "load_model", "participants", "require", "trial",
-           "trials"]
+__all__ = [
+    "BONES",
+    "add_folder",
+    "bones",
+    "cache_dir",
+    "folder",
+    "load_model",
+    "participants",
+    "require",
+    "trial",
+    "trials",
+]

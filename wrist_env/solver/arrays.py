@@ -17,7 +17,10 @@ from wrist_env.model import BONES, PAIR_BONES, Model
 Bodies = namedtuple("Bodies", "com0 inv_mass inv_inertia mass inertia")
 Grids = namedtuple("Grids", "pair_bones sample_offsets points thickness area values offsets shape origin spacing")
 Fibres = namedtuple("Fibres", "bones origin insertion ligament rest_length")
-Membrane = namedtuple("Membrane", "connectors kind first_row bone rest scaphoid grid_values grid_offset grid_shape grid_origin grid_spacing rest_length")
+Membrane = namedtuple(
+    "Membrane",
+    "connectors kind first_row bone rest scaphoid grid_values grid_offset grid_shape grid_origin grid_spacing rest_length",
+)
 Settings = namedtuple(
     "Settings",
     "dt settle_steps move_steps ramp_steps min_hold_steps max_hold_steps tolerance force_floor damping rot_damping fibre_damping_s "
@@ -68,9 +71,15 @@ class SolverSettings:
         """The same run with half the time step (twice the steps)."""
         from dataclasses import replace
 
-        return replace(self, dt_s=self.dt_s / 2, settle_steps=2 * self.settle_steps, move_steps=2 * self.move_steps,
-                       ramp_steps=2 * self.ramp_steps, min_hold_steps=2 * self.min_hold_steps,
-                       max_hold_steps=2 * self.max_hold_steps)
+        return replace(
+            self,
+            dt_s=self.dt_s / 2,
+            settle_steps=2 * self.settle_steps,
+            move_steps=2 * self.move_steps,
+            ramp_steps=2 * self.ramp_steps,
+            min_hold_steps=2 * self.min_hold_steps,
+            max_hold_steps=2 * self.max_hold_steps,
+        )
 
 
 def bodies(model: Model, s: SolverSettings) -> Bodies:
@@ -98,8 +107,13 @@ def grids(model: Model) -> Grids:
 
 def fibres(model: Model) -> Fibres:
     rest = np.linalg.norm(model.fibre_insertion - model.fibre_origin, axis=1)
-    return Fibres(np.ascontiguousarray(model.fibre_bones), np.ascontiguousarray(model.fibre_origin),
-                  np.ascontiguousarray(model.fibre_insertion), np.ascontiguousarray(model.fibre_ligament), rest)
+    return Fibres(
+        np.ascontiguousarray(model.fibre_bones),
+        np.ascontiguousarray(model.fibre_origin),
+        np.ascontiguousarray(model.fibre_insertion),
+        np.ascontiguousarray(model.fibre_ligament),
+        rest,
+    )
 
 
 def membrane(model: Model, grd: Grids) -> Membrane:
@@ -108,11 +122,18 @@ def membrane(model: Model, grd: Grids) -> Membrane:
     radius = BONES.index("radius")
     first_row = (model.membrane_bone[conn[:, 0]] == radius) | (model.membrane_bone[conn[:, 1]] == radius)
     return Membrane(
-        conn, np.ascontiguousarray(model.membrane_kind), first_row & (model.membrane_kind == 0),
-        np.ascontiguousarray(model.membrane_bone), np.ascontiguousarray(model.membrane_nodes), s,
-        grd.values, int(grd.offsets[s]),
-        np.ascontiguousarray(model.grid_shape[s]), np.ascontiguousarray(model.grid_origin[s]),
-        float(model.grid_spacing[s]), np.ascontiguousarray(model.membrane_length),
+        conn,
+        np.ascontiguousarray(model.membrane_kind),
+        first_row & (model.membrane_kind == 0),
+        np.ascontiguousarray(model.membrane_bone),
+        np.ascontiguousarray(model.membrane_nodes),
+        s,
+        grd.values,
+        int(grd.offsets[s]),
+        np.ascontiguousarray(model.grid_shape[s]),
+        np.ascontiguousarray(model.grid_origin[s]),
+        float(model.grid_spacing[s]),
+        np.ascontiguousarray(model.membrane_length),
     )
 
 
@@ -142,9 +163,23 @@ def design_arrays(model: Model, fib: Fibres, mem: Membrane, design: Design):
 
 def settings_tuple(s: SolverSettings, driver: int) -> Settings:
     return Settings(
-        float(s.dt_s), int(s.settle_steps), int(s.move_steps), int(s.ramp_steps), int(s.min_hold_steps),
-        int(s.max_hold_steps), float(s.tolerance), float(s.force_floor_n),
-        float(s.damping_per_s), float(s.rot_damping_per_s), float(s.fibre_damping_s), float(s.active_band_mm),
-        int(s.rebuild_every), float(s.node_mass_t), float(s.membrane_contact_stiffness), int(driver),
-        float(s.max_disp_mm), float(np.radians(s.max_rot_deg)), float(s.fire_alpha0),
+        float(s.dt_s),
+        int(s.settle_steps),
+        int(s.move_steps),
+        int(s.ramp_steps),
+        int(s.min_hold_steps),
+        int(s.max_hold_steps),
+        float(s.tolerance),
+        float(s.force_floor_n),
+        float(s.damping_per_s),
+        float(s.rot_damping_per_s),
+        float(s.fibre_damping_s),
+        float(s.active_band_mm),
+        int(s.rebuild_every),
+        float(s.node_mass_t),
+        float(s.membrane_contact_stiffness),
+        int(driver),
+        float(s.max_disp_mm),
+        float(np.radians(s.max_rot_deg)),
+        float(s.fire_alpha0),
     )

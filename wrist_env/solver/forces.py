@@ -30,25 +30,31 @@ R_MEAN, R_PEAK, R_AREA, R_FORCE = (CONTACT_FIELDS.index(f) for f in CONTACT_FIEL
 def to_world(R, x, com0, b, px, py, pz):
     """World position of neutral-pose point p of body b."""
     qx, qy, qz = px - com0[b, 0], py - com0[b, 1], pz - com0[b, 2]
-    return (R[b, 0, 0] * qx + R[b, 0, 1] * qy + R[b, 0, 2] * qz + x[b, 0],
-            R[b, 1, 0] * qx + R[b, 1, 1] * qy + R[b, 1, 2] * qz + x[b, 1],
-            R[b, 2, 0] * qx + R[b, 2, 1] * qy + R[b, 2, 2] * qz + x[b, 2])
+    return (
+        R[b, 0, 0] * qx + R[b, 0, 1] * qy + R[b, 0, 2] * qz + x[b, 0],
+        R[b, 1, 0] * qx + R[b, 1, 1] * qy + R[b, 1, 2] * qz + x[b, 1],
+        R[b, 2, 0] * qx + R[b, 2, 1] * qy + R[b, 2, 2] * qz + x[b, 2],
+    )
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def to_local(R, x, com0, b, wx, wy, wz):
     """Neutral-pose coordinates in body b of world point w."""
     qx, qy, qz = wx - x[b, 0], wy - x[b, 1], wz - x[b, 2]
-    return (R[b, 0, 0] * qx + R[b, 1, 0] * qy + R[b, 2, 0] * qz + com0[b, 0],
-            R[b, 0, 1] * qx + R[b, 1, 1] * qy + R[b, 2, 1] * qz + com0[b, 1],
-            R[b, 0, 2] * qx + R[b, 1, 2] * qy + R[b, 2, 2] * qz + com0[b, 2])
+    return (
+        R[b, 0, 0] * qx + R[b, 1, 0] * qy + R[b, 2, 0] * qz + com0[b, 0],
+        R[b, 0, 1] * qx + R[b, 1, 1] * qy + R[b, 2, 1] * qz + com0[b, 1],
+        R[b, 0, 2] * qx + R[b, 1, 2] * qy + R[b, 2, 2] * qz + com0[b, 2],
+    )
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def rotate(R, b, gx, gy, gz):
-    return (R[b, 0, 0] * gx + R[b, 0, 1] * gy + R[b, 0, 2] * gz,
-            R[b, 1, 0] * gx + R[b, 1, 1] * gy + R[b, 1, 2] * gz,
-            R[b, 2, 0] * gx + R[b, 2, 1] * gy + R[b, 2, 2] * gz)
+    return (
+        R[b, 0, 0] * gx + R[b, 0, 1] * gy + R[b, 0, 2] * gz,
+        R[b, 1, 0] * gx + R[b, 1, 1] * gy + R[b, 1, 2] * gz,
+        R[b, 2, 0] * gx + R[b, 2, 1] * gy + R[b, 2, 2] * gz,
+    )
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -93,7 +99,9 @@ def _lookup(grids, b, M, s):
     qx = m00 * px + m01 * py + m02 * pz + tx
     qy = m10 * px + m11 * py + m12 * pz + ty
     qz = m20 * px + m21 * py + m22 * pz + tz
-    d, gx, gy, gz = sdf_lookup_scalar(grids.values, grids.offsets[b], grids.shape[b], grids.origin[b], grids.spacing[b], qx, qy, qz)
+    d, gx, gy, gz = sdf_lookup_scalar(
+        grids.values, grids.offsets[b], grids.shape[b], grids.origin[b], grids.spacing[b], qx, qy, qz
+    )
     return d, gx, gy, gz, qx, qy, qz
 
 
@@ -239,7 +247,9 @@ def place_nodes(R, x, com0, mem, nodes):
     for i in range(nodes.shape[0]):
         b = mem.bone[i]
         if b >= 0:
-            nodes[i, 0], nodes[i, 1], nodes[i, 2] = to_world(R, x, com0, b, mem.rest[i, 0], mem.rest[i, 1], mem.rest[i, 2])
+            nodes[i, 0], nodes[i, 1], nodes[i, 2] = to_world(
+                R, x, com0, b, mem.rest[i, 0], mem.rest[i, 1], mem.rest[i, 2]
+            )
 
 
 @njit(cache=True, error_model="numpy")
@@ -278,8 +288,9 @@ def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node
         if mem.bone[i] >= 0:
             continue
         qx, qy, qz = to_local(R, x, com0, s, nodes[i, 0], nodes[i, 1], nodes[i, 2])
-        d, gx, gy, gz = sdf_lookup_scalar(mem.grid_values, mem.grid_offset, mem.grid_shape,
-                                          mem.grid_origin, mem.grid_spacing, qx, qy, qz)
+        d, gx, gy, gz = sdf_lookup_scalar(
+            mem.grid_values, mem.grid_offset, mem.grid_shape, mem.grid_origin, mem.grid_spacing, qx, qy, qz
+        )
         if d < 0.0:
             gn = np.sqrt(gx * gx + gy * gy + gz * gz)
             if gn > 1e-12:
@@ -293,6 +304,8 @@ def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node
     for i in range(nodes.shape[0]):
         b = mem.bone[i]
         if b >= 0:
-            apply_force(F, T, x, b, node_force[i, 0], node_force[i, 1], node_force[i, 2], nodes[i, 0], nodes[i, 1], nodes[i, 2])
+            apply_force(
+                F, T, x, b, node_force[i, 0], node_force[i, 1], node_force[i, 2], nodes[i, 0], nodes[i, 1], nodes[i, 2]
+            )
             node_force[i, 0] = node_force[i, 1] = node_force[i, 2] = 0.0
     return energy, along

@@ -72,10 +72,10 @@ def _fire(v, w, nv, F, T, node_force, mem, st, fire):
     if power > 0.0:
         a = fire[0]
         for b in (SCAPHOID, LUNATE):
-            _mix(v[b:b + 1], F[b:b + 1], a)
-            _mix(w[b:b + 1], T[b:b + 1], a)
+            _mix(v[b : b + 1], F[b : b + 1], a)
+            _mix(w[b : b + 1], T[b : b + 1], a)
         if st.driver == 1:
-            _mix(v[CAPITATE:CAPITATE + 1], F[CAPITATE:CAPITATE + 1], a)
+            _mix(v[CAPITATE : CAPITATE + 1], F[CAPITATE : CAPITATE + 1], a)
         _mix(nv, node_force, a)
         fire[1] += 1.0
         if fire[1] > FIRE_N_MIN:
@@ -89,8 +89,32 @@ def _fire(v, w, nv, F, T, node_force, mem, st, fire):
 
 
 @njit(cache=True, error_model="numpy")
-def _forces(R, x, v, w, nodes, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st,
-            active, n_active, F, T, node_force, stats, bundle, load, rebuild):
+def _forces(
+    R,
+    x,
+    v,
+    w,
+    nodes,
+    bod,
+    grids,
+    law,
+    fib,
+    f_l0,
+    f_K,
+    mem,
+    m_l0,
+    m_K,
+    st,
+    active,
+    n_active,
+    F,
+    T,
+    node_force,
+    stats,
+    bundle,
+    load,
+    rebuild,
+):
     """Forces F (N), torques T (N·mm), contact stats and bundle forces at the current
     state; rebuilds the active contact set first if `rebuild`; returns internal energy (N·mm)."""
     com0 = bod.com0
@@ -111,8 +135,36 @@ def _forces(R, x, v, w, nodes, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, 
 
 
 @njit(cache=True, error_model="numpy")
-def _step(R, x, v, w, nodes, nv, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st,
-          active, n_active, F, T, node_force, stats, bundle, capR, capx, load, step_index, fire):
+def _step(
+    R,
+    x,
+    v,
+    w,
+    nodes,
+    nv,
+    bod,
+    grids,
+    law,
+    fib,
+    f_l0,
+    f_K,
+    mem,
+    m_l0,
+    m_K,
+    st,
+    active,
+    n_active,
+    F,
+    T,
+    node_force,
+    stats,
+    bundle,
+    capR,
+    capx,
+    load,
+    step_index,
+    fire,
+):
     """One explicit step with the capitate at target (capR, capx), or, for the loaded
     driver, at rotation capR under a compressive `load` (N, along +y); returns
     internal energy (N·mm) before the step."""
@@ -121,8 +173,32 @@ def _step(R, x, v, w, nodes, nv, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K
         x[CAPITATE, 0], x[CAPITATE, 1], x[CAPITATE, 2] = capx
         v[CAPITATE] = 0.0
     w[CAPITATE] = 0.0
-    energy = _forces(R, x, v, w, nodes, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st,
-                     active, n_active, F, T, node_force, stats, bundle, load, step_index % st.rebuild_every == 0)
+    energy = _forces(
+        R,
+        x,
+        v,
+        w,
+        nodes,
+        bod,
+        grids,
+        law,
+        fib,
+        f_l0,
+        f_K,
+        mem,
+        m_l0,
+        m_K,
+        st,
+        active,
+        n_active,
+        F,
+        T,
+        node_force,
+        stats,
+        bundle,
+        load,
+        step_index % st.rebuild_every == 0,
+    )
     if st.fire_alpha0 > 0.0:
         _fire(v, w, nv, F, T, node_force, mem, st, fire)
     dt = st.dt
@@ -191,8 +267,11 @@ def _kinetic(R, v, w, nv, bod, st):
         u1 = R[b, 0, 1] * w[b, 0] + R[b, 1, 1] * w[b, 1] + R[b, 2, 1] * w[b, 2]
         u2 = R[b, 0, 2] * w[b, 0] + R[b, 1, 2] * w[b, 1] + R[b, 2, 2] * w[b, 2]
         I = bod.inertia[b]
-        rot = (u0 * (I[0, 0] * u0 + I[0, 1] * u1 + I[0, 2] * u2) + u1 * (I[1, 0] * u0 + I[1, 1] * u1 + I[1, 2] * u2)
-               + u2 * (I[2, 0] * u0 + I[2, 1] * u1 + I[2, 2] * u2))
+        rot = (
+            u0 * (I[0, 0] * u0 + I[0, 1] * u1 + I[0, 2] * u2)
+            + u1 * (I[1, 0] * u0 + I[1, 1] * u1 + I[1, 2] * u2)
+            + u2 * (I[2, 0] * u0 + I[2, 1] * u1 + I[2, 2] * u2)
+        )
         ke += 0.5 * bod.mass[b] * (v[b, 0] ** 2 + v[b, 1] ** 2 + v[b, 2] ** 2) + 0.5 * rot
     if st.driver == 1:
         ke += 0.5 * bod.mass[CAPITATE] * (v[CAPITATE, 0] ** 2 + v[CAPITATE, 1] ** 2 + v[CAPITATE, 2] ** 2)
@@ -202,8 +281,28 @@ def _kinetic(R, v, w, nv, bod, st):
 
 
 @njit(cache=True, error_model="numpy")
-def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x, frame_load,
-        poses, contact, bundle_out, energy_out, residual_out, steps_out, status):
+def run(
+    bod,
+    grids,
+    law,
+    fib,
+    f_l0,
+    f_K,
+    mem,
+    m_l0,
+    m_K,
+    st,
+    frame_R,
+    frame_x,
+    frame_load,
+    poses,
+    contact,
+    bundle_out,
+    energy_out,
+    residual_out,
+    steps_out,
+    status,
+):
     """Simulate one design; fills the per-frame outputs and status[0] (0 ok, 1 NaN, 2 diverged).
 
     frame_R (n_frames, 3, 3), frame_x (n_frames, 3): capitate rotation and
@@ -262,8 +361,36 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x, f
             s = smoothstep((k + 1) / ramp) if ramp > 0 else 1.0
             capx = interpolate_pose(Ra, xa, axis, capR, shift, s)
             load = la + s * (lb - la)
-            energy = _step(R, x, v, w, nodes, nv, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st,
-                           active, n_active, F, T, node_force, stats, bundle, capR, capx, load, step, fire)
+            energy = _step(
+                R,
+                x,
+                v,
+                w,
+                nodes,
+                nv,
+                bod,
+                grids,
+                law,
+                fib,
+                f_l0,
+                f_K,
+                mem,
+                m_l0,
+                m_K,
+                st,
+                active,
+                n_active,
+                F,
+                T,
+                node_force,
+                stats,
+                bundle,
+                capR,
+                capx,
+                load,
+                step,
+                fire,
+            )
             step += 1
             k += 1
             if k >= ramp + st.min_hold_steps and _converged(F, T, bundle, st):
@@ -288,8 +415,32 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x, f
         if f < 0:
             continue
         # outputs at the state reached (the last step's forces were those before it)
-        energy = _forces(R, x, v, w, nodes, bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st,
-                         active, n_active, F, T, node_force, stats, bundle, lb, True)
+        energy = _forces(
+            R,
+            x,
+            v,
+            w,
+            nodes,
+            bod,
+            grids,
+            law,
+            fib,
+            f_l0,
+            f_K,
+            mem,
+            m_l0,
+            m_K,
+            st,
+            active,
+            n_active,
+            F,
+            T,
+            node_force,
+            stats,
+            bundle,
+            lb,
+            True,
+        )
         for b in range(N_BONES):
             poses[f, b, :3, :3] = R[b]
             poses[f, b, :3, 3] = x[b] - R[b] @ com0[b]
@@ -311,9 +462,49 @@ def run(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x, f
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def run_batch(bod, grids, law, fib, f_l0, f_K, mem, m_l0, m_K, st, frame_R, frame_x, frame_load,
-              poses, contact, bundle_out, energy_out, residual_out, steps_out, status):
+def run_batch(
+    bod,
+    grids,
+    law,
+    fib,
+    f_l0,
+    f_K,
+    mem,
+    m_l0,
+    m_K,
+    st,
+    frame_R,
+    frame_x,
+    frame_load,
+    poses,
+    contact,
+    bundle_out,
+    energy_out,
+    residual_out,
+    steps_out,
+    status,
+):
     """`run` for many designs: f_l0, f_K (n, N), m_l0, m_K (n, C); outputs with a leading n axis."""
     for i in prange(f_l0.shape[0]):
-        run(bod, grids, law, fib, f_l0[i], f_K[i], mem, m_l0[i], m_K[i], st, frame_R, frame_x, frame_load,
-            poses[i], contact[i], bundle_out[i], energy_out[i], residual_out[i], steps_out[i], status[i])
+        run(
+            bod,
+            grids,
+            law,
+            fib,
+            f_l0[i],
+            f_K[i],
+            mem,
+            m_l0[i],
+            m_K[i],
+            st,
+            frame_R,
+            frame_x,
+            frame_load,
+            poses[i],
+            contact[i],
+            bundle_out[i],
+            energy_out[i],
+            residual_out[i],
+            steps_out[i],
+            status[i],
+        )

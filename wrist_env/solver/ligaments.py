@@ -29,5 +29,5 @@ def blankevoort_energy(K, l0, strain):
         return 0.0
     el = EPSILON_L
     if strain <= 2.0 * el:
-        return K * l0 * strain ** 3 / (12.0 * el)
+        return K * l0 * strain**3 / (12.0 * el)
     return K * l0 * (2.0 * el * el / 3.0 + 0.5 * strain * strain - el * strain)

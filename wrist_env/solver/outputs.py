@@ -37,8 +37,14 @@ def pressure_map(model: Model, pose_frame) -> np.ndarray:
     """
     R, x = _state(model, pose_frame)
     pressure = np.zeros(len(model.sample_points))
-    forces.sample_pressures(R, x, np.ascontiguousarray(model.com, dtype=np.float64), arrays.grids(model),
-                            np.ascontiguousarray(model.contact_law, dtype=np.float64), pressure)
+    forces.sample_pressures(
+        R,
+        x,
+        np.ascontiguousarray(model.com, dtype=np.float64),
+        arrays.grids(model),
+        np.ascontiguousarray(model.contact_law, dtype=np.float64),
+        pressure,
+    )
     return pressure
 
 
@@ -87,19 +93,22 @@ def result_to_dict(result, model: Model) -> dict:
     angles = cardan_deg(result.poses)
     frames = []
     for f in range(n):
-        frames.append({
-            "frame": f,
-            "capitate_angle_deg": _num(result.angle_deg[f]),
-            "rotation_deg": {b: [_num(a) for a in angles[f, i]] for i, b in enumerate(BONES)},
-            "poses": {b: _matrix(result.poses[f, i]) for i, b in enumerate(BONES)},
-            "contact": {p: {field: _num(v) for field, v in zip(CONTACT_FIELDS, c)}
-                        for p, c in zip(PAIRS, result.contact[f])},
-            "ligament_force_n": {name: _num(v) for name, v in zip(ALL_LIGAMENT_NAMES, result.bundle_force[f])},
-            "kinetic_energy_nmm": _num(result.energy[f, 0]),
-            "internal_energy_nmm": _num(result.energy[f, 1]),
-            "residual": {"force_n": _num(result.residual[f, 0]), "moment_nmm": _num(result.residual[f, 1])},
-            "steps": int(result.steps[f]),
-        })
+        frames.append(
+            {
+                "frame": f,
+                "capitate_angle_deg": _num(result.angle_deg[f]),
+                "rotation_deg": {b: [_num(a) for a in angles[f, i]] for i, b in enumerate(BONES)},
+                "poses": {b: _matrix(result.poses[f, i]) for i, b in enumerate(BONES)},
+                "contact": {
+                    p: {field: _num(v) for field, v in zip(CONTACT_FIELDS, c)} for p, c in zip(PAIRS, result.contact[f])
+                },
+                "ligament_force_n": {name: _num(v) for name, v in zip(ALL_LIGAMENT_NAMES, result.bundle_force[f])},
+                "kinetic_energy_nmm": _num(result.energy[f, 0]),
+                "internal_energy_nmm": _num(result.energy[f, 1]),
+                "residual": {"force_n": _num(result.residual[f, 0]), "moment_nmm": _num(result.residual[f, 1])},
+                "steps": int(result.steps[f]),
+            }
+        )
     return {
         "status": int(result.status),
         "ok": bool(result.ok),

@@ -20,7 +20,11 @@ from wrist_env.model import BONES, Model
 from wrist_env.solver import arrays, kernel
 
 IDEALIZED_LOAD_N = 10.0  # compressive load that keeps the joint in contact (N)
-STATUS = {kernel.OK: "ok", kernel.FAILED_NAN: "failed: NaN in the state", kernel.FAILED_DIVERGED: "failed: a free bone dislocated (moved beyond max_disp_mm or turned beyond max_rot_deg from the capitate)"}
+STATUS = {
+    kernel.OK: "ok",
+    kernel.FAILED_NAN: "failed: NaN in the state",
+    kernel.FAILED_DIVERGED: "failed: a free bone dislocated (moved beyond max_disp_mm or turned beyond max_rot_deg from the capitate)",
+}
 
 
 @dataclass(frozen=True)
@@ -71,8 +75,15 @@ def static(model: Model, n_frames: int = 3) -> Driver:
     return experimental(model, np.tile(np.eye(4), (int(n_frames), 1, 1)))
 
 
-def idealized(model: Model, *, flexion_deg: float = 40.0, extension_deg: float = 40.0, n_frames: int = 17,
-              angles_deg=None, load_n: float = IDEALIZED_LOAD_N) -> Driver:
+def idealized(
+    model: Model,
+    *,
+    flexion_deg: float = 40.0,
+    extension_deg: float = 40.0,
+    n_frames: int = 17,
+    angles_deg=None,
+    load_n: float = IDEALIZED_LOAD_N,
+) -> Driver:
     """Idealized flexion–extension (preprint 2.2.3.2): the capitate from `flexion_deg` of
     flexion to `extension_deg` of extension about the RCS z axis in `n_frames` equal steps
     (or through `angles_deg`, flexion +), other rotations held, translations free under
@@ -113,9 +124,15 @@ class Result:
 
 def _outputs(n: int, n_frames: int):
     shape = (n,) if n else ()
-    return (np.full(shape + (n_frames, 5, 4, 4), np.nan), np.full(shape + (n_frames, 5, 4), np.nan),
-            np.full(shape + (n_frames, len(ALL_LIGAMENT_NAMES)), np.nan), np.full(shape + (n_frames, 2), np.nan),
-            np.full(shape + (n_frames, 2), np.nan), np.zeros(shape + (n_frames,), np.int64), np.zeros(shape + (1,), np.int64))
+    return (
+        np.full(shape + (n_frames, 5, 4, 4), np.nan),
+        np.full(shape + (n_frames, 5, 4), np.nan),
+        np.full(shape + (n_frames, len(ALL_LIGAMENT_NAMES)), np.nan),
+        np.full(shape + (n_frames, 2), np.nan),
+        np.full(shape + (n_frames, 2), np.nan),
+        np.zeros(shape + (n_frames,), np.int64),
+        np.zeros(shape + (1,), np.int64),
+    )
 
 
 @dataclass(frozen=True)
@@ -134,16 +151,26 @@ class Prepared:
 
     def check(self, model: Model, driver: Driver) -> None:
         if model is not self.model or driver.mode != self.mode:
-            raise ValueError(f"these prepared arrays are for model {self.model.name!r} and driver mode {self.mode}, "
-                             f"but got model {model.name!r} and mode {driver.mode}")
+            raise ValueError(
+                f"these prepared arrays are for model {self.model.name!r} and driver mode {self.mode}, "
+                f"but got model {model.name!r} and mode {driver.mode}"
+            )
 
 
 def prepare(model: Model, settings: arrays.SolverSettings | None = None, mode: int = arrays.EXPERIMENTAL) -> Prepared:
     """The kernel arrays of `model` under `settings` (default `SolverSettings()`) for drivers of `mode`."""
     s = settings or arrays.SolverSettings()
     grd = arrays.grids(model)
-    return Prepared(model, int(mode), arrays.bodies(model, s), grd, arrays.fibres(model), arrays.membrane(model, grd),
-                    arrays.settings_tuple(s, mode), np.ascontiguousarray(model.contact_law, dtype=np.float64))
+    return Prepared(
+        model,
+        int(mode),
+        arrays.bodies(model, s),
+        grd,
+        arrays.fibres(model),
+        arrays.membrane(model, grd),
+        arrays.settings_tuple(s, mode),
+        np.ascontiguousarray(model.contact_law, dtype=np.float64),
+    )
 
 
 def _prepared(model, settings, driver, prepared) -> Prepared:
@@ -153,21 +180,47 @@ def _prepared(model, settings, driver, prepared) -> Prepared:
     return prepared
 
 
-def simulate(model: Model, design: Design, driver: Driver, settings: arrays.SolverSettings | None = None, *,
-             prepared: Prepared | None = None) -> Result:
+def simulate(
+    model: Model,
+    design: Design,
+    driver: Driver,
+    settings: arrays.SolverSettings | None = None,
+    *,
+    prepared: Prepared | None = None,
+) -> Result:
     """Simulate one design: settle, move the capitate to the first pose, then the motion.
 
     prepared: `prepare(model, settings, driver.mode)`, to skip rebuilding the kernel arrays."""
     p = _prepared(model, settings, driver, prepared)
     f_l0, f_K, m_l0, m_K = arrays.design_arrays(model, p.fibres, p.membrane, design)
     out = _outputs(0, len(driver.rotation))
-    kernel.run(p.bodies, p.grids, p.law, p.fibres, f_l0, f_K, p.membrane, m_l0, m_K, p.settings, driver.rotation,
-               driver.com, driver.load_n, *out)
+    kernel.run(
+        p.bodies,
+        p.grids,
+        p.law,
+        p.fibres,
+        f_l0,
+        f_K,
+        p.membrane,
+        m_l0,
+        m_K,
+        p.settings,
+        driver.rotation,
+        driver.com,
+        driver.load_n,
+        *out,
+    )
     return _result(out, driver, int(out[-1][0]))
 
 
-def simulate_batch(model: Model, designs, driver: Driver, settings: arrays.SolverSettings | None = None, *,
-                   prepared: Prepared | None = None) -> list[Result]:
+def simulate_batch(
+    model: Model,
+    designs,
+    driver: Driver,
+    settings: arrays.SolverSettings | None = None,
+    *,
+    prepared: Prepared | None = None,
+) -> list[Result]:
     """Simulate many designs in parallel (Numba prange); same results as one at a time."""
     p = _prepared(model, settings, driver, prepared)
     per = [arrays.design_arrays(model, p.fibres, p.membrane, d) for d in designs]
@@ -175,8 +228,22 @@ def simulate_batch(model: Model, designs, driver: Driver, settings: arrays.Solve
     out = _outputs(len(per), len(driver.rotation))
     previous = numba.set_parallel_chunksize(1)  # designs differ in cost: hand them out one at a time
     try:
-        kernel.run_batch(p.bodies, p.grids, p.law, p.fibres, f_l0, f_K, p.membrane, m_l0, m_K, p.settings,
-                         driver.rotation, driver.com, driver.load_n, *out)
+        kernel.run_batch(
+            p.bodies,
+            p.grids,
+            p.law,
+            p.fibres,
+            f_l0,
+            f_K,
+            p.membrane,
+            m_l0,
+            m_K,
+            p.settings,
+            driver.rotation,
+            driver.com,
+            driver.load_n,
+            *out,
+        )
     finally:
         numba.set_parallel_chunksize(previous)
     return [_result(tuple(o[i] for o in out), driver, int(out[-1][i, 0])) for i in range(len(per))]

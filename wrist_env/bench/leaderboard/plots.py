@@ -18,22 +18,32 @@ def convergence_figure(path, board, colors) -> None:
     """Best cost so far against evaluations: median and IQR band per calibrator, a panel per participant."""
     import matplotlib.pyplot as plt
 
-    runs_frame, curves, refs, participants, labels, budgets = (board.runs_frame, board.curves, board.refs,
-                                                               board.participants, board.labels, board.budgets)
+    runs_frame, curves, refs, participants, labels, budgets = (
+        board.runs_frame,
+        board.curves,
+        board.refs,
+        board.participants,
+        board.labels,
+        board.budgets,
+    )
 
     n = len(participants)
     ncols = min(n, 3)
     nrows = -(-n // ncols)
-    fig, axes = plt.subplots(nrows, ncols, figsize=(4.6 * ncols + 0.4, 4.0 * nrows + 0.5), squeeze=False,
-                             constrained_layout=True)
+    fig, axes = plt.subplots(
+        nrows, ncols, figsize=(4.6 * ncols + 0.4, 4.0 * nrows + 0.5), squeeze=False, constrained_layout=True
+    )
     for ax in axes.flat[n:]:
         ax.set_visible(False)
     for ax, p in zip(axes.flat, participants):
         lows = []
         for label in labels:
             sub = runs_frame[(runs_frame.participant == p) & (runs_frame.calibrator == label)]
-            cs = [curves[(r.participant, r.optimizer, r.seed, r.budget)] for r in sub.itertuples()
-                  if (r.participant, r.optimizer, r.seed, r.budget) in curves]
+            cs = [
+                curves[(r.participant, r.optimizer, r.seed, r.budget)]
+                for r in sub.itertuples()
+                if (r.participant, r.optimizer, r.seed, r.budget) in curves
+            ]
             if not cs:
                 continue
             length = max(len(c) for c in cs)
@@ -45,13 +55,29 @@ def convergence_figure(path, board, colors) -> None:
             ax.fill_between(x, q25, q75, color=colors[label], alpha=0.18, lw=0)
         pop = refs[p].population["calibrate"]["cost"]
         ax.axhline(pop, color="0.35", ls="--", lw=1)
-        ax.text(0.99, pop, "population", color="0.35", fontsize=8, ha="right", va="bottom",
-                transform=ax.get_yaxis_transform())
+        ax.text(
+            0.99,
+            pop,
+            "population",
+            color="0.35",
+            fontsize=8,
+            ha="right",
+            va="bottom",
+            transform=ax.get_yaxis_transform(),
+        )
         if refs[p].truth is not None:
             truth = refs[p].truth["calibrate"]["cost"]
             ax.axhline(truth, color="0.1", ls=":", lw=1.2)
-            ax.text(0.01, truth, "hidden truth", color="0.1", fontsize=8, ha="left", va="top",
-                    transform=ax.get_yaxis_transform())
+            ax.text(
+                0.01,
+                truth,
+                "hidden truth",
+                color="0.1",
+                fontsize=8,
+                ha="left",
+                va="top",
+                transform=ax.get_yaxis_transform(),
+            )
         ax.set_yscale("log")
         low = min([refs[p].truth["calibrate"]["cost"] if refs[p].truth is not None else np.inf] + lows) * 0.85
         ax.set_ylim(low, 1.6 * pop)  # failed runs (cost 1000) would squash the interesting range
@@ -81,15 +107,27 @@ def ecdf_figure(path, board, colors) -> None:
     """COCO-style ECDF of (run, target) pairs solved against evaluations."""
     import matplotlib.pyplot as plt
 
-    runs_frame, targets, curves, participants, labels, budgets = (board.runs_frame, board.targets, board.curves,
-                                                                  board.participants, board.labels, board.budgets)
+    runs_frame, targets, curves, participants, labels, budgets = (
+        board.runs_frame,
+        board.targets,
+        board.curves,
+        board.participants,
+        board.labels,
+        board.budgets,
+    )
 
     groups = [("all participants", participants)] + ([(p, [p]) for p in participants] if len(participants) > 1 else [])
     n = len(groups)
     ncols = n if n <= 3 else 2 if n == 4 else 3
     nrows = -(-n // ncols)
-    fig, axes = plt.subplots(nrows, ncols, figsize=(4.6 * ncols + 0.4, 3.9 * nrows + 0.5), squeeze=False,
-                             constrained_layout=True, sharey=True)
+    fig, axes = plt.subplots(
+        nrows,
+        ncols,
+        figsize=(4.6 * ncols + 0.4, 3.9 * nrows + 0.5),
+        squeeze=False,
+        constrained_layout=True,
+        sharey=True,
+    )
     for ax in axes.flat[n:]:
         ax.set_visible(False)
     top = max(budgets)

@@ -32,8 +32,10 @@ def reference(participant: str) -> Reference:
     designs = {"population": design.population()}
     if participant in builtin.BUILTIN:
         designs["truth"] = builtin.truth(participant)
-    scores = {name: {m: _score(task(participant, m).evaluate(d)) for m in ("calibrate", "validate")}
-              for name, d in designs.items()}
+    scores = {
+        name: {m: _score(task(participant, m).evaluate(d)) for m in ("calibrate", "validate")}
+        for name, d in designs.items()
+    }
     return Reference(participant, scores["population"], scores.get("truth"))
 
 

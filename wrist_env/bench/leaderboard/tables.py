@@ -67,10 +67,20 @@ def best_cost(runs_frame, refs, participants, labels) -> pd.DataFrame:
             if sub.empty:
                 continue
             v = sub.best_cost.to_numpy()
-            rows.append({"participant": p, "calibrator": label, "runs": len(v), "median": quantile(v, 0.5),
-                         "q25": quantile(v, 0.25), "q75": quantile(v, 0.75), "min": float(v.min()), "max": float(v.max()),
-                         "population": refs[p].population["calibrate"]["cost"],
-                         "truth": refs[p].truth["calibrate"]["cost"] if refs[p].truth else np.nan})
+            rows.append(
+                {
+                    "participant": p,
+                    "calibrator": label,
+                    "runs": len(v),
+                    "median": quantile(v, 0.5),
+                    "q25": quantile(v, 0.25),
+                    "q75": quantile(v, 0.75),
+                    "min": float(v.min()),
+                    "max": float(v.max()),
+                    "population": refs[p].population["calibrate"]["cost"],
+                    "truth": refs[p].truth["calibrate"]["cost"] if refs[p].truth else np.nan,
+                }
+            )
     return pd.DataFrame(rows)
 
 
@@ -83,14 +93,24 @@ def evals_to_target(runs_frame, targets, participants, labels, curves) -> pd.Dat
             sub = runs_frame[(runs_frame.participant == t.participant) & (runs_frame.calibrator == label)]
             if sub.empty:
                 continue
-            hits = [hit(curves.get((r.participant, r.optimizer, r.seed, r.budget), np.array([r.best_cost])), t.value)
-                    for r in sub.itertuples()]
+            hits = [
+                hit(curves.get((r.participant, r.optimizer, r.seed, r.budget), np.array([r.best_cost])), t.value)
+                for r in sub.itertuples()
+            ]
             solved = [h for h in hits if h is not None]
             spent = sum(h if h is not None else r.nfev for h, r in zip(hits, sub.itertuples()))
-            rows.append({"participant": t.participant, "target": t.target, "target_value": t.value,
-                         "calibrator": label, "solved": len(solved), "runs": len(hits),
-                         "ert": spent / len(solved) if solved else np.inf,
-                         "median_evals_solved": float(np.median(solved)) if solved else np.nan})
+            rows.append(
+                {
+                    "participant": t.participant,
+                    "target": t.target,
+                    "target_value": t.value,
+                    "calibrator": label,
+                    "solved": len(solved),
+                    "runs": len(hits),
+                    "ert": spent / len(solved) if solved else np.inf,
+                    "median_evals_solved": float(np.median(solved)) if solved else np.nan,
+                }
+            )
     return pd.DataFrame(rows)
 
 
@@ -103,8 +123,17 @@ def recovery(runs_frame, summaries, participants, labels) -> pd.DataFrame:
             v = [x for x in sub.recovery_z if x is not None and np.isfinite(x)]
             if sub.empty or not v:
                 continue
-            rows.append({"participant": p, "calibrator": label, "runs": len(v), "median": quantile(v, 0.5),
-                         "q25": quantile(v, 0.25), "q75": quantile(v, 0.75), "population": population.get(p)})
+            rows.append(
+                {
+                    "participant": p,
+                    "calibrator": label,
+                    "runs": len(v),
+                    "median": quantile(v, 0.5),
+                    "q25": quantile(v, 0.25),
+                    "q75": quantile(v, 0.75),
+                    "population": population.get(p),
+                }
+            )
     return pd.DataFrame(rows)
 
 
@@ -116,19 +145,37 @@ def heldout(runs_frame, refs, participants, labels) -> pd.DataFrame:
             if score is None:
                 continue
             val = rmse_array(score["validate"]["rmse"])
-            rows.append({"participant": p, "calibrator": name, "runs": 0, "cost_median": score["validate"]["cost"],
-                         "cost_q25": np.nan, "cost_q75": np.nan, "failed": int(score["validate"]["failed"]),
-                         "rmse_translation_mm": float(np.nanmean(val[:, :3])),
-                         "rmse_rotation_deg": float(np.nanmean(val[:, 3:]))})
+            rows.append(
+                {
+                    "participant": p,
+                    "calibrator": name,
+                    "runs": 0,
+                    "cost_median": score["validate"]["cost"],
+                    "cost_q25": np.nan,
+                    "cost_q75": np.nan,
+                    "failed": int(score["validate"]["failed"]),
+                    "rmse_translation_mm": float(np.nanmean(val[:, :3])),
+                    "rmse_rotation_deg": float(np.nanmean(val[:, 3:])),
+                }
+            )
         for label in labels:
             sub = runs_frame[(runs_frame.participant == p) & (runs_frame.calibrator == label)]
             if sub.empty:
                 continue
             v = sub.validate_cost.to_numpy()
-            rows.append({"participant": p, "calibrator": label, "runs": len(v), "cost_median": quantile(v, 0.5),
-                         "cost_q25": quantile(v, 0.25), "cost_q75": quantile(v, 0.75), "failed": int(sub.validate_failed.sum()),
-                         "rmse_translation_mm": quantile(sub.validate_rmse_translation_mm, 0.5),
-                         "rmse_rotation_deg": quantile(sub.validate_rmse_rotation_deg, 0.5)})
+            rows.append(
+                {
+                    "participant": p,
+                    "calibrator": label,
+                    "runs": len(v),
+                    "cost_median": quantile(v, 0.5),
+                    "cost_q25": quantile(v, 0.25),
+                    "cost_q75": quantile(v, 0.75),
+                    "failed": int(sub.validate_failed.sum()),
+                    "rmse_translation_mm": quantile(sub.validate_rmse_translation_mm, 0.5),
+                    "rmse_rotation_deg": quantile(sub.validate_rmse_rotation_deg, 0.5),
+                }
+            )
     return pd.DataFrame(rows)
 
 
@@ -176,25 +223,51 @@ def dof_improved(summaries, chosen, refs, participants, labels, budgets) -> pd.D
     rows = []
 
     def row(name, trial_pairs, runs):
-        rows.append({"calibrated design": name, "runs": runs,
-                     "calibrate_pct": trial_pairs["calibrate"], "validate_pct": trial_pairs["validate"],
-                     "dof": 12 * len(participants)})
+        rows.append(
+            {
+                "calibrated design": name,
+                "runs": runs,
+                "calibrate_pct": trial_pairs["calibrate"],
+                "validate_pct": trial_pairs["validate"],
+                "dof": 12 * len(participants),
+            }
+        )
 
-    row("best run per participant",
-        {t: share_improved([(rmse_array(refs[p].population[t]["rmse"]), rmse_array(chosen[p][t]["rmse"]))
-                             for p in participants]) for t in ("calibrate", "validate")}, len(participants))
+    row(
+        "best run per participant",
+        {
+            t: share_improved(
+                [(rmse_array(refs[p].population[t]["rmse"]), rmse_array(chosen[p][t]["rmse"])) for p in participants]
+            )
+            for t in ("calibrate", "validate")
+        },
+        len(participants),
+    )
     for label in labels:
         shares = {"calibrate": [], "validate": []}
         mine = [s for s in summaries if calibrator_label(s["optimizer"], s["budget"], budgets) == label]
         for t in shares:  # every run counts: share over all its runs' DOF, pooled over participants
-            shares[t] = share_improved([(rmse_array(refs[s["participant"]].population[t]["rmse"]),
-                                          rmse_array(s[t]["rmse"])) for s in mine])
-        rows.append({"calibrated design": f"{label} (all runs)", "runs": len(mine),
-                     "calibrate_pct": shares["calibrate"], "validate_pct": shares["validate"],
-                     "dof": 12 * len(mine)})
-    rows.append({"calibrated design": "preprint (Tables 3–4)", "runs": 3,
-                 "calibrate_pct": PREPRINT_SHARE_IMPROVED["calibrate"],
-                 "validate_pct": PREPRINT_SHARE_IMPROVED["validate"], "dof": 36})
+            shares[t] = share_improved(
+                [(rmse_array(refs[s["participant"]].population[t]["rmse"]), rmse_array(s[t]["rmse"])) for s in mine]
+            )
+        rows.append(
+            {
+                "calibrated design": f"{label} (all runs)",
+                "runs": len(mine),
+                "calibrate_pct": shares["calibrate"],
+                "validate_pct": shares["validate"],
+                "dof": 12 * len(mine),
+            }
+        )
+    rows.append(
+        {
+            "calibrated design": "preprint (Tables 3–4)",
+            "runs": 3,
+            "calibrate_pct": PREPRINT_SHARE_IMPROVED["calibrate"],
+            "validate_pct": PREPRINT_SHARE_IMPROVED["validate"],
+            "dof": 36,
+        }
+    )
     return pd.DataFrame(rows)
 
 
@@ -229,8 +302,16 @@ def _targets(participants, refs) -> pd.DataFrame:
         for name, base, factor in TARGETS:
             score = r.population if base == "population" else r.truth
             if score is not None:
-                rows.append({"participant": p, "target": name, "reference": base, "factor": factor,
-                             "reference_cost": score["calibrate"]["cost"], "value": factor * score["calibrate"]["cost"]})
+                rows.append(
+                    {
+                        "participant": p,
+                        "target": name,
+                        "reference": base,
+                        "factor": factor,
+                        "reference_cost": score["calibrate"]["cost"],
+                        "value": factor * score["calibrate"]["cost"],
+                    }
+                )
     return pd.DataFrame(rows)
 
 
@@ -240,11 +321,20 @@ def _runs_frame(summaries, curves_by_key, targets, budgets) -> pd.DataFrame:
     for s in summaries:
         key = (s["participant"], s["optimizer"], s["seed"], s["budget"])
         curve = curves_by_key.get(key, np.array([s["best_cost"]]))
-        row = {"participant": s["participant"], "calibrator": calibrator_label(s["optimizer"], s["budget"], budgets),
-               "optimizer": s["optimizer"], "seed": s["seed"], "budget": s["budget"], "nfev": s["nfev"],
-               "best_cost": s["best_cost"], "best_eval": s["best_eval"],
-               "calibrate_cost": s["calibrate"]["cost"], "validate_cost": s["validate"]["cost"],
-               "validate_failed": s["validate"]["failed"], "recovery_z": s["recovery_z"]}
+        row = {
+            "participant": s["participant"],
+            "calibrator": calibrator_label(s["optimizer"], s["budget"], budgets),
+            "optimizer": s["optimizer"],
+            "seed": s["seed"],
+            "budget": s["budget"],
+            "nfev": s["nfev"],
+            "best_cost": s["best_cost"],
+            "best_eval": s["best_eval"],
+            "calibrate_cost": s["calibrate"]["cost"],
+            "validate_cost": s["validate"]["cost"],
+            "validate_failed": s["validate"]["failed"],
+            "recovery_z": s["recovery_z"],
+        }
         val = rmse_array(s["validate"]["rmse"])
         row["validate_rmse_translation_mm"] = float(np.nanmean(val[:, :3])) if np.isfinite(val).any() else np.nan
         row["validate_rmse_rotation_deg"] = float(np.nanmean(val[:, 3:])) if np.isfinite(val).any() else np.nan
@@ -273,20 +363,38 @@ def build(runs, references: dict | None = None) -> Leaderboard:
     runs_frame = _runs_frame(summaries, by_key, targets, budgets)
     chosen = best_runs(summaries)
     return Leaderboard(
-        str(runs), summaries, unfinished, participants, labels, budgets, refs, by_key, targets, runs_frame,
+        str(runs),
+        summaries,
+        unfinished,
+        participants,
+        labels,
+        budgets,
+        refs,
+        by_key,
+        targets,
+        runs_frame,
         best_cost(runs_frame, refs, participants, labels),
         evals_to_target(runs_frame, targets, participants, labels, by_key),
         recovery(runs_frame, summaries, participants, labels),
         heldout(runs_frame, refs, participants, labels),
-        chosen, rmse_table(chosen, refs, participants, "calibrate"), rmse_table(chosen, refs, participants, "validate"),
-        dof_improved(summaries, chosen, refs, participants, labels, budgets))
+        chosen,
+        rmse_table(chosen, refs, participants, "calibrate"),
+        rmse_table(chosen, refs, participants, "validate"),
+        dof_improved(summaries, chosen, refs, participants, labels, budgets),
+    )
 
 
-CSV_FILES = {"best_cost.csv": ("best", "%.6g"), "targets.csv": ("targets", "%.6g"),
-             "evals_to_target.csv": ("ert", "%.6g"), "recovery.csv": ("recovery", "%.6g"),
-             "heldout.csv": ("heldout", "%.6g"), "table3_rmse_calibrate.csv": ("table3", "%.4g"),
-             "table4_rmse_validate.csv": ("table4", "%.4g"), "dof_improved.csv": ("improved", "%.4g"),
-             "runs.csv": ("runs_frame", "%.6g")}
+CSV_FILES = {
+    "best_cost.csv": ("best", "%.6g"),
+    "targets.csv": ("targets", "%.6g"),
+    "evals_to_target.csv": ("ert", "%.6g"),
+    "recovery.csv": ("recovery", "%.6g"),
+    "heldout.csv": ("heldout", "%.6g"),
+    "table3_rmse_calibrate.csv": ("table3", "%.4g"),
+    "table4_rmse_validate.csv": ("table4", "%.4g"),
+    "dof_improved.csv": ("improved", "%.4g"),
+    "runs.csv": ("runs_frame", "%.6g"),
+}
 """The CSV files of a leaderboard: {file name: (Leaderboard field, float format)}."""
 
 
