@@ -19,7 +19,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from wrist_env import design
-from wrist_env.build.pipeline import BuildParams
+from wrist_env.builder.pipeline import BuildParams
 from wrist_env.model import BODY_PARTS, BONES, PAIR_BONES, PAIRS
 from wrist_env.montecarlo import sampler
 from wrist_env.participants.registry import load_model

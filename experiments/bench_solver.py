@@ -146,7 +146,7 @@ def main(name: str, params=None, load_n=None) -> None:
 if __name__ == "__main__":
     import argparse
 
-    from wrist_env.build.pipeline import add_anatomy_arguments, anatomy_params
+    from wrist_env.builder.pipeline import add_anatomy_arguments, anatomy_params
 
     cli = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     cli.add_argument("participant", nargs="?", default="P1")

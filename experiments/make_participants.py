@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from wrist_env import design
-from wrist_env.build.warp import random_warp
+from wrist_env.builder.warp import random_warp
 
 OUT = Path(__file__).resolve().parents[1] / "wrist_env" / "participants" / "data"
 

@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from wrist_env.build.pipeline import BuildParams
+from wrist_env.builder.pipeline import BuildParams
 from wrist_env.frames import cardan_rotation
 from wrist_env.model import BONES
 from wrist_env.participants import builtin

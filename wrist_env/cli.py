@@ -170,7 +170,7 @@ def _evaluate(args) -> int:
 
 def _validate(args) -> int:
     from wrist_env import validation
-    from wrist_env.build.pipeline import BuildParams, anatomy_params
+    from wrist_env.builder.pipeline import BuildParams, anatomy_params
     from wrist_env.participants import registry
     from wrist_env.solver.simulate import IDEALIZED_LOAD_N
 
@@ -362,7 +362,7 @@ def _montecarlo_report(args) -> int:
 
 
 def parser() -> argparse.ArgumentParser:
-    from wrist_env.build.pipeline import add_anatomy_arguments
+    from wrist_env.builder.pipeline import add_anatomy_arguments
     from wrist_env.design import INJURABLE, SPAN_SD
     from wrist_env.montecarlo.sampler import EXCLUDE_ABOVE_MPA, TEAR_PROBABILITY
 

@@ -223,7 +223,7 @@ def validate(
     params: build parameters (`BuildParams`; the anatomy variant), default the default build.
     load_n: the compressive load (N) of the sweeps; the neutral pose takes `NEUTRAL_LOAD_N`.
     """
-    from wrist_env.build.pipeline import BuildParams
+    from wrist_env.builder.pipeline import BuildParams
     from wrist_env.participants.registry import load_model
     from wrist_env.solver import simulate as sim
     from wrist_env.solver.outputs import cardan_deg

@@ -9,7 +9,7 @@ import pytest
 import trimesh
 from scipy.spatial.transform import Rotation
 
-from wrist_env.build.pipeline import BuildParams
+from wrist_env.builder.pipeline import BuildParams
 from wrist_env.errors import MeshError, ParticipantError, TrialError
 from wrist_env.participants import builtin, registry
 from wrist_env.participants import folder as folder_module

@@ -25,7 +25,7 @@ from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 
 from wrist_env import design
-from wrist_env.build.contact_law import fit_contact_law
+from wrist_env.builder.contact_law import fit_contact_law
 from wrist_env.design import LIGAMENT_NAMES
 from wrist_env.model import BONES, PAIRS
 from wrist_env.participants.builtin import truth

@@ -102,7 +102,7 @@ def annotations_figure(out: Path | None = None) -> Path:
     """The template with its cartilage coverage and ligament attachment sites, for review."""
     from wrist_env.anatomy.annotations import ARTICULATIONS, template_annotations
     from wrist_env.anatomy.template import load_template
-    from wrist_env.build.pipeline import BuildParams
+    from wrist_env.builder.pipeline import BuildParams
 
     anatomy = BuildParams().anatomy  # the default build's template: swept fossae, distal row
     bones = load_template(*anatomy).bones

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from wrist_env.anatomy.template import BoneSurface, load_template
-from wrist_env.build.warp import Warp
+from wrist_env.builder.warp import Warp
 from wrist_env.design import Design
 from wrist_env.errors import ParticipantError
 
@@ -88,7 +88,7 @@ def source(name: str, fossa_sweep_deg: tuple | None = None):
     `folder.write_participant_folder` writes it as a folder that loads back; its radius keeps the open
     shaft beside the closed articular solid, and its ulna is open (see `folder`).
     """
-    from wrist_env.build.pipeline import BuildParams
+    from wrist_env.builder.pipeline import BuildParams
     from wrist_env.participants.folder import ParticipantSource
 
     sweep = BuildParams().fossa_sweep_deg if fossa_sweep_deg is None else fossa_sweep_deg

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from wrist_env.build.cartilage import closed_face_mask
+from wrist_env.builder.cartilage import closed_face_mask
 from wrist_env.errors import MeshError, ParticipantError
 from wrist_env.model import BONES
 from wrist_env.trial import ROLES, Trial, mirror_trial, read_trial_csv, write_trial_csv

@@ -12,7 +12,7 @@ import warnings
 from pathlib import Path
 
 from wrist_env.anatomy.template import BoneSurface, carry_parts, load_template
-from wrist_env.build.pipeline import BuildParams, build_model, source_hash
+from wrist_env.builder.pipeline import BuildParams, build_model, source_hash
 from wrist_env.errors import BuildError, ParticipantError, StoreError
 from wrist_env.model import BONES, Model
 from wrist_env.participants import builtin

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from wrist_env.build.contact_law import (
+from wrist_env.builder.contact_law import (
     ContactLawFit,
     TrilinearLaw,
     fit_contact_law,

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from wrist_env.build.fibres import Membrane, build_bundle, build_membrane, fibre_endpoints, pair_fibres
+from wrist_env.builder.fibres import Membrane, build_bundle, build_membrane, fibre_endpoints, pair_fibres
 from wrist_env.errors import InputError
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from wrist_env.build.cartilage import (
+from wrist_env.builder.cartilage import (
     build_cartilage,
     cartilage_layer,
     closed_faces,

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 import trimesh
 
-from wrist_env.build.morph import morph, transfer_mask, transfer_points
-from wrist_env.build.warp import Warp, random_warp
+from wrist_env.builder.morph import morph, transfer_mask, transfer_points
+from wrist_env.builder.warp import Warp, random_warp
 from wrist_env.errors import InputError, MeshError
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from wrist_env.build.warp import Warp, apply_to_mesh, random_warp
+from wrist_env.builder.warp import Warp, apply_to_mesh, random_warp
 from wrist_env.errors import InputError, MeshError
 
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from wrist_env.anatomy.annotations import read_annotation_data
-from wrist_env.build.sdf import DistanceGrid, trilinear
+from wrist_env.builder.sdf import DistanceGrid, trilinear
 from wrist_env.design import ALL_LIGAMENTS
 from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model
 
@@ -117,7 +117,7 @@ def test_tracked_centroid_is_the_principal_bones_and_parts_recover_it(built, nam
 def test_implausible_joint_spaces_stop_the_build():
     """Each articulation outside its plausible range (or with none measured) is named with its value and
     range; the built-in participants' 1.5–2.5 mm pass, and the scapholunate may be a dissociated 6 mm."""
-    from wrist_env.build.pipeline import _check_joint_spaces
+    from wrist_env.builder.pipeline import _check_joint_spaces
     from wrist_env.errors import BuildError
 
     normal = dict(zip(PAIRS, (1.83, 1.71, 1.72, 2.31, 1.55)))

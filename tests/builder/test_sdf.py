@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from wrist_env.build.sdf import signed_distance_grid, trilinear
+from wrist_env.builder.sdf import signed_distance_grid, trilinear
 
 
 def test_sphere_grid_matches_the_closed_form_distance():

@@ -19,7 +19,7 @@ from scipy.spatial import cKDTree
 
 from wrist_env.anatomy.annotations import template_annotations
 from wrist_env.anatomy.template import load_template
-from wrist_env.build import cartilage, contact_law, fibres, mass, morph, sdf
+from wrist_env.builder import cartilage, contact_law, fibres, mass, morph, sdf
 from wrist_env.design import ALL_LIGAMENTS, LIGAMENT_NAMES, LIGAMENTS, RSC_INDEX
 from wrist_env.errors import BuildError
 from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model, offsets
