@@ -75,43 +75,8 @@ def test_seeded_log_is_identical_on_local_worker_processes(reference, tmp_path):
     assert summary.done and read_runs(tmp_path).equals(reference[1])
 
 
-def test_killed_study_resumes_with_no_run_lost_or_repeated(reference, tmp_path):
-    cmd = [
-        sys.executable,
-        "-m",
-        "wrist_env.cli",
-        "montecarlo",
-        "P1",
-        "--n",
-        "40",
-        "--seed",
-        "3",
-        "--batch",
-        "2",
-        "--out",
-        str(tmp_path),
-        "--no-progress",
-    ]
-    proc = subprocess.Popen(cmd, env=dict(os.environ), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    runs = tmp_path / "runs"
-    deadline = time.monotonic() + 120
-    try:
-        while time.monotonic() < deadline and proc.poll() is None:
-            if runs.is_dir() and len(list(runs.glob("*.parquet"))) >= 3:
-                break
-            time.sleep(0.01)
-        assert proc.poll() is None, f"the study ended before the kill: {proc.stderr.read().decode()[-2000:]}"
-        os.kill(proc.pid, signal.SIGKILL)
-    finally:
-        proc.wait(timeout=30)
-    partial = read_runs(tmp_path)
-    assert partial is not None and 0 < partial.num_rows < reference[1].num_rows
-    summary = run_study(CONFIG, tmp_path, batch=5)
-    assert summary.done and summary.simulated == reference[1].num_rows - partial.num_rows
-    assert read_runs(tmp_path).equals(reference[1])
-
-
 def _start_cli_study(out, batch=2, workers=0):
+    """`wrist-bench montecarlo` on P1 (CONFIG's study) as a subprocess."""
     cmd = [
         sys.executable,
         "-m",
@@ -140,6 +105,20 @@ def _wait_for_parts(proc, out, n: int, seconds: float = 120) -> None:
             return
         time.sleep(0.01)
     assert proc.poll() is None, f"the study ended too soon: {proc.stderr.read().decode()[-2000:]}"
+
+
+def test_killed_study_resumes_with_no_run_lost_or_repeated(reference, tmp_path):
+    proc = _start_cli_study(tmp_path)
+    try:
+        _wait_for_parts(proc, tmp_path, 3)
+        os.kill(proc.pid, signal.SIGKILL)
+    finally:
+        proc.wait(timeout=30)
+    partial = read_runs(tmp_path)
+    assert partial is not None and 0 < partial.num_rows < reference[1].num_rows
+    summary = run_study(CONFIG, tmp_path, batch=5)
+    assert summary.done and summary.simulated == reference[1].num_rows - partial.num_rows
+    assert read_runs(tmp_path).equals(reference[1])
 
 
 def test_a_second_run_on_the_same_folder_is_refused_while_one_runs(reference, tmp_path):
