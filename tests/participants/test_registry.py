@@ -69,3 +69,18 @@ def test_a_right_wrist_declared_left_is_refused_by_the_build(tmp_path):
         r"check `side` in participant.toml",
     ):
         registry.load_model("U2", BuildParams(distal_row=False), cache=False)  # 5 bones to morph, not 9
+
+
+def test_a_folder_is_read_once_when_registered(tmp_path, monkeypatch):
+    from wrist_env.participants import folder as folder_module
+
+    path = warped_template_folder(tmp_path / "u2", name="U2")
+    calls = []
+    original = folder_module.load_participant_folder
+    monkeypatch.setattr(folder_module, "load_participant_folder", lambda p: calls.append(p) or original(p))
+    registry.add_folder(path)
+    bones = registry.bones("U2")
+    trials = registry.trials("U2")
+    assert set(bones) >= {"radius", "scaphoid", "capitate"} and list(trials) == ["unresisted"]
+    assert registry.trial("U2", "calibrate").name == "unresisted"
+    assert len(calls) == 1

@@ -275,7 +275,9 @@ def _seat_samples(points, normals, sample_offsets, grids):
     return points, worst
 
 
-def build_model(name: str, bones: dict, params: BuildParams | None = None, *, workers: int | None = None) -> Model:
+def build_model(
+    name: str, bones: dict, params: BuildParams | None = None, *, workers: int | None = None, digest: str | None = None
+) -> Model:
     """Build the participant model from its bones (name -> BoneSurface, RCS mm, neutral pose).
 
     workers: processes for the morphs (default: the machine's cores, at most 2).
@@ -358,7 +360,7 @@ def build_model(name: str, bones: dict, params: BuildParams | None = None, *, wo
     }
     return Model(
         name=name,
-        source_hash=source_hash(name, bones, params),
+        source_hash=digest or source_hash(name, bones, params),
         vertices=np.vstack([bones[b].vertices for b in BONES]),
         vertex_offsets=offsets([len(bones[b].vertices) for b in BONES]),
         faces=np.vstack([bones[b].faces for b in BONES]).astype(np.int64),

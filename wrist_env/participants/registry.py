@@ -18,6 +18,7 @@ from wrist_env.model import BONES, Model
 from wrist_env.participants import builtin
 
 _FOLDERS: dict[str, Path] = {}
+_SOURCES: dict = {}  # name -> the ParticipantSource read once by add_folder
 
 
 def cache_dir() -> Path:
@@ -49,7 +50,9 @@ def folder(name: str) -> Path:
 
 
 def add_folder(folder) -> str:
-    """Validate a participant folder and make it known by its name; returns the name."""
+    """Validate a participant folder and make it known by its name; returns the name.
+
+    The folder is read and checked once, here: edit its files, then add it again."""
     from wrist_env.participants.folder import load_participant_folder
 
     source = load_participant_folder(folder)
@@ -58,6 +61,7 @@ def add_folder(folder) -> str:
             f"{Path(folder) / 'participant.toml'}: name {source.name!r} is taken by a built-in participant"
         )
     _FOLDERS[source.name] = Path(folder)
+    _SOURCES[source.name] = source
     return source.name
 
 
@@ -68,9 +72,9 @@ def bones(name: str, params: BuildParams | None = None) -> dict:
     if name in builtin.BUILTIN:
         return builtin.bones(name, *params.anatomy)
     require(name)
-    from wrist_env.participants.folder import load_participant_folder, solid_mask
+    from wrist_env.participants.folder import solid_mask
 
-    source = load_participant_folder(_FOLDERS[name])
+    source = _SOURCES[name]
     principal = {b: BoneSurface(b, v, f, solid_mask(v, f)) for b, (v, f) in source.bones.items()}
     return carry_parts(principal, load_template()) if params.distal_row else principal
 
@@ -80,9 +84,7 @@ def trials(name: str) -> dict:
     if name in builtin.BUILTIN:
         return builtin.trials(name)
     require(name)
-    from wrist_env.participants.folder import load_participant_folder
-
-    return load_participant_folder(_FOLDERS[name]).trials
+    return _SOURCES[name].trials
 
 
 def trial(name: str, role: str):
@@ -113,7 +115,7 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
         except StoreError as e:
             warnings.warn(f"rebuilding a damaged cached model: {e}", stacklevel=2)
     try:
-        model = build_model(name, b, params)
+        model = build_model(name, b, params, digest=digest)
     except BuildError as e:
         if name in _FOLDERS:  # name the folder's file
             raise BuildError(f"{_FOLDERS[name] / 'participant.toml'}: {e}") from e
