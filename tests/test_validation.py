@@ -9,6 +9,8 @@ import pytest
 from wrist_env import design, validation
 from wrist_env.cli import main
 
+pytestmark = pytest.mark.slow  # builds models or runs simulations/studies (minutes)
+
 CHECK_IDS = (
     "scaphoid_slope",
     "lunate_slope",

@@ -21,6 +21,8 @@ from wrist_env.bench.log import KEY_FIELDS
 from wrist_env.cli import main
 from wrist_env.errors import StoreError
 
+pytestmark = pytest.mark.slow  # builds models or runs simulations/studies (minutes)
+
 REPO = Path(wrist_env.__file__).resolve().parent.parent
 TINY = ["random", "lhs"] if "lhs" in optimizers.available() else ["random"]
 LEADERBOARD_FILES = (

@@ -8,6 +8,8 @@ from wrist_env.builder.sdf import DistanceGrid, trilinear
 from wrist_env.design import ALL_LIGAMENTS
 from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model
 
+pytestmark = pytest.mark.slow  # builds models or runs simulations/studies (minutes)
+
 PARTICIPANTS = ("P1", "P2", "P3")
 
 

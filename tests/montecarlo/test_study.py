@@ -17,6 +17,8 @@ from wrist_env.montecarlo import StudyConfig, StudyError, read_runs, run_study
 from wrist_env.montecarlo.sampler import FRAME_COLUMNS, SCHEMA, TEAR_COLUMNS
 from wrist_env.runs import StoreBusyError
 
+pytestmark = pytest.mark.slow  # builds models or runs simulations/studies (minutes)
+
 CONFIG = StudyConfig(("P1",), n=40, seed=3)
 
 

@@ -15,6 +15,8 @@ from wrist_env.participants import registry
 from wrist_env.participants.folder import ParticipantSource, write_participant_folder
 from wrist_env.trial import Trial
 
+pytestmark = pytest.mark.slow  # builds models or runs simulations/studies (minutes)
+
 
 def warped_template_folder(path, name="U1", seed=7):
     """A folder made from the template under a warp, with closed forearm bones as a CT

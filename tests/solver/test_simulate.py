@@ -10,6 +10,8 @@ from wrist_env.participants.builtin import truth
 from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.simulate import experimental, idealized, simulate, simulate_batch
 
+pytestmark = pytest.mark.slow  # builds models or runs simulations/studies (minutes)
+
 SCAPHOID, LUNATE, CAPITATE = (BONES.index(b) for b in ("scaphoid", "lunate", "capitate"))
 
 
