@@ -1,0 +1,62 @@
+"""What an environment step costs beyond the simulation it wraps (issue 12/13: at most 5 %).
+
+The kernel is replaced by a copy of a stored run's outputs, so what is timed is the Python around
+it: the action's checks, the design, the kernel arrays, the cost and the info dict. Prints that
+overhead for `WristEnv.step` and for a bare `simulate` call, in ms, and as a share of one real
+simulation. Run on a quiet machine: `python experiments/bench_env_overhead.py`.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from wrist_env import design
+from wrist_env.envs.wrist import WristEnv
+from wrist_env.solver import kernel
+from wrist_env.solver import simulate as sim
+
+
+def per_call_s(fn, n: int) -> float:
+    start = time.perf_counter()
+    for _ in range(n):
+        fn()
+    return (time.perf_counter() - start) / n
+
+
+def main(participant: str = "P1", n: int = 500) -> None:
+    env = WristEnv(participant, "calibrate")
+    env.reset(seed=0)
+    d = design.population()
+    action = design.to_action(d)
+    task = env.task
+    real = per_call_s(lambda: sim.simulate(task.model, d, task.driver), 10)
+    stored = {}
+    run = kernel.run
+
+    def capture(*args):
+        run(*args)
+        stored["out"] = [np.array(x, copy=True) for x in args[-7:]]
+
+    def replay(*args):
+        for dst, src in zip(args[-7:], stored["out"]):
+            dst[...] = src
+
+    kernel.run = capture
+    env.step(action)
+    kernel.run = replay
+    try:
+        step = per_call_s(lambda: env.step(action), n)
+        bare = per_call_s(lambda: sim.simulate(task.model, d, task.driver), n)
+    finally:
+        kernel.run = run
+    print(f"{participant} calibration trial: one simulation {real * 1e3:.2f} ms")
+    print(f"without the kernel: env.step {step * 1e3:.3f} ms, bare simulate {bare * 1e3:.3f} ms")
+    print(
+        f"env-step overhead over simulate: {(step - bare) * 1e3:.3f} ms = {100 * (step - bare) / real:.1f} % of a simulation"
+    )
+
+
+if __name__ == "__main__":
+    main()
