@@ -1,32 +1,24 @@
 """Nelder–Mead: SciPy's bounded simplex method behind ask/tell, restarted until the budget is spent.
 
-SciPy drives the objective itself (callback style), so control is inverted:
-SciPy runs in a daemon worker thread whose objective hands each point to
-`ask` through a queue and blocks until `tell` sends the value back. Only one
-side runs at a time, so the run is deterministic. When the budget is spent
-(or the optimizer is closed or garbage-collected) the objective raises a
-private exception inside SciPy, which unwinds the worker thread.
+SciPy drives the objective itself (callback style), so control is inverted
+(`optimizers.bridge`): SciPy runs in a daemon worker thread whose objective
+hands each point to `ask` and blocks until `tell` sends the value back. Only
+one side runs at a time, so the run is deterministic. When the budget is
+spent (or the optimizer is closed or garbage-collected) the objective raises
+`bridge.Stop` inside SciPy, which unwinds the worker thread.
 """
 
 from __future__ import annotations
 
-import queue
-import threading
+import functools
 
 import numpy as np
 from scipy.optimize import Bounds
 from scipy.optimize import minimize as scipy_minimize
 
 from optimizers.base import Optimizer
+from optimizers.bridge import Bridge, Stop
 from optimizers.registry import register
-
-
-class _Stop(Exception):
-    """Raised inside SciPy's objective to end the worker thread."""
-
-
-_STOP = object()  # sent on the reply queue instead of a value
-_END = object()  # posted on the request queue when the worker has finished
 
 
 def initial_simplex(x0, lower, upper, scale: float = 0.25) -> np.ndarray:
@@ -43,20 +35,17 @@ def initial_simplex(x0, lower, upper, scale: float = 0.25) -> np.ndarray:
     return sim
 
 
-def _worker(requests, replies, budget, lower, upper, x0, rng, scale, restart, perturb, options):
-    """Run SciPy's Nelder–Mead with restarts until `budget` evaluations, talking through the queues."""
+def _runs(request, budget, lower, upper, x0, rng, scale, restart, perturb, options) -> None:
+    """SciPy's Nelder–Mead with restarts until `budget` evaluations; `request(x)` evaluates one point."""
     evals = 0
     best_x, best_f = None, np.inf
 
     def fun(x):
         nonlocal evals, best_x, best_f
         if evals >= budget:
-            raise _Stop
+            raise Stop("budget spent")
         x = np.array(x, dtype=np.float64)
-        requests.put(x)
-        y = replies.get()
-        if y is _STOP:
-            raise _Stop
+        y = request(x)
         evals += 1
         if y < best_f:
             best_x, best_f = x, y
@@ -64,34 +53,28 @@ def _worker(requests, replies, budget, lower, upper, x0, rng, scale, restart, pe
 
     bounds = Bounds(lower, upper)
     start = x0
-    try:
-        while evals < budget:
-            # inf values (failed evaluations) make SciPy compute inf - inf; np.errstate is
-            # thread-local (unlike warnings.catch_warnings, which must not be used here)
-            with np.errstate(invalid="ignore", over="ignore"):
-                scipy_minimize(
-                    fun,
-                    start,
-                    method="Nelder-Mead",
-                    bounds=bounds,
-                    options={
-                        **options,
-                        "maxfev": budget - evals,
-                        "initial_simplex": initial_simplex(start, lower, upper, scale),
-                    },
-                )
-            if evals >= budget:
-                break
-            # converged before the budget: restart
-            if restart == "best" and best_x is not None:
-                start = np.clip(best_x + rng.normal(0.0, perturb, len(lower)) * (upper - lower), lower, upper)
-            else:
-                start = rng.uniform(lower, upper)
-        requests.put(_END)
-    except _Stop:
-        requests.put(_END)
-    except BaseException as error:  # noqa: BLE001  (handed to the main thread)
-        requests.put(error)
+    while evals < budget:
+        # inf values (failed evaluations) make SciPy compute inf - inf; np.errstate is
+        # thread-local (unlike warnings.catch_warnings, which must not be used here)
+        with np.errstate(invalid="ignore", over="ignore"):
+            scipy_minimize(
+                fun,
+                start,
+                method="Nelder-Mead",
+                bounds=bounds,
+                options={
+                    **options,
+                    "maxfev": budget - evals,
+                    "initial_simplex": initial_simplex(start, lower, upper, scale),
+                },
+            )
+        if evals >= budget:
+            break
+        # converged before the budget: restart
+        if restart == "best" and best_x is not None:
+            start = np.clip(best_x + rng.normal(0.0, perturb, len(lower)) * (upper - lower), lower, upper)
+        else:
+            start = rng.uniform(lower, upper)
 
 
 @register("nelder-mead")
@@ -124,70 +107,45 @@ class NelderMead(Optimizer):
             "fatol": float(options.get("fatol", 1e-4)),
             "adaptive": bool(options.get("adaptive", False)),
         }
-        self._requests: queue.Queue = queue.Queue()
-        self._replies: queue.Queue = queue.Queue()
-        self._thread: threading.Thread | None = None
-        self._finished = False
-
-    def _next(self):
-        item = self._requests.get()
-        if isinstance(item, BaseException):
-            self._finished = True
-            raise RuntimeError(f"{self.name}: SciPy's Nelder-Mead failed") from item
-        return item
+        self._bridge: Bridge | None = None
 
     def _ask(self, n_max: int) -> np.ndarray:
-        if self._finished:
-            raise RuntimeError(f"{self.name}: the optimizer was closed")
-        if self._thread is None:
-            self._thread = threading.Thread(
-                target=_worker,
-                name=f"nelder-mead-{id(self):x}",
-                daemon=True,
-                args=(
-                    self._requests,
-                    self._replies,
-                    self.budget,
-                    self.lower,
-                    self.upper,
-                    self.x0,
-                    self.rng,
-                    float(self.options.get("simplex_scale", 0.25)),
-                    self.restart,
-                    float(self.options.get("perturb", 0.1)),
-                    self._scipy_options,
-                ),
+        if self._bridge is None:
+            run = functools.partial(
+                _runs,
+                budget=self.budget,
+                lower=self.lower,
+                upper=self.upper,
+                x0=self.x0,
+                rng=self.rng,
+                scale=float(self.options.get("simplex_scale", 0.25)),
+                restart=self.restart,
+                perturb=float(self.options.get("perturb", 0.1)),
+                options=self._scipy_options,
             )
-            self._thread.start()
-        x = self._next()
-        if x is _END:  # cannot happen while budget remains; kept as a guard
-            self._finished = True
+            self._bridge = Bridge(run, name=f"nelder-mead-{id(self):x}")
+            self._bridge.start()
+        elif self._bridge.finished:
+            raise RuntimeError(f"{self.name}: the optimizer was closed")
+        kind, x = self._bridge.next()
+        if kind == "done":  # cannot happen while budget remains; kept as a guard
             raise RuntimeError(f"{self.name}: the worker ended with {self.remaining} evaluations left")
         return x[None, :]
 
     def _tell(self, x, y) -> None:
-        self._replies.put(float(y[0]))
+        self._bridge.reply(float(y[0]))
         if self.remaining <= 0:
             self.close()
 
     def close(self) -> None:
         """End the worker thread (done automatically when the budget is spent)."""
-        if self._thread is None or self._finished:
-            return
-        self._finished = True
-        if self._pending:  # a point was asked and not told: the worker waits for its value
-            self._replies.put(_STOP)
-        else:
-            item = self._requests.get()  # the worker's next request, or its end
-            if item is not _END and not isinstance(item, BaseException):
-                self._replies.put(_STOP)
-                self._requests.get()  # _END
-        self._thread.join()
+        if self._bridge is not None:
+            self._bridge.stop()
 
     def __del__(self):
         # the worker holds no reference to self; unblock it so the thread ends
         try:
-            if getattr(self, "_thread", None) is not None and not self._finished and self._thread.is_alive():
-                self._replies.put(_STOP)
+            if getattr(self, "_bridge", None) is not None:
+                self._bridge.abandon()
         except Exception:  # noqa: BLE001  (interpreter shutdown)
             pass

@@ -34,7 +34,7 @@ cube u = (x − lower) / (upper − lower):
    point. Its gradients are forward differences with step `fd_step` (1e-3 box
    widths; backward at the upper bound), and each (value, gradient) it asks
    for is ONE batch of dim + 1 points (dim when the centre was evaluated
-   already). SciPy runs in a worker thread that hands each batch to `ask` and
+   already). SciPy runs in a worker thread (`optimizers.bridge`) that hands each batch to `ask` and
    waits for `tell`; it stops when L-BFGS-B converges or the next batch
    would not fit in the budget, and the thread ends then. Polishing is skipped
    when its share of the budget can't pay for one gradient.
@@ -52,9 +52,8 @@ leaves its worker thread waiting; the thread is a daemon and `close()` ends it.
 
 from __future__ import annotations
 
+import functools
 import math
-import queue
-import threading
 
 import numpy as np
 from scipy.interpolate import RBFInterpolator
@@ -62,11 +61,8 @@ from scipy.optimize import minimize as scipy_minimize
 from scipy.spatial import cKDTree
 
 from optimizers.base import Optimizer
+from optimizers.bridge import Bridge, Stop
 from optimizers.registry import register
-
-
-class _Stop(Exception):
-    """Raised inside the polish thread to end L-BFGS-B (budget spent or close())."""
 
 
 @register("surrogate")
@@ -116,9 +112,7 @@ class Surrogate(Optimizer):
         self._cycle = 0
         self._asked = "init"  # what the pending batch is: "init", "search" or "polish"
         self._polished = self.polish_budget == 0
-        self._worker: threading.Thread | None = None
-        self._to_main: queue.Queue = queue.Queue()
-        self._to_worker: queue.Queue = queue.Queue()
+        self._bridge: Bridge | None = None  # the L-BFGS-B polish in its worker thread
         self._request: np.ndarray | None = None  # the batch (k, dim) the polish waits for
         self.polish_log: list[dict] = []
 
@@ -154,15 +148,14 @@ class Surrogate(Optimizer):
         if self._asked == "search":
             self._adapt(best_before, float(np.min(y)))
         elif self._asked == "polish":
-            self._to_worker.put(np.asarray(y, dtype=np.float64))
+            self._bridge.reply(np.asarray(y, dtype=np.float64))
             self._receive()
 
     def close(self) -> None:
         """End the polish thread if it is waiting (only needed when abandoning a run mid-polish)."""
-        if self._worker is not None and self._worker.is_alive():
-            self._to_worker.put(None)
+        if self._bridge is not None:
             self._request = None
-            self._receive()
+            self._finish(self._bridge.stop())
 
     # surrogate rounds
 
@@ -238,25 +231,29 @@ class Surrogate(Optimizer):
         if not np.isfinite(Y[i]):
             return
         self.polish_log.append({"nfev_start": self.nfev, "fun_start": float(Y[i])})
-        self._worker = threading.Thread(
-            target=self._polish, args=(self._U[i].copy(),), daemon=True, name=f"surrogate-polish-seed{self.seed}"
+        self._bridge = Bridge(
+            functools.partial(self._polish, self._U[i].copy()), name=f"surrogate-polish-seed{self.seed}"
         )
-        self._worker.start()
+        self._bridge.start()
         self._receive()
 
     def _receive(self) -> None:
         """Wait for the polish thread's next message: a batch to evaluate, or its end."""
-        kind, payload = self._to_main.get()
+        try:
+            kind, payload = self._bridge.next()
+        except RuntimeError as error:
+            self._bridge = None
+            raise RuntimeError(f"{self.name}: the L-BFGS-B polish failed") from error.__cause__
         if kind == "request":
             self._request = payload
             return
-        self._worker.join()
-        self._worker = None
-        if kind == "error":
-            raise RuntimeError(f"{self.name}: the L-BFGS-B polish failed") from payload
-        self.polish_log[-1].update(nfev_end=self.nfev, fun_end=float(np.min(self._Y)), message=payload)
+        self._finish(payload)
 
-    def _polish(self, u0: np.ndarray) -> None:
+    def _finish(self, message) -> None:
+        self._bridge = None
+        self.polish_log[-1].update(nfev_end=self.nfev, fun_end=float(np.min(self._Y)), message=message)
+
+    def _polish(self, u0: np.ndarray, request) -> str:
         # runs in the worker thread; the main thread waits in _receive meanwhile, so reading
         # self.remaining and self._cache here is safe
         d, h = self.dim, self.fd_step
@@ -269,11 +266,8 @@ class Surrogate(Optimizer):
             if f0 is None:
                 points = np.vstack([u, points])
             if len(points) > self.remaining:
-                raise _Stop("budget spent")
-            self._to_main.put(("request", points))
-            values = self._to_worker.get()
-            if values is None:
-                raise _Stop("closed")
+                raise Stop("budget spent")
+            values = request(points)
             if f0 is None:
                 f0, values = values[0], values[1:]
             if not np.isfinite(f0):
@@ -281,22 +275,15 @@ class Surrogate(Optimizer):
             g = np.where(np.isfinite(values), (values - f0) / steps, 0.0)
             return float(f0), g
 
-        try:
-            res = scipy_minimize(
-                value_and_gradient,
-                u0,
-                jac=True,
-                method="L-BFGS-B",
-                bounds=[(0.0, 1.0)] * d,
-                options={"maxiter": 10**6, "maxfun": 10**6},
-            )
-            message = f"L-BFGS-B: {res.message}"
-        except _Stop as stop:
-            message = str(stop)
-        except BaseException as exc:  # handed to the main thread
-            self._to_main.put(("error", exc))
-            return
-        self._to_main.put(("done", message))
+        res = scipy_minimize(
+            value_and_gradient,
+            u0,
+            jac=True,
+            method="L-BFGS-B",
+            bounds=[(0.0, 1.0)] * d,
+            options={"maxiter": 10**6, "maxfun": 10**6},
+        )  # a Stop ("budget spent", "closed") ends the run with its message (the bridge's result)
+        return f"L-BFGS-B: {res.message}"
 
     # helpers
 

@@ -154,13 +154,13 @@ def test_nelder_mead_restart_options(restart):
     opt = optimizers.make("nelder-mead", dim=3, budget=500, seed=2, restart=restart)
     result = optimizers.minimize(opt, sphere)
     assert result.nfev == 500 and result.fun < 1e-8
-    assert not opt._thread.is_alive()
+    assert not opt._bridge.thread.is_alive()
 
 
 def test_nelder_mead_thread_ends_when_abandoned_or_closed():
     opt = optimizers.make("nelder-mead", dim=3, budget=100, seed=0)
     opt.tell(opt.ask(), [1.0])
-    thread = opt._thread
+    thread = opt._bridge.thread
     opt.close()
     assert not thread.is_alive()
     with pytest.raises(RuntimeError):
@@ -168,7 +168,7 @@ def test_nelder_mead_thread_ends_when_abandoned_or_closed():
 
     opt = optimizers.make("nelder-mead", dim=3, budget=100, seed=0)
     opt.ask()
-    thread = opt._thread
+    thread = opt._bridge.thread
     del opt  # mid-evaluation: __del__ unblocks the worker
     thread.join(timeout=5)
     assert not thread.is_alive()

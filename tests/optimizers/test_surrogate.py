@@ -117,7 +117,7 @@ def test_close_mid_polish():
         opt.tell(x, quadratic(x))
     opt.ask()  # a gradient batch the thread now waits for
     opt.close()
-    assert opt._worker is None and opt.polish_log[0]["message"] == "closed"
+    assert opt._bridge is None and opt.polish_log[0]["message"] == "closed"
 
 
 def test_rejects_bad_options():
