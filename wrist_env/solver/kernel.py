@@ -280,6 +280,23 @@ def _kinetic(R, v, w, nv, bod, st):
     return ke
 
 
+SETTLE, MOVE = -2, -1
+"""The stages before frame 0: settle with the capitate at its static pose, then move it to the first pose."""
+
+
+@njit(cache=True, error_model="numpy")
+def _stage(f, R0, x0, frame_R, frame_x, frame_load, st):
+    """Capitate targets of stage f (`SETTLE`, `MOVE` or a frame): start and end rotation, centre (mm)
+    and load (N), ramp steps, most hold steps."""
+    if f == SETTLE:
+        return R0, x0, frame_load[0], R0, x0, frame_load[0], 0, st.settle_steps
+    if f == MOVE:
+        return R0, x0, frame_load[0], frame_R[0], frame_x[0], frame_load[0], st.move_steps, st.max_hold_steps
+    a = max(f - 1, 0)
+    ramp = st.ramp_steps if f > 0 else 0
+    return frame_R[a], frame_x[a], frame_load[a], frame_R[f], frame_x[f], frame_load[f], ramp, st.max_hold_steps
+
+
 @njit(cache=True, error_model="numpy")
 def run(
     bod,
@@ -343,17 +360,8 @@ def run(
     fire = np.array([st.fire_alpha0, 0.0])
     capR = np.eye(3)
     taken = 0
-    for f in range(-2, n_frames):
-        if f == -2:  # settle with the capitate at its static pose
-            Ra, xa, Rb, xb, ramp, most = R0, x0, R0, x0, 0, st.settle_steps
-            la = lb = frame_load[0]
-        elif f == -1:  # move the capitate to the first pose
-            Ra, xa, Rb, xb, ramp, most = R0, x0, frame_R[0], frame_x[0], st.move_steps, st.max_hold_steps
-            la = lb = frame_load[0]
-        else:
-            Ra, xa, la = frame_R[max(f - 1, 0)], frame_x[max(f - 1, 0)], frame_load[max(f - 1, 0)]
-            Rb, xb, lb = frame_R[f], frame_x[f], frame_load[f]
-            ramp, most = (st.ramp_steps if f > 0 else 0), st.max_hold_steps
+    for f in range(SETTLE, n_frames):
+        Ra, xa, la, Rb, xb, lb, ramp, most = _stage(f, R0, x0, frame_R, frame_x, frame_load, st)
         axis = matrix_to_rotvec(Rb @ Ra.T)
         shift = xb - xa
         k = 0
@@ -412,7 +420,7 @@ def run(
                     status[0] = FAILED_DIVERGED
         if status[0] != OK:
             return
-        if f < 0:
+        if f < 0:  # SETTLE and MOVE have no output frame
             continue
         # outputs at the state reached (the last step's forces were those before it)
         energy = _forces(
