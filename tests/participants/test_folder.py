@@ -155,65 +155,56 @@ def test_missing_folder(tmp_path):
         load_participant_folder(tmp_path / "nowhere")
 
 
-def test_missing_toml(folder):
-    (folder / "participant.toml").unlink()
-    with raises(ParticipantError, folder / "participant.toml", "does not exist"):
+TOML = "participant.toml"
+BAD_TOML = [
+    # (id, text replaced in participant.toml, replacement, error, file named, message)
+    ("syntax", 'name = "P7"', 'name = "P7', ParticipantError, TOML, r"TOML syntax error: .*line 1"),
+    ("required key", 'units = "mm"\n', "", ParticipantError, TOML, r"required keys \['units'\] are missing"),
+    ("unknown key", "frames = 15", "frame = 15", ParticipantError, TOML, r"but got \['frame'\]"),
+    ("units", 'units = "mm"', 'units = "m"', ParticipantError, TOML, "units must be \"mm\", but got 'm'"),
+    ("side", 'side = "right"', 'side = "R"', ParticipantError, TOML, "side must be one of.*got 'R'"),
+    ("name", 'name = "P7"', 'name = "P-7"', ParticipantError, TOML, "name must match.*got 'P-7'"),
+    ("age", "age = 41", 'age = "41"', ParticipantError, TOML, "age must be a number.*got '41'"),
+    ("bone entry", 'lunate = "bones/lunate.stl"\n', "", ParticipantError, TOML, r"absent=\['lunate'\]"),
+    (
+        "no calibrate trial",
+        'role = "calibrate"',
+        'role = "other"',
+        ParticipantError,
+        TOML,
+        "role \"calibrate\", but got .*'unresisted': 'other'",
+    ),
+    (
+        "trial role",
+        'role = "calibrate"',
+        'role = "train"',
+        ParticipantError,
+        TOML,
+        r"\[trials.unresisted\] role must be one of.*'train'",
+    ),
+    ("frames", "frames = 15", "frames = 12", TrialError, "trials/unresisted.csv", "n_frames=12 frames, but has 15"),
+]
+MISSING_FILES = [
+    # (file removed, error, file named, message)
+    (TOML, ParticipantError, TOML, "does not exist"),
+    ("bones/lunate.stl", ParticipantError, TOML, "bones.lunate = 'bones/lunate.stl', but .*does not exist"),
+    ("trials/resisted.csv", ParticipantError, TOML, "trials/resisted.csv', but .*does not exist"),
+]
+
+
+@pytest.mark.parametrize("case", BAD_TOML, ids=[c[0] for c in BAD_TOML])
+def test_a_bad_participant_toml_names_the_file_and_the_value(folder, case):
+    _, old, new, error, named, message = case
+    edit_toml(folder, old, new)
+    with raises(error, folder / named, message):
         load_participant_folder(folder)
 
 
-def test_toml_syntax_error(folder):
-    edit_toml(folder, 'name = "P7"', 'name = "P7')
-    with raises(ParticipantError, folder / "participant.toml", r"TOML syntax error: .*line 1"):
-        load_participant_folder(folder)
-
-
-def test_missing_required_key(folder):
-    edit_toml(folder, 'units = "mm"\n', "")
-    with raises(ParticipantError, folder / "participant.toml", r"required keys \['units'\] are missing"):
-        load_participant_folder(folder)
-
-
-def test_unknown_key(folder):
-    edit_toml(folder, "frames = 15", "frame = 15")
-    with raises(ParticipantError, folder / "participant.toml", r"but got \['frame'\]"):
-        load_participant_folder(folder)
-
-
-def test_bad_units(folder):
-    edit_toml(folder, 'units = "mm"', 'units = "m"')
-    with raises(ParticipantError, folder / "participant.toml", "units must be \"mm\", but got 'm'"):
-        load_participant_folder(folder)
-
-
-def test_bad_side(folder):
-    edit_toml(folder, 'side = "right"', 'side = "R"')
-    with raises(ParticipantError, folder / "participant.toml", "side must be one of.*got 'R'"):
-        load_participant_folder(folder)
-
-
-def test_bad_name(folder):
-    edit_toml(folder, 'name = "P7"', 'name = "P-7"')
-    with raises(ParticipantError, folder / "participant.toml", "name must match.*got 'P-7'"):
-        load_participant_folder(folder)
-
-
-def test_bad_age(folder):
-    edit_toml(folder, "age = 41", 'age = "41"')
-    with raises(ParticipantError, folder / "participant.toml", "age must be a number.*got '41'"):
-        load_participant_folder(folder)
-
-
-def test_missing_bone_entry(folder):
-    edit_toml(folder, 'lunate = "bones/lunate.stl"\n', "")
-    with raises(ParticipantError, folder / "participant.toml", r"absent=\['lunate'\]"):
-        load_participant_folder(folder)
-
-
-def test_missing_bone_file(folder):
-    (folder / "bones" / "lunate.stl").unlink()
-    with raises(
-        ParticipantError, folder / "participant.toml", "bones.lunate = 'bones/lunate.stl', but .*does not exist"
-    ):
+@pytest.mark.parametrize("case", MISSING_FILES, ids=[c[0] for c in MISSING_FILES])
+def test_a_missing_file_is_named(folder, case):
+    removed, error, named, message = case
+    (folder / removed).unlink()
+    with raises(error, folder / named, message):
         load_participant_folder(folder)
 
 
@@ -359,30 +350,6 @@ def test_too_few_faces(folder):
     mesh.apply_scale(10.0)
     replace_mesh(folder, "lunate", mesh.vertices, mesh.faces)
     with raises(MeshError, folder / "bones" / "lunate.stl", "at least 100 faces, but has 80"):
-        load_participant_folder(folder)
-
-
-def test_no_calibrate_trial(folder):
-    edit_toml(folder, 'role = "calibrate"', 'role = "other"')
-    with raises(ParticipantError, folder / "participant.toml", "role \"calibrate\", but got .*'unresisted': 'other'"):
-        load_participant_folder(folder)
-
-
-def test_bad_trial_role(folder):
-    edit_toml(folder, 'role = "calibrate"', 'role = "train"')
-    with raises(ParticipantError, folder / "participant.toml", r"\[trials.unresisted\] role must be one of.*'train'"):
-        load_participant_folder(folder)
-
-
-def test_missing_trial_file(folder):
-    (folder / "trials" / "resisted.csv").unlink()
-    with raises(ParticipantError, folder / "participant.toml", "trials/resisted.csv', but .*does not exist"):
-        load_participant_folder(folder)
-
-
-def test_trial_frames_differ_from_toml(folder):
-    edit_toml(folder, "frames = 15", "frames = 12")
-    with raises(TrialError, folder / "trials" / "unresisted.csv", "n_frames=12 frames, but has 15"):
         load_participant_folder(folder)
 
 
