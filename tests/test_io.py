@@ -93,7 +93,7 @@ def test_the_registry_rebuilds_a_damaged_cached_model_and_says_which(built, mode
     entry = tmp_path / f"P1-{model.source_hash}"
     rebuilt = []
 
-    def fake_build(name, bones, params):
+    def fake_build(name, bones, params, **_):
         rebuilt.append(name)
         return model
 
