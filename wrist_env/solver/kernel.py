@@ -9,11 +9,14 @@ compressive load), the RSC membrane's interior nodes free point masses.
 
 from __future__ import annotations
 
+from collections import namedtuple
+
 import numpy as np
 from numba import njit, prange
 
 from wrist_env.design import ALL_LIGAMENT_NAMES, RSC_INDEX
 from wrist_env.model import BONES, CAPITATE, LUNATE, PAIRS, SCAPHOID
+from wrist_env.solver.arrays import EXPERIMENTAL, LOADED
 from wrist_env.solver.forces import (
     C_AREA,
     C_FORCE,
@@ -65,7 +68,7 @@ def _fire(v, w, nv, F, T, node_force, mem, st, fire):
     for k in range(3):
         for b in (SCAPHOID, LUNATE):
             power += F[b, k] * v[b, k] + T[b, k] * w[b, k]
-        if st.driver == 1:
+        if st.driver == LOADED:
             power += F[CAPITATE, k] * v[CAPITATE, k]
         for i in range(nv.shape[0]):
             power += node_force[i, k] * nv[i, k]
@@ -74,7 +77,7 @@ def _fire(v, w, nv, F, T, node_force, mem, st, fire):
         for b in (SCAPHOID, LUNATE):
             _mix(v[b : b + 1], F[b : b + 1], a)
             _mix(w[b : b + 1], T[b : b + 1], a)
-        if st.driver == 1:
+        if st.driver == LOADED:
             _mix(v[CAPITATE : CAPITATE + 1], F[CAPITATE : CAPITATE + 1], a)
         _mix(nv, node_force, a)
         fire[1] += 1.0
@@ -89,34 +92,12 @@ def _fire(v, w, nv, F, T, node_force, mem, st, fire):
 
 
 @njit(cache=True, error_model="numpy")
-def _forces(
-    R,
-    x,
-    v,
-    w,
-    nodes,
-    bod,
-    grids,
-    law,
-    fib,
-    f_l0,
-    f_K,
-    mem,
-    m_l0,
-    m_K,
-    st,
-    active,
-    n_active,
-    F,
-    T,
-    node_force,
-    stats,
-    bundle,
-    load,
-    rebuild,
-):
+def _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, rebuild):
     """Forces F (N), torques T (N·mm), contact stats and bundle forces at the current
     state; rebuilds the active contact set first if `rebuild`; returns internal energy (N·mm)."""
+    R, x, v, w, nodes, _ = state
+    active, n_active, F, T, node_force, stats, bundle = work
+    f_l0, f_K, m_l0, m_K = stiffness
     com0 = bod.com0
     if rebuild:
         rebuild_active(R, x, com0, grids, st.active_band_mm, active, n_active)
@@ -129,76 +110,24 @@ def _forces(
     e_mem, rsc = membrane_forces(R, x, com0, mem, nodes, m_l0, m_K, st.membrane_contact_stiffness, F, T, node_force)
     energy += e_mem
     bundle[RSC] += rsc
-    if st.driver == 1:
+    if st.driver == LOADED:
         F[CAPITATE, 1] += load
     return energy
 
 
 @njit(cache=True, error_model="numpy")
-def _step(
-    R,
-    x,
-    v,
-    w,
-    nodes,
-    nv,
-    bod,
-    grids,
-    law,
-    fib,
-    f_l0,
-    f_K,
-    mem,
-    m_l0,
-    m_K,
-    st,
-    active,
-    n_active,
-    F,
-    T,
-    node_force,
-    stats,
-    bundle,
-    capR,
-    capx,
-    load,
-    step_index,
-    fire,
-):
+def _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step_index, fire):
     """One explicit step with the capitate at target (capR, capx), or, for the loaded
     driver, at rotation capR under a compressive `load` (N, along +y); returns
     internal energy (N·mm) before the step."""
+    R, x, v, w, nodes, nv = state
+    _, _, F, T, node_force, _, _ = work
     R[CAPITATE] = capR
-    if st.driver == 0:
+    if st.driver == EXPERIMENTAL:
         x[CAPITATE, 0], x[CAPITATE, 1], x[CAPITATE, 2] = capx
         v[CAPITATE] = 0.0
     w[CAPITATE] = 0.0
-    energy = _forces(
-        R,
-        x,
-        v,
-        w,
-        nodes,
-        bod,
-        grids,
-        law,
-        fib,
-        f_l0,
-        f_K,
-        mem,
-        m_l0,
-        m_K,
-        st,
-        active,
-        n_active,
-        F,
-        T,
-        node_force,
-        stats,
-        bundle,
-        load,
-        step_index % st.rebuild_every == 0,
-    )
+    energy = _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, step_index % st.rebuild_every == 0)
     if st.fire_alpha0 > 0.0:
         _fire(v, w, nv, F, T, node_force, mem, st, fire)
     dt = st.dt
@@ -219,7 +148,7 @@ def _step(
         for k in range(3):
             w[b, k] = (w[b, k] + dt * (Rb[k, 0] * a0 + Rb[k, 1] * a1 + Rb[k, 2] * a2)) * rot
         rotate_in_place(Rb, w[b, 0] * dt, w[b, 1] * dt, w[b, 2] * dt)
-    if st.driver == 1:
+    if st.driver == LOADED:
         for k in range(3):
             v[CAPITATE, k] = (v[CAPITATE, k] + dt * bod.inv_mass[CAPITATE] * F[CAPITATE, k]) * lin
             x[CAPITATE, k] += dt * v[CAPITATE, k]
@@ -245,7 +174,7 @@ def _converged(F, T, bundle, st):
         largest = max(largest, bundle[i])
     tol = max(st.force_floor, st.tolerance * largest)
     for b in (SCAPHOID, LUNATE, CAPITATE):
-        if b == CAPITATE and st.driver == 0:
+        if b == CAPITATE and st.driver == EXPERIMENTAL:
             continue
         f2 = F[b, 0] * F[b, 0] + F[b, 1] * F[b, 1] + F[b, 2] * F[b, 2]
         if not f2 <= tol * tol:
@@ -273,12 +202,21 @@ def _kinetic(R, v, w, nv, bod, st):
             + u2 * (I[2, 0] * u0 + I[2, 1] * u1 + I[2, 2] * u2)
         )
         ke += 0.5 * bod.mass[b] * (v[b, 0] ** 2 + v[b, 1] ** 2 + v[b, 2] ** 2) + 0.5 * rot
-    if st.driver == 1:
+    if st.driver == LOADED:
         ke += 0.5 * bod.mass[CAPITATE] * (v[CAPITATE, 0] ** 2 + v[CAPITATE, 1] ** 2 + v[CAPITATE, 2] ** 2)
     for i in range(nv.shape[0]):
         ke += 0.5 * st.node_mass * (nv[i, 0] ** 2 + nv[i, 1] ** 2 + nv[i, 2] ** 2)
     return ke
 
+
+State = namedtuple("State", ["R", "x", "v", "w", "nodes", "nv"])
+"""A run's mutable state: rotations (5, 3, 3), centres of mass (5, 3) mm, velocities (5, 3) mm/s and
+angular velocities (5, 3) rad/s of the bodies; RSC membrane node positions (M, 3) mm and velocities."""
+Work = namedtuple("Work", ["active", "n_active", "F", "T", "node_force", "stats", "bundle"])
+"""A run's scratch: active contact samples and their count per pair, forces (5, 3) N and torques
+(5, 3) N·mm on the bodies, membrane node forces (M, 3) N, per-pair contact stats, bundle forces (N)."""
+Stiffness = namedtuple("Stiffness", ["f_l0", "f_K", "m_l0", "m_K"])
+"""A design's zero-load lengths (mm) and stiffnesses of the fibres and the membrane connectors."""
 
 SETTLE, MOVE = -2, -1
 """The stages before frame 0: settle with the capitate at its static pose, then move it to the first pose."""
@@ -352,6 +290,9 @@ def run(
     T = np.zeros((N_BONES, 3))
     stats = np.zeros((grids.pair_bones.shape[0], 3))
     bundle = np.zeros(N_LIGAMENTS)
+    state = State(R, x, v, w, nodes, nv)
+    work = Work(active, n_active, F, T, node_force, stats, bundle)
+    stiffness = Stiffness(f_l0, f_K, m_l0, m_K)
     status[0] = OK
     step = 0
     R0 = np.eye(3)
@@ -369,36 +310,7 @@ def run(
             s = smoothstep((k + 1) / ramp) if ramp > 0 else 1.0
             capx = interpolate_pose(Ra, xa, axis, capR, shift, s)
             load = la + s * (lb - la)
-            energy = _step(
-                R,
-                x,
-                v,
-                w,
-                nodes,
-                nv,
-                bod,
-                grids,
-                law,
-                fib,
-                f_l0,
-                f_K,
-                mem,
-                m_l0,
-                m_K,
-                st,
-                active,
-                n_active,
-                F,
-                T,
-                node_force,
-                stats,
-                bundle,
-                capR,
-                capx,
-                load,
-                step,
-                fire,
-            )
+            energy = _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step, fire)
             step += 1
             k += 1
             if k >= ramp + st.min_hold_steps and _converged(F, T, bundle, st):
@@ -423,32 +335,7 @@ def run(
         if f < 0:  # SETTLE and MOVE have no output frame
             continue
         # outputs at the state reached (the last step's forces were those before it)
-        energy = _forces(
-            R,
-            x,
-            v,
-            w,
-            nodes,
-            bod,
-            grids,
-            law,
-            fib,
-            f_l0,
-            f_K,
-            mem,
-            m_l0,
-            m_K,
-            st,
-            active,
-            n_active,
-            F,
-            T,
-            node_force,
-            stats,
-            bundle,
-            lb,
-            True,
-        )
+        energy = _forces(state, work, bod, grids, law, fib, stiffness, mem, st, lb, True)
         for b in range(N_BONES):
             poses[f, b, :3, :3] = R[b]
             poses[f, b, :3, 3] = x[b] - R[b] @ com0[b]
