@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from wrist_env.bench.leaderboard.tables import hit
+from wrist_env.bench.leaderboard.tables import hit, runs_of
 
 
 def colors(labels) -> dict:
@@ -38,7 +38,7 @@ def convergence_figure(path, board, colors) -> None:
     for ax, p in zip(axes.flat, participants):
         lows = []
         for label in labels:
-            sub = runs_frame[(runs_frame.participant == p) & (runs_frame.calibrator == label)]
+            sub = runs_of(runs_frame, p, label)
             cs = [
                 curves[(r.participant, r.optimizer, r.seed, r.budget)]
                 for r in sub.itertuples()
@@ -137,7 +137,7 @@ def ecdf_figure(path, board, colors) -> None:
         for label in labels:
             hits, pairs = [], 0
             for p in members:
-                sub = runs_frame[(runs_frame.participant == p) & (runs_frame.calibrator == label)]
+                sub = runs_of(runs_frame, p, label)
                 ts = targets[targets.participant == p]
                 for r in sub.itertuples():
                     curve = curves.get((r.participant, r.optimizer, r.seed, r.budget))

@@ -29,6 +29,11 @@ def quantile(values, q):
     return float(np.quantile(values, q)) if len(values) else np.nan
 
 
+def runs_of(runs_frame: pd.DataFrame, participant: str, calibrator: str) -> pd.DataFrame:
+    """The rows of `runs_frame` (one per run) of one participant and calibrator label."""
+    return runs_frame[(runs_frame.participant == participant) & (runs_frame.calibrator == calibrator)]
+
+
 def calibrator_label(optimizer: str, budget: int, budgets: set) -> str:
     return optimizer if len(budgets) == 1 else f"{optimizer} (budget {budget})"
 
@@ -63,7 +68,7 @@ def best_cost(runs_frame, refs, participants, labels) -> pd.DataFrame:
     rows = []
     for p in participants:
         for label in labels:
-            sub = runs_frame[(runs_frame.participant == p) & (runs_frame.calibrator == label)]
+            sub = runs_of(runs_frame, p, label)
             if sub.empty:
                 continue
             v = sub.best_cost.to_numpy()
@@ -90,7 +95,7 @@ def evals_to_target(runs_frame, targets, participants, labels, curves) -> pd.Dat
     rows = []
     for t in targets.itertuples():
         for label in labels:
-            sub = runs_frame[(runs_frame.participant == t.participant) & (runs_frame.calibrator == label)]
+            sub = runs_of(runs_frame, t.participant, label)
             if sub.empty:
                 continue
             hits = [
@@ -119,7 +124,7 @@ def recovery(runs_frame, summaries, participants, labels) -> pd.DataFrame:
     rows = []
     for p in participants:
         for label in labels:
-            sub = runs_frame[(runs_frame.participant == p) & (runs_frame.calibrator == label)]
+            sub = runs_of(runs_frame, p, label)
             v = [x for x in sub.recovery_z if x is not None and np.isfinite(x)]
             if sub.empty or not v:
                 continue
@@ -159,7 +164,7 @@ def heldout(runs_frame, refs, participants, labels) -> pd.DataFrame:
                 }
             )
         for label in labels:
-            sub = runs_frame[(runs_frame.participant == p) & (runs_frame.calibrator == label)]
+            sub = runs_of(runs_frame, p, label)
             if sub.empty:
                 continue
             v = sub.validate_cost.to_numpy()
