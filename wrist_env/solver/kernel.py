@@ -217,6 +217,13 @@ Work = namedtuple("Work", ["active", "n_active", "F", "T", "node_force", "stats"
 (5, 3) N·mm on the bodies, membrane node forces (M, 3) N, per-pair contact stats, bundle forces (N)."""
 Stiffness = namedtuple("Stiffness", ["f_l0", "f_K", "m_l0", "m_K"])
 """A design's zero-load lengths (mm) and stiffnesses of the fibres and the membrane connectors."""
+Frames = namedtuple("Frames", ["rotation", "com", "load"])
+"""The capitate's targets per frame: rotation (n_frames, 3, 3), centre of mass (n_frames, 3) mm (for the
+loaded driver only the start: the centre is free), compressive load (n_frames,) N along +y."""
+Outputs = namedtuple("Outputs", ["poses", "contact", "bundle", "energy", "residual", "steps", "status"])
+"""What a run fills: poses (n_frames, 5, 4, 4); contact (n_frames, n_pairs, 4) (`forces.CONTACT_FIELDS`);
+bundle forces (n_frames, n_ligaments) N; kinetic and internal energy (n_frames, 2) N·mm; largest net
+force (N) and moment (N·mm) on the free bones (n_frames, 2); steps per frame (n_frames,); status (1,)."""
 
 SETTLE, MOVE = -2, -1
 """The stages before frame 0: settle with the capitate at its static pose, then move it to the first pose."""
@@ -236,43 +243,16 @@ def _stage(f, R0, x0, frame_R, frame_x, frame_load, st):
 
 
 @njit(cache=True, error_model="numpy")
-def run(
-    bod,
-    grids,
-    law,
-    fib,
-    f_l0,
-    f_K,
-    mem,
-    m_l0,
-    m_K,
-    st,
-    frame_R,
-    frame_x,
-    frame_load,
-    poses,
-    contact,
-    bundle_out,
-    energy_out,
-    residual_out,
-    steps_out,
-    status,
-):
-    """Simulate one design; fills the per-frame outputs and status[0] (0 ok, 1 NaN, 2 diverged).
-
-    frame_R (n_frames, 3, 3), frame_x (n_frames, 3): capitate rotation and
-    centre-of-mass targets per frame (for the loaded driver the centre is
-    free and frame_x is only the start); frame_load (n_frames,) compressive
-    load on the capitate (N, along +y; loaded driver only). Outputs: poses (n_frames, 5, 4, 4);
-    contact (n_frames, 5, 4) mean pressure (MPa), peak pressure (MPa), area
-    (mm²), force (N); bundle_out (n_frames, len(ALL_LIGAMENT_NAMES)) N; energy_out (n_frames, 2)
-    kinetic, internal (N·mm); residual_out (n_frames, 2) largest net force (N)
-    and moment (N·mm) on the free bones; steps_out (n_frames,) steps
-    taken since the previous frame (frame 0: settling and the move included).
+def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
+    """Simulate one design (`Stiffness`) through the capitate's `Frames`; fills `out` (`Outputs`) and
+    out.status[0] (0 ok, 1 NaN, 2 diverged). Steps per frame count those since the previous frame
+    (frame 0: settling and the move included).
     Each stage ramps the capitate over its ramp steps, then holds until
     `_converged` (at least min_hold_steps, at most max_hold_steps; settling
     at most settle_steps).
     """
+    frame_R, frame_x, frame_load = frames
+    poses, contact, bundle_out, energy_out, residual_out, steps_out, status = out
     com0 = bod.com0
     n_frames = frame_R.shape[0]
     R = np.zeros((N_BONES, 3, 3))
@@ -292,7 +272,6 @@ def run(
     bundle = np.zeros(N_LIGAMENTS)
     state = State(R, x, v, w, nodes, nv)
     work = Work(active, n_active, F, T, node_force, stats, bundle)
-    stiffness = Stiffness(f_l0, f_K, m_l0, m_K)
     status[0] = OK
     step = 0
     R0 = np.eye(3)
@@ -357,49 +336,11 @@ def run(
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
-def run_batch(
-    bod,
-    grids,
-    law,
-    fib,
-    f_l0,
-    f_K,
-    mem,
-    m_l0,
-    m_K,
-    st,
-    frame_R,
-    frame_x,
-    frame_load,
-    poses,
-    contact,
-    bundle_out,
-    energy_out,
-    residual_out,
-    steps_out,
-    status,
-):
-    """`run` for many designs: f_l0, f_K (n, N), m_l0, m_K (n, C); outputs with a leading n axis."""
-    for i in prange(f_l0.shape[0]):
-        run(
-            bod,
-            grids,
-            law,
-            fib,
-            f_l0[i],
-            f_K[i],
-            mem,
-            m_l0[i],
-            m_K[i],
-            st,
-            frame_R,
-            frame_x,
-            frame_load,
-            poses[i],
-            contact[i],
-            bundle_out[i],
-            energy_out[i],
-            residual_out[i],
-            steps_out[i],
-            status[i],
+def run_batch(bod, grids, law, fib, stiffness, mem, st, frames, out):
+    """`run` for many designs: `Stiffness` and `Outputs` arrays with a leading design axis."""
+    for i in prange(stiffness.f_l0.shape[0]):
+        design = Stiffness(stiffness.f_l0[i], stiffness.f_K[i], stiffness.m_l0[i], stiffness.m_K[i])
+        filled = Outputs(
+            out.poses[i], out.contact[i], out.bundle[i], out.energy[i], out.residual[i], out.steps[i], out.status[i]
         )
+        run(bod, grids, law, fib, design, mem, st, frames, filled)

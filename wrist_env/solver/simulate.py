@@ -122,9 +122,9 @@ class Result:
         return self.status == kernel.OK
 
 
-def _outputs(n: int, n_frames: int):
+def _outputs(n: int, n_frames: int) -> kernel.Outputs:
     shape = (n,) if n else ()
-    return (
+    return kernel.Outputs(
         np.full(shape + (n_frames, 5, 4, 4), np.nan),
         np.full(shape + (n_frames, 5, 4), np.nan),
         np.full(shape + (n_frames, len(ALL_LIGAMENT_NAMES)), np.nan),
@@ -199,18 +199,13 @@ def simulate(
         p.grids,
         p.law,
         p.fibres,
-        f_l0,
-        f_K,
+        kernel.Stiffness(f_l0, f_K, m_l0, m_K),
         p.membrane,
-        m_l0,
-        m_K,
         p.settings,
-        driver.rotation,
-        driver.com,
-        driver.load_n,
-        *out,
+        _frames(driver),
+        out,
     )
-    return _result(out, driver, int(out[-1][0]))
+    return _result(out, driver, int(out.status[0]))
 
 
 def simulate_batch(
@@ -233,23 +228,22 @@ def simulate_batch(
             p.grids,
             p.law,
             p.fibres,
-            f_l0,
-            f_K,
+            kernel.Stiffness(f_l0, f_K, m_l0, m_K),
             p.membrane,
-            m_l0,
-            m_K,
             p.settings,
-            driver.rotation,
-            driver.com,
-            driver.load_n,
-            *out,
+            _frames(driver),
+            out,
         )
     finally:
         numba.set_parallel_chunksize(previous)
-    return [_result(tuple(o[i] for o in out), driver, int(out[-1][i, 0])) for i in range(len(per))]
+    return [_result(kernel.Outputs(*(o[i] for o in out)), driver, int(out.status[i, 0])) for i in range(len(per))]
 
 
-def _result(out, driver: Driver, status: int) -> Result:
+def _frames(driver: Driver) -> kernel.Frames:
+    return kernel.Frames(driver.rotation, driver.com, driver.load_n)
+
+
+def _result(out: kernel.Outputs, driver: Driver, status: int) -> Result:
     poses, contact, bundle, energy, residual, steps, _ = out
     if status != kernel.OK:
         for a in (poses, contact, bundle, energy, residual):
