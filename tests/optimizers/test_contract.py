@@ -156,6 +156,11 @@ def test_an_unknown_option_is_an_error_listing_the_valid_ones(name, third_party_
 @pytest.mark.parametrize("name", NAMES)
 def test_close_is_safe_before_and_after_use(name, third_party_optimizer):
     opt = optimizers.make(name, dim=5, budget=3, seed=0)
-    optimizers.minimize(opt, lambda x: np.sum(x**2, axis=1))
+    opt.close()  # before any ask
+    result = optimizers.minimize(optimizers.make(name, dim=5, budget=3, seed=0), lambda x: np.sum(x**2, axis=1))
+    opt = optimizers.make(name, dim=5, budget=3, seed=0)
+    again = optimizers.minimize(opt, lambda x: np.sum(x**2, axis=1))
     opt.close()
-    opt.close()
+    opt.close()  # twice after use: no error, and the result stands
+    assert again.nfev == result.nfev == 3 and np.array_equal(again.history_fun, result.history_fun)
+    assert opt.result().nfev == 3

@@ -86,3 +86,15 @@ def test_a_folder_is_read_once_when_registered(tmp_path, monkeypatch):
     assert set(bones) >= {"radius", "scaphoid", "capitate"} and list(trials) == ["unresisted"]
     assert registry.trial("U2", "calibrate").name == "unresisted"
     assert len(calls) == 1
+
+
+def test_ensure_folder_reads_a_registered_folder_once(tmp_path, monkeypatch):
+    from wrist_env.participants import folder as folder_module
+
+    path = warped_template_folder(tmp_path / "u3", name="U3")
+    calls = []
+    original = folder_module.load_participant_folder
+    monkeypatch.setattr(folder_module, "load_participant_folder", lambda p: calls.append(p) or original(p))
+    assert registry.ensure_folder(path) == "U3" and registry.ensure_folder(tmp_path / "u3" / ".." / "u3") == "U3"
+    assert len(calls) == 1
+    assert registry.add_folder(path) == "U3" and len(calls) == 2  # add_folder re-reads (files may have changed)

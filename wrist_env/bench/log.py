@@ -195,6 +195,7 @@ class RunLog:
                         )
                         is not None
                     )
+        progress = self.progress()  # after the damaged parts were moved
         for name in self.store.record_names():
             path = self.store.record_path(name)
             try:
@@ -205,7 +206,7 @@ class RunLog:
                     self.store.quarantine(path, "damaged cell summary, the cell runs again (by replay)") is not None
                 )
                 continue
-            logged = self.progress().get(name, 0)
+            logged = progress.get(name, 0)
             if logged < n:
                 moved += (
                     self.store.quarantine(

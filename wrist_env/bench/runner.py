@@ -96,7 +96,7 @@ def run_cell(
 
     set_threads(threads)
     for folder in folders:
-        registry.add_folder(folder)
+        registry.ensure_folder(folder)
     log = RunLog(out_dir)
     with log.lock(key):
         summary = log.summary(key)
@@ -189,7 +189,7 @@ def _check_names(cells, folders) -> None:
     from wrist_env.participants import registry
 
     for folder in folders:
-        registry.add_folder(folder)
+        registry.ensure_folder(folder)
     registry.require(*sorted({k.participant for k in cells}))
     for name in sorted({k.optimizer for k in cells}):
         optimizers.get(name)  # UnknownOptimizerError lists the registered ones

@@ -169,10 +169,8 @@ def run_chunk(
     if folders:
         from wrist_env.participants import registry
 
-        known = set(registry.participants())
         for folder in folders:
-            if participant not in known:
-                registry.add_folder(folder)
+            registry.ensure_folder(folder)
     actions = np.asarray(actions, dtype=np.float64)
     k = len(actions)
     env = vector_env(participant, k)

@@ -311,7 +311,7 @@ def _run_locked(
         from wrist_env.participants import registry
 
         for f in folders:
-            registry.add_folder(f)
+            registry.ensure_folder(f)
 
     summary = StudySummary(config, {}, out=out)
     bar = None

@@ -65,6 +65,16 @@ def add_folder(folder) -> str:
     return source.name
 
 
+def ensure_folder(folder) -> str:
+    """`add_folder` unless this folder is registered already (a worker or a runner given the folders a
+    caller registered: read once, not again); returns its name."""
+    here = Path(folder).resolve()
+    for name, path in _FOLDERS.items():
+        if path.resolve() == here:
+            return name
+    return add_folder(folder)
+
+
 def bones(name: str, params: BuildParams | None = None) -> dict:
     """The participant's bones (name -> BoneSurface, RCS mm, neutral pose) for the anatomy
     variant of `params` (default: `BuildParams()`)."""
@@ -128,6 +138,7 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
 __all__ = [
     "BONES",
     "add_folder",
+    "ensure_folder",
     "bones",
     "cache_dir",
     "folder",
