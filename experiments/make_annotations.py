@@ -20,10 +20,13 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial import cKDTree
 
-from wrist_env.anatomy.template import load_template
+from wrist_env.anatomy import midcarpal
+from wrist_env.anatomy.template import JOINT_SPACE_MM, load_template, oriented_parts
 from wrist_env.design import LIGAMENTS
 
-OUT = Path(__file__).resolve().parents[1] / "wrist_env" / "anatomy" / "data" / "annotations.json"
+DATA = Path(__file__).resolve().parents[1] / "wrist_env" / "anatomy" / "data"
+OUT = DATA / "annotations.json"
+SEAT = DATA / midcarpal.SEAT_FILE
 
 
 def unit(*v):
@@ -46,7 +49,16 @@ def patch_radius(bone: str, lig) -> float:
     return 2.5 if lig.fibres >= 7 else 2.0
 
 
+def write_seat() -> None:
+    """Fit the distal row's seating on the myo-sim bones and write it (`anatomy.midcarpal`)."""
+    record = midcarpal.seat_record(oriented_parts()[0], JOINT_SPACE_MM)
+    SEAT.write_text(json.dumps(record, indent=1) + "\n")
+    print(f"wrote {SEAT}: facet gaps {record['facet_gaps_before_mm']} -> {record['facet_gaps_after_mm']} mm")
+
+
 def main() -> None:
+    write_seat()
+    load_template.cache_clear()
     template = load_template()
     V = {b: template.parts[b].vertices for b in template.parts}  # rules read the bones one by one
     near = lambda a, b, gap: cKDTree(V[b]).query(V[a])[0] < gap  # noqa: E731

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 import trimesh
 
+from wrist_env.anatomy.midcarpal import DISTAL_ROW, read_seat
 from wrist_env.anatomy.myosim import load_myosim_anatomy
 from wrist_env.anatomy.radius_cap import build_radius_cap
 from wrist_env.model import BODY_PARTS, BONES, PARTS
@@ -76,7 +77,8 @@ class Template:
     bones: the five rigid bodies (`BONES`); with the distal row, each composed of its
         `BODY_PARTS`, otherwise the principal bones alone.
     parts: the nine bones one by one (`PARTS`).
-    rcs_from_myosim: 4x4 transform from the myo-sim radius body frame (mm) to the RCS.
+    rcs_from_myosim: 4x4 transform from the myo-sim radius body frame (mm) to the RCS (the distal
+        row's bones are moved on from there by `midcarpal.read_seat()`).
     """
 
     bones: dict
@@ -156,6 +158,17 @@ def _transform(mesh: trimesh.Trimesh, T: np.ndarray) -> trimesh.Trimesh:
     return out
 
 
+def oriented_parts() -> tuple[dict, np.ndarray]:
+    """The nine myo-sim bones as myo-sim assembles them, turned to the RCS axes (not yet centred):
+    part name -> trimesh (mm), and that rotation (4×4)."""
+    anatomy = load_myosim_anatomy()
+    meshes = anatomy.meshes
+    carpus = np.mean([meshes[b].centroid for b in CARPALS], axis=0)
+    oriented = np.eye(4)
+    oriented[:3, :3] = rcs_rotation(meshes["radius"], carpus, anatomy.flexor_sites, anatomy.extensor_sites)
+    return {b: _transform(meshes[b], oriented) for b in PARTS}, oriented
+
+
 @functools.lru_cache(maxsize=4)
 def load_template(fossa_sweep_deg: tuple = (0.0, 0.0), distal_row: bool = False) -> Template:
     """The anatomy template (built once per process and variant, ~1–5 s).
@@ -164,13 +177,9 @@ def load_template(fossa_sweep_deg: tuple = (0.0, 0.0), distal_row: bool = False)
     the radius fossae ((0, 0): moulded to the neutral row). distal_row: the lunate body
     carries the triquetrum and the capitate body the trapezium, trapezoid and hamate.
     """
-    anatomy = load_myosim_anatomy()
-    meshes = anatomy.meshes
-    carpus = np.mean([meshes[b].centroid for b in CARPALS], axis=0)
-    R = rcs_rotation(meshes["radius"], carpus, anatomy.flexor_sites, anatomy.extensor_sites)
-    oriented = np.eye(4)
-    oriented[:3, :3] = R
-    m = {b: _transform(meshes[b], oriented) for b in PARTS}
+    m, oriented = oriented_parts()
+    seat = read_seat()
+    m |= {b: _transform(m[b], seat) for b in DISTAL_ROW}
     cap, articular = build_radius_cap([m[b] for b in ROW], m["radius"], joint_space_mm=JOINT_SPACE_MM)
     top = cap.vertices[articular]  # the origin comes from the moulded surface, whatever the variant
     origin = top[np.argmin(np.linalg.norm(top[:, [0, 2]] - top[:, [0, 2]].mean(axis=0), axis=1))]

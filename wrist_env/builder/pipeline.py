@@ -24,7 +24,7 @@ from wrist_env.design import ALL_LIGAMENTS, LIGAMENT_NAMES, LIGAMENTS, RSC_INDEX
 from wrist_env.errors import BuildError
 from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model, offsets
 
-BUILDER_VERSION = 3  # 2: distal row and triquetrum as body parts, swept fossae; 3: both by default, TC and TH
+BUILDER_VERSION = 4  # 2: distal row and triquetrum as body parts, swept fossae; 3: both by default, TC and TH; 4: the distal row seated (anatomy.midcarpal)
 GRID_BONES = ("radius", "scaphoid", "lunate", "capitate")
 MIN_SITE_VERTICES = 8
 JOINT_SPACE_MM = {art: (0.3, 4.0) for art in PAIRS} | {"scapholunate": (0.3, 8.0)}

@@ -1,0 +1,64 @@
+"""Regenerate every committed result from real runs: the README's figures, `leaderboards/`
+and `leaderboards/montecarlo/` (the maintainer's one command after a model change).
+
+Runs, from the repository root, each step as the README documents it and prints its wall time:
+the figures (`wrist-bench figure ...`, `wrist-bench validate P1`), the full default benchmark
+and its leaderboard (3 participants × 7 calibrators × 5 seeds × 300 evaluations), and the full
+Monte Carlo study (P1 + P2, 2 × 12,500) with its report. The studies' run logs go to a fresh
+folder `runs/regenerate-<commit>/` (a killed run resumes there when rerun at the same commit).
+
+Run: `python experiments/regenerate.py` (~40 min on a 2-core machine); `--figures-only` skips the
+two studies (a minute).
+"""
+
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _commit() -> str:
+    out = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True)
+    return out.stdout.strip() or "worktree"
+
+
+def steps(runs: Path, figures_only: bool) -> list[list[str]]:
+    """The commands, in order (argv lists for `wrist-bench`)."""
+    figures = [
+        ["figure", "annotations"],
+        ["figure", "model", "P1"],
+        ["figure", "pressure", "P1"],
+        ["figure", "kinematics", "P1"],
+        ["validate", "P1", "--out", "experiments/figures"],
+    ]
+    if figures_only:
+        return figures
+    return figures + [
+        ["benchmark", "--storage", "memory", "--out", str(runs / "benchmark"), "--leaderboard", "leaderboards"],
+        ["montecarlo", "P1", "P2", "--n", "12500", "--seed", "0", "--out", str(runs / "montecarlo")],
+        ["montecarlo-report", "--runs", str(runs / "montecarlo"), "--out", "leaderboards/montecarlo"],
+    ]
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--figures-only", action="store_true", help="skip the benchmark and the Monte Carlo study")
+    args = parser.parse_args(argv)
+    runs = ROOT / "runs" / f"regenerate-{_commit()}"
+    for argv_ in steps(runs, args.figures_only):
+        print("$ wrist-bench " + " ".join(argv_), flush=True)
+        start = time.perf_counter()
+        # validate exits 1 when a published check fails: its figure and table are still the result
+        done = subprocess.run([sys.executable, "-m", "wrist_env.cli", *argv_], cwd=ROOT)
+        if done.returncode not in (0, 1) or (done.returncode == 1 and argv_[0] != "validate"):
+            sys.exit(f"`wrist-bench {' '.join(argv_)}` failed (exit status {done.returncode})")
+        print(f"  {time.perf_counter() - start:.0f} s", flush=True)
+
+
+if __name__ == "__main__":
+    main()
