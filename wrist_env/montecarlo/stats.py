@@ -182,19 +182,8 @@ def fit_pressure(frames: pd.DataFrame, *, max_runs: int | None = None, seed: int
         ("Angle spline", "s2", "Angle spline 2"),
     ]
     rows += [("Ligament injury", lig, BUNDLE_LABELS[lig]) for lig in INJURABLE]
-    table = _table(result, rows, mean)
-    return Fit(
-        table,
-        mean,
-        float(result.cov_re.iloc[0, 0]),
-        float(result.scale),
-        runs,
-        len(data),
-        available,
-        time.perf_counter() - start,
-        bool(result.converged),
-        PRESSURE_FORMULA,
-        {"angle_range_deg": list(bounds), "max_runs": max_runs, "subsample_seed": seed},
+    return _fit(
+        _table(result, rows, mean), mean, result, PRESSURE_FORMULA, data, runs, available, start, bounds, max_runs, seed
     )
 
 
@@ -226,10 +215,17 @@ def fit_slil(frames: pd.DataFrame, *, max_runs: int | None = None, seed: int = 0
         ("Ligament", "s1:proximal", "Angle spline 1 × proximal"),
         ("Ligament", "s2:proximal", "Angle spline 2 × proximal"),
     ]
-    table = _table(result, rows, None)
+    mean = float(data["force_n"].mean())
+    return _fit(
+        _table(result, rows, None), mean, result, SLIL_FORMULA, data, runs, available, start, bounds, max_runs, seed
+    )
+
+
+def _fit(table, mean, result, formula, data, runs, available, start, bounds, max_runs, seed) -> Fit:
+    """A `Fit` from a fitted MixedLM `result` on `data` (timed from `start`, perf_counter s)."""
     return Fit(
         table,
-        float(data["force_n"].mean()),
+        mean,
         float(result.cov_re.iloc[0, 0]),
         float(result.scale),
         runs,
@@ -237,7 +233,7 @@ def fit_slil(frames: pd.DataFrame, *, max_runs: int | None = None, seed: int = 0
         available,
         time.perf_counter() - start,
         bool(result.converged),
-        SLIL_FORMULA,
+        formula,
         {"angle_range_deg": list(bounds), "max_runs": max_runs, "subsample_seed": seed},
     )
 

@@ -194,17 +194,7 @@ def simulate(
     p = _prepared(model, settings, driver, prepared)
     f_l0, f_K, m_l0, m_K = arrays.design_arrays(model, p.fibres, p.membrane, design)
     out = _outputs(0, len(driver.rotation))
-    kernel.run(
-        p.bodies,
-        p.grids,
-        p.law,
-        p.fibres,
-        kernel.Stiffness(f_l0, f_K, m_l0, m_K),
-        p.membrane,
-        p.settings,
-        _frames(driver),
-        out,
-    )
+    _run(kernel.run, p, kernel.Stiffness(f_l0, f_K, m_l0, m_K), driver, out)
     return _result(out, driver, int(out.status[0]))
 
 
@@ -223,24 +213,16 @@ def simulate_batch(
     out = _outputs(len(per), len(driver.rotation))
     previous = numba.set_parallel_chunksize(1)  # designs differ in cost: hand them out one at a time
     try:
-        kernel.run_batch(
-            p.bodies,
-            p.grids,
-            p.law,
-            p.fibres,
-            kernel.Stiffness(f_l0, f_K, m_l0, m_K),
-            p.membrane,
-            p.settings,
-            _frames(driver),
-            out,
-        )
+        _run(kernel.run_batch, p, kernel.Stiffness(f_l0, f_K, m_l0, m_K), driver, out)
     finally:
         numba.set_parallel_chunksize(previous)
     return [_result(kernel.Outputs(*(o[i] for o in out)), driver, int(out.status[i, 0])) for i in range(len(per))]
 
 
-def _frames(driver: Driver) -> kernel.Frames:
-    return kernel.Frames(driver.rotation, driver.com, driver.load_n)
+def _run(entry, p: Prepared, stiffness: kernel.Stiffness, driver: Driver, out: kernel.Outputs) -> None:
+    """Call a kernel entry point (`kernel.run` or `kernel.run_batch`) on prepared arrays; fills `out`."""
+    frames = kernel.Frames(driver.rotation, driver.com, driver.load_n)
+    entry(p.bodies, p.grids, p.law, p.fibres, stiffness, p.membrane, p.settings, frames, out)
 
 
 def _result(out: kernel.Outputs, driver: Driver, status: int) -> Result:

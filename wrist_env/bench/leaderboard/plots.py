@@ -14,6 +14,13 @@ def colors(labels) -> dict:
     return {label: cmap(i % 10) for i, label in enumerate(labels)}
 
 
+def _reference_line(ax, cost: float, text: str, color: str, style: str, *, right: bool) -> None:
+    """A horizontal line at a reference design's cost, labelled at the right (above) or left (below) end."""
+    ax.axhline(cost, color=color, ls=style, lw=1.0 if right else 1.2)
+    x, ha, va = (0.99, "right", "bottom") if right else (0.01, "left", "top")
+    ax.text(x, cost, text, color=color, fontsize=8, ha=ha, va=va, transform=ax.get_yaxis_transform())
+
+
 def convergence_figure(path, board, colors) -> None:
     """Best cost so far against evaluations: median and IQR band per calibrator, a panel per participant."""
     import matplotlib.pyplot as plt
@@ -54,30 +61,9 @@ def convergence_figure(path, board, colors) -> None:
             ax.plot(x, med, color=colors[label], lw=1.8, label=f"{label} ({len(cs)} run{'s' if len(cs) > 1 else ''})")
             ax.fill_between(x, q25, q75, color=colors[label], alpha=0.18, lw=0)
         pop = refs[p].population["calibrate"]["cost"]
-        ax.axhline(pop, color="0.35", ls="--", lw=1)
-        ax.text(
-            0.99,
-            pop,
-            "population",
-            color="0.35",
-            fontsize=8,
-            ha="right",
-            va="bottom",
-            transform=ax.get_yaxis_transform(),
-        )
+        _reference_line(ax, pop, "population", "0.35", "--", right=True)
         if refs[p].truth is not None:
-            truth = refs[p].truth["calibrate"]["cost"]
-            ax.axhline(truth, color="0.1", ls=":", lw=1.2)
-            ax.text(
-                0.01,
-                truth,
-                "hidden truth",
-                color="0.1",
-                fontsize=8,
-                ha="left",
-                va="top",
-                transform=ax.get_yaxis_transform(),
-            )
+            _reference_line(ax, refs[p].truth["calibrate"]["cost"], "hidden truth", "0.1", ":", right=False)
         ax.set_yscale("log")
         low = min([refs[p].truth["calibrate"]["cost"] if refs[p].truth is not None else np.inf] + lows) * 0.85
         ax.set_ylim(low, 1.6 * pop)  # failed runs (cost 1000) would squash the interesting range

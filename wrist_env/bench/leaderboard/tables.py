@@ -64,6 +64,11 @@ def hit(curve: np.ndarray, target: float) -> int | None:
     return int(idx[0]) + 1 if len(idx) else None
 
 
+def spread(values, prefix: str = "") -> dict:
+    """{prefix + "median", "q25", "q75"} of `values` (NaN-free quantiles, see `quantile`)."""
+    return {f"{prefix}{name}": quantile(values, q) for name, q in (("median", 0.5), ("q25", 0.25), ("q75", 0.75))}
+
+
 def best_cost(runs_frame, refs, participants, labels) -> pd.DataFrame:
     rows = []
     for p in participants:
@@ -77,9 +82,7 @@ def best_cost(runs_frame, refs, participants, labels) -> pd.DataFrame:
                     "participant": p,
                     "calibrator": label,
                     "runs": len(v),
-                    "median": quantile(v, 0.5),
-                    "q25": quantile(v, 0.25),
-                    "q75": quantile(v, 0.75),
+                    **spread(v),
                     "min": float(v.min()),
                     "max": float(v.max()),
                     "population": refs[p].population["calibrate"]["cost"],
@@ -133,9 +136,7 @@ def recovery(runs_frame, summaries, participants, labels) -> pd.DataFrame:
                     "participant": p,
                     "calibrator": label,
                     "runs": len(v),
-                    "median": quantile(v, 0.5),
-                    "q25": quantile(v, 0.25),
-                    "q75": quantile(v, 0.75),
+                    **spread(v),
                     "population": population.get(p),
                 }
             )
@@ -173,9 +174,7 @@ def heldout(runs_frame, refs, participants, labels) -> pd.DataFrame:
                     "participant": p,
                     "calibrator": label,
                     "runs": len(v),
-                    "cost_median": quantile(v, 0.5),
-                    "cost_q25": quantile(v, 0.25),
-                    "cost_q75": quantile(v, 0.75),
+                    **spread(v, "cost_"),
                     "failed": int(sub.validate_failed.sum()),
                     "rmse_translation_mm": quantile(sub.validate_rmse_translation_mm, 0.5),
                     "rmse_rotation_deg": quantile(sub.validate_rmse_rotation_deg, 0.5),
