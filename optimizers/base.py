@@ -9,9 +9,11 @@ left; `tell(x, y)` returns their values. `minimize` drives the loop.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from wrist_env.errors import InputError
 
@@ -101,7 +103,7 @@ class Optimizer(ABC):
         self._pending = len(x)
         return x
 
-    def tell(self, x, y) -> None:
+    def tell(self, x: ArrayLike, y: ArrayLike) -> None:
         """The values y (k,) of the points x (k, dim) last asked."""
         x = np.atleast_2d(np.asarray(x, dtype=np.float64))
         y = np.atleast_1d(np.asarray(y, dtype=np.float64))
@@ -147,7 +149,11 @@ class Optimizer(ABC):
         return np.clip(np.broadcast_to(np.asarray(x0, dtype=np.float64), (self.dim,)), self.lower, self.upper)
 
 
-def minimize(optimizer: Optimizer, fun_batch, callback=None) -> OptimizeResult:
+def minimize(
+    optimizer: Optimizer,
+    fun_batch: Callable[[np.ndarray], ArrayLike],
+    callback: Callable[[np.ndarray, np.ndarray], object] | None = None,
+) -> OptimizeResult:
     """Run `optimizer` on `fun_batch` ((k, dim) → (k,)) until its budget is spent or it stops.
 
     callback(x, y) is called after every batch (e.g. to log evaluations).

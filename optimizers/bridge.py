@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import queue
 import threading
+from typing import Any
 
 
 class Stop(Exception):
@@ -33,7 +34,7 @@ class Bridge:
 
     # worker side
 
-    def request(self, points):
+    def request(self, points: object) -> Any:
         """Hand `points` to the main thread; their values, or `Stop` if the run is ended."""
         self._to_main.put(("request", points))
         values = self._to_worker.get()
@@ -72,12 +73,12 @@ class Bridge:
             raise RuntimeError(f"{self.thread.name}: the worker failed") from payload
         return kind, payload
 
-    def reply(self, values) -> None:
+    def reply(self, values: object) -> None:
         """The values of the points last requested."""
         self._awaiting = False
         self._to_worker.put(values)
 
-    def stop(self):
+    def stop(self) -> object:
         """End the worker (if it runs) and wait for it; returns its result (None if it never ran)."""
         if not self.started or self.finished:
             return None

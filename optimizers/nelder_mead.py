@@ -13,6 +13,7 @@ from __future__ import annotations
 import functools
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.optimize import Bounds
 from scipy.optimize import minimize as scipy_minimize
 
@@ -21,7 +22,7 @@ from optimizers.bridge import Bridge, Stop
 from optimizers.registry import register
 
 
-def initial_simplex(x0, lower, upper, scale: float = 0.25) -> np.ndarray:
+def initial_simplex(x0: ArrayLike, lower: np.ndarray, upper: np.ndarray, scale: float = 0.25) -> np.ndarray:
     """(dim + 1, dim): x0 and x0 ± scale·(upper − lower) along each axis.
 
     Each step goes up unless that leaves the box, then down (SciPy would

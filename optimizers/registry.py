@@ -8,9 +8,14 @@ A third-party package adds one without touching wrist-env::
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from importlib.metadata import entry_points
+from typing import TYPE_CHECKING, Any
 
 from wrist_env.errors import WristEnvError
+
+if TYPE_CHECKING:
+    from optimizers.base import Optimizer
 
 ENTRY_POINT_GROUP = "wrist_env.optimizers"
 _REGISTRY: dict[str, type] = {}
@@ -23,7 +28,7 @@ class UnknownOptimizerError(WristEnvError, KeyError):
         return str(self.args[0])
 
 
-def register(name: str):
+def register(name: str) -> Callable[[type], type]:
     """Class decorator: make an `Optimizer` subclass available under `name`."""
 
     def decorate(cls):
@@ -58,6 +63,6 @@ def get(name: str) -> type:
     return _REGISTRY[name]
 
 
-def make(name: str, dim: int, budget: int, seed: int = 0, **options):
+def make(name: str, dim: int, budget: int, seed: int = 0, **options: Any) -> Optimizer:
     """An instance of the calibrator `name`."""
     return get(name)(dim=dim, budget=budget, seed=seed, **options)

@@ -6,7 +6,14 @@ import argparse
 import json
 import sys
 import time
+from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from wrist_env.design import Design
+    from wrist_env.model import Model
+    from wrist_env.solver.simulate import Driver
 
 FIGURES_HELP = "$WRIST_ENV_FIGURES or experiments/figures"  # wrist_env.figures.draw.FIGURES (no matplotlib import here)
 
@@ -41,7 +48,7 @@ def _build(args) -> int:
     return 0
 
 
-def load_design(spec: str, participant: str):
+def load_design(spec: str, participant: str) -> Design:
     """`population`, `truth` (a built-in participant's hidden ground truth) or a JSON file of a Design."""
     from wrist_env import design
     from wrist_env.errors import DesignError
@@ -62,7 +69,7 @@ def load_design(spec: str, participant: str):
     return design.read_json(spec)
 
 
-def make_driver(model, motion: str, frames: int | None, flexion: float, extension: float):
+def make_driver(model: Model, motion: str, frames: int | None, flexion: float, extension: float) -> Driver:
     """The capitate driver of `simulate`: an idealized sweep or the capitate held at neutral."""
     from wrist_env.solver import simulate
 
@@ -588,7 +595,7 @@ def parser() -> argparse.ArgumentParser:
     return p
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     args = parser().parse_args(argv)
     from wrist_env.errors import WristEnvError
 

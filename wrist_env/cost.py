@@ -32,6 +32,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, fields
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from wrist_env.errors import InputError
 from wrist_env.frames import (
@@ -145,12 +146,12 @@ class CostReport:
 
 
 def kinematic_cost(
-    model_poses,
-    experimental_poses,
+    model_poses: ArrayLike | Mapping[str, ArrayLike],
+    experimental_poses: ArrayLike | Mapping[str, ArrayLike],
     *,
-    reference_points=None,
+    reference_points: ArrayLike | Mapping[str, ArrayLike] | None = None,
     weights: CostWeights | Mapping | None = None,
-    range_floor=RANGE_FLOOR,
+    range_floor: ArrayLike = RANGE_FLOOR,
     expressed_in: str = "bone",
 ) -> CostReport:
     """The kinematic cost of model vs experimental scaphoid and lunate poses (see the module docstring).

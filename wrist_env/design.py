@@ -12,10 +12,15 @@ Normalized action a in [-1, 1]^27 ↔ physical value:
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from wrist_env.errors import DesignError
+
+if TYPE_CHECKING:
+    from pathlib import Path
 
 
 @dataclass(frozen=True)
@@ -131,7 +136,7 @@ class Design:
         return out
 
     @classmethod
-    def from_vector(cls, values) -> "Design":
+    def from_vector(cls, values: ArrayLike) -> "Design":
         """From the 27 physical values in `NAMES` order."""
         v = np.asarray(values, dtype=np.float64)
         if v.shape != (N_DESIGN,):
@@ -150,7 +155,7 @@ class Design:
         return cls.from_vector([data[n] for n in NAMES])
 
 
-def read_json(path) -> Design:
+def read_json(path: str | Path) -> Design:
     """A Design from a JSON file: {name: value} in physical units (`NAMES`), or an object whose
     "design" is one (a calibration's `--json` output); `DesignError` naming the file otherwise."""
     import json
@@ -171,7 +176,7 @@ def read_json(path) -> Design:
         raise DesignError(f"{path}: {exc}") from None
 
 
-def check_action(action) -> np.ndarray:
+def check_action(action: ArrayLike) -> np.ndarray:
     """The action as float64 of shape (27,) in [-1, 1], or a DesignError naming the offending entries."""
     raw = np.asarray(action)
     if not (np.issubdtype(raw.dtype, np.floating) or np.issubdtype(raw.dtype, np.integer)):
@@ -186,7 +191,7 @@ def check_action(action) -> np.ndarray:
     return np.clip(a, -1.0, 1.0)
 
 
-def from_action(action) -> Design:
+def from_action(action: ArrayLike) -> Design:
     """Physical design of a normalized action in [-1, 1]^27."""
     a = check_action(action)
     values = MEAN + SPAN_SD * np.nan_to_num(SD) * a

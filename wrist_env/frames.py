@@ -30,7 +30,10 @@ neutral pose (identity) is all zeros for any reference point.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
 from wrist_env.errors import InputError
@@ -45,7 +48,13 @@ ORTHONORMAL_TOL = 1e-4  # max |RᵀR − I|
 BOTTOM_ROW_TOL = 1e-9
 
 
-def validate_poses(poses, name: str = "poses", *, error: type = InputError, where=None) -> np.ndarray:
+def validate_poses(
+    poses: ArrayLike,
+    name: str = "poses",
+    *,
+    error: type = InputError,
+    where: Callable[[Sequence[int]], str] | None = None,
+) -> np.ndarray:
     """The poses as a float64 array of shape (..., 4, 4), or `error` naming `name`, the entry and its value.
 
     Rules: shape (..., 4, 4); finite; bottom row 0 0 0 1; rotation orthonormal
@@ -85,7 +94,7 @@ def validate_poses(poses, name: str = "poses", *, error: type = InputError, wher
     return t
 
 
-def validate_points(points, name: str = "reference_point") -> np.ndarray:
+def validate_points(points: ArrayLike, name: str = "reference_point") -> np.ndarray:
     """Points (mm) as a float64 array of shape (..., 3), or an InputError naming `name` and the value."""
     try:
         p = np.asarray(points, dtype=np.float64)
@@ -99,7 +108,7 @@ def validate_points(points, name: str = "reference_point") -> np.ndarray:
     return p
 
 
-def cardan_angles(rotations) -> np.ndarray:
+def cardan_angles(rotations: ArrayLike) -> np.ndarray:
     """Cardan Z-X-Y angles (degrees) of rotation matrices (..., 3, 3): array (..., 3) = Flex/Ext, UlnD/RadD, Pro/Sup.
 
     Matrices are assumed valid (see validate_poses). Intrinsic: R = Rz(a)·Rx(b)·Ry(c).
@@ -112,7 +121,7 @@ def cardan_angles(rotations) -> np.ndarray:
     return Rotation.from_matrix(flat).as_euler(CARDAN_SEQUENCE, degrees=True).reshape(lead + (3,))
 
 
-def cardan_rotation(angles) -> np.ndarray:
+def cardan_rotation(angles: ArrayLike) -> np.ndarray:
     """Rotation matrices (..., 3, 3) of Cardan Z-X-Y angles (..., 3) in degrees (Flex/Ext, UlnD/RadD, Pro/Sup)."""
     a = np.asarray(angles, dtype=np.float64)
     if a.ndim < 1 or a.shape[-1] != 3:
@@ -128,14 +137,14 @@ def cardan_rotation(angles) -> np.ndarray:
     return Rotation.from_euler(CARDAN_SEQUENCE, flat, degrees=True).as_matrix().reshape(lead + (3, 3))
 
 
-def apply(poses, points) -> np.ndarray:
+def apply(poses: ArrayLike, points: ArrayLike) -> np.ndarray:
     """Points (..., 3) mm moved by poses (..., 4, 4): R·p + t, broadcast over leading axes."""
     t = np.asarray(poses, dtype=np.float64)
     p = np.asarray(points, dtype=np.float64)
     return (t[..., :3, :3] @ p[..., :, None])[..., 0] + t[..., :3, 3]
 
 
-def invert(poses) -> np.ndarray:
+def invert(poses: ArrayLike) -> np.ndarray:
     """Inverses of rigid transforms (..., 4, 4): [Rᵀ, −Rᵀt; 0 0 0 1]."""
     t = np.asarray(poses, dtype=np.float64)
     out = np.zeros_like(t)
@@ -146,7 +155,7 @@ def invert(poses) -> np.ndarray:
     return out
 
 
-def pose_to_dof(poses, reference_point=None) -> np.ndarray:
+def pose_to_dof(poses: ArrayLike, reference_point: ArrayLike | None = None) -> np.ndarray:
     """Six DOF (..., 6) of poses (..., 4, 4): displacement T·c − c (mm, RCS) of the reference point c, then Cardan angles (deg).
 
     reference_point: (3,) or broadcastable to poses.shape[:-2] + (3,), mm, RCS, neutral pose;
@@ -158,7 +167,7 @@ def pose_to_dof(poses, reference_point=None) -> np.ndarray:
     return _dof(t, c)
 
 
-def dof_to_pose(dof, reference_point=None) -> np.ndarray:
+def dof_to_pose(dof: ArrayLike, reference_point: ArrayLike | None = None) -> np.ndarray:
     """Poses (..., 4, 4) of six DOF (..., 6) (mm, deg): the inverse of pose_to_dof with the same reference point."""
     d = np.asarray(dof, dtype=np.float64)
     if d.ndim < 1 or d.shape[-1] != 6:
@@ -178,7 +187,7 @@ def dof_to_pose(dof, reference_point=None) -> np.ndarray:
     return out
 
 
-def error_transform(model, experiment, *, expressed_in: str = "bone") -> np.ndarray:
+def error_transform(model: ArrayLike, experiment: ArrayLike, *, expressed_in: str = "bone") -> np.ndarray:
     """Error transforms (..., 4, 4) between model and experimental poses of one bone, frame by frame.
 
     expressed_in="bone" (default): E = T_exp⁻¹ · T_model, the model bone's pose relative to the
@@ -200,7 +209,9 @@ def _error_transform(m: np.ndarray, e: np.ndarray, expressed_in: str) -> np.ndar
     raise InputError(f"expressed_in must be one of {EXPRESSED_IN}, but got {expressed_in!r}.")
 
 
-def error_dof(model, experiment, reference_point=None, *, expressed_in: str = "bone") -> np.ndarray:
+def error_dof(
+    model: ArrayLike, experiment: ArrayLike, reference_point: ArrayLike | None = None, *, expressed_in: str = "bone"
+) -> np.ndarray:
     """Six-DOF error (..., 6) of model vs experimental poses (..., 4, 4) (mm, deg), model minus experiment.
 
     The rotation DOF are the Cardan Z-X-Y angles of the error transform's rotation; the
@@ -232,7 +243,9 @@ def pose_to_dof_validated(poses: np.ndarray, point: np.ndarray) -> np.ndarray:
     return _dof(poses, point)
 
 
-def rmse(model, experiment, reference_point=None, *, expressed_in: str = "bone") -> np.ndarray:
+def rmse(
+    model: ArrayLike, experiment: ArrayLike, reference_point: ArrayLike | None = None, *, expressed_in: str = "bone"
+) -> np.ndarray:
     """Per-DOF root mean squared error (..., 6) over frames (mm, deg) of poses (..., n_frames, 4, 4).
 
     The RMSE of error_dof over the frame axis (axis −3 of the poses), as in the preprint's Tables 3–4.

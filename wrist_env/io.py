@@ -16,16 +16,23 @@ import os
 import time
 import uuid
 import zipfile
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 
 from wrist_env.errors import StoreError
 
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
+
+_D = TypeVar("_D", bound="DataclassInstance")
+
 FORMAT_VERSION = 1
 
 
-def save_dataclass(obj, path) -> None:
+def save_dataclass(obj: DataclassInstance, path: str | Path) -> None:
     """Write `path.npz` and `path.json` for the frozen dataclass `obj`."""
     path = Path(path)
     arrays, meta = {}, {}
@@ -49,7 +56,7 @@ def save_dataclass(obj, path) -> None:
     atomic_write(path.with_suffix(".json"), lambda p: Path(p).write_text(text))
 
 
-def load_dataclass(cls, path):
+def load_dataclass(cls: type[_D], path: str | Path) -> _D:
     """Read an instance of `cls` written by `save_dataclass`; `StoreError` naming the file if the
     pair is damaged, its `.npz` is not the one the `.json` was written with, or a field is missing."""
     path = Path(path)
@@ -118,7 +125,7 @@ def _fsync_dir(folder: Path) -> None:
         os.close(fd)
 
 
-def atomic_write(path, write) -> Path:
+def atomic_write(path: str | Path, write: Callable[[Path], object]) -> Path:
     """Write a file whole or not at all: `write(tmp_path)` to a hidden name in the same folder,
     fsync, `os.replace` onto `path`, fsync the folder. A reader, or a writer killed midway, never
     sees half a file; a killed writer leaves at most a `.<name>.<hex>.tmp` (`clean_temporary`)."""
@@ -136,7 +143,7 @@ def atomic_write(path, write) -> Path:
     return path
 
 
-def clean_temporary(folder, min_age_s: float = 0.0) -> int:
+def clean_temporary(folder: str | Path, min_age_s: float = 0.0) -> int:
     """Remove the temporary files killed `atomic_write`s left in `folder` (those at least `min_age_s`
     old: a live writer's file is younger); returns how many."""
     folder = Path(folder)
@@ -153,13 +160,13 @@ def clean_temporary(folder, min_age_s: float = 0.0) -> int:
     return removed
 
 
-def write_json(path, data) -> Path:
+def write_json(path: str | Path, data: object) -> Path:
     """Strict JSON (no NaN; sorted keys), atomically (`atomic_write`)."""
     text = json.dumps(data, indent=1, allow_nan=False, sort_keys=True, default=_jsonable) + "\n"
     return atomic_write(path, lambda p: Path(p).write_text(text))
 
 
-def read_json(path, what: str = "file", advice: str = "") -> dict | list:
+def read_json(path: str | Path, what: str = "file", advice: str = "") -> dict | list:
     """The JSON in `path`; `StoreError` naming the file (and `advice`) if it is missing, truncated or garbage."""
     path = Path(path)
     try:

@@ -9,8 +9,10 @@ points. Ragged per-bone or per-pair data are concatenated with offsets, so
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from wrist_env.io import load_dataclass, save_dataclass
 
@@ -132,16 +134,16 @@ class Model:
         i = BONES.index(bone)
         return self.grid_values[self.grid_offsets[i] : self.grid_offsets[i + 1]].reshape(self.grid_shape[i])
 
-    def save(self, path) -> None:
+    def save(self, path: str | Path) -> None:
         """Write `path.npz` + `path.json`."""
         save_dataclass(self, path)
 
     @classmethod
-    def load(cls, path) -> "Model":
+    def load(cls, path: str | Path) -> "Model":
         """Read a model written by `save`."""
         return load_dataclass(cls, path)
 
 
-def offsets(sizes) -> np.ndarray:
+def offsets(sizes: ArrayLike) -> np.ndarray:
     """Offsets (n + 1,) of concatenated items of the given sizes."""
     return np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)

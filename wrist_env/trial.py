@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from numpy.typing import ArrayLike
 
 from wrist_env.errors import TrialError
 from wrist_env.frames import validate_poses
@@ -79,7 +80,7 @@ def mirror_trial(trial: Trial) -> Trial:
     return Trial(trial.name, trial.role, trial.bones, MIRROR @ trial.transforms @ MIRROR)
 
 
-def validate_transforms(array, source: str, bones: tuple[str, ...] | None = None) -> np.ndarray:
+def validate_transforms(array: ArrayLike, source: str, bones: tuple[str, ...] | None = None) -> np.ndarray:
     """The transforms as float64 array of shape (..., 4, 4), or a TrialError naming `source` and the entry.
 
     Rules: finite; bottom row 0 0 0 1; rotation orthonormal (max |RᵀR − I| <= 1e-4) and proper
@@ -112,7 +113,7 @@ def validate_transforms(array, source: str, bones: tuple[str, ...] | None = None
 
 
 def read_trial_csv(
-    path,
+    path: str | Path,
     name: str,
     role: str,
     required_bones: tuple[str, ...] = REQUIRED_BONES,
@@ -192,7 +193,7 @@ def read_trial_csv(
     return Trial(name, role, bones, transforms)
 
 
-def write_trial_csv(trial: Trial, path) -> None:
+def write_trial_csv(trial: Trial, path: str | Path) -> None:
     """Write the trial as CSV (rows frame-major, bones in BONES order; exact float round trip)."""
     n_bones, n_frames = trial.transforms.shape[:2]
     matrix = trial.transforms[:, :, :3, :].transpose(1, 0, 2, 3).reshape(n_frames * n_bones, 12)

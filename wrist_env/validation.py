@@ -14,14 +14,20 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from wrist_env import design as design_mod
-from wrist_env.model import BONES, PAIRS
+from wrist_env.model import BONES, PAIRS, Model
 from wrist_env.solver.simulate import IDEALIZED_LOAD_N
+
+if TYPE_CHECKING:
+    from wrist_env.builder.pipeline import BuildParams
 
 SLIL = ("SLIL_v", "SLIL_p", "SLIL_d")
 EXTENSION_30_DEG = -30.0  # flexion + / extension −, as the idealized driver's angle_deg
@@ -127,7 +133,7 @@ def _list(a):
 # -- measures ------------------------------------------------------------------------------------------------
 
 
-def slope(x, y) -> float:
+def slope(x: ArrayLike, y: ArrayLike) -> float:
     """Least-squares slope of y against x over the finite pairs; NaN if x does not vary."""
     x, y = np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64)
     ok = np.isfinite(x) & np.isfinite(y)
@@ -138,7 +144,9 @@ def slope(x, y) -> float:
     return float(dx @ (y - y.mean()) / (dx @ dx))
 
 
-def surface_gap_mm(a_mesh, b_mesh, a_poses, b_poses) -> np.ndarray:
+def surface_gap_mm(
+    a_mesh: tuple[ArrayLike, ArrayLike], b_mesh: tuple[ArrayLike, ArrayLike], a_poses: ArrayLike, b_poses: ArrayLike
+) -> np.ndarray:
     """Minimum distance (mm) between two posed triangle surfaces at each frame.
 
     a_mesh, b_mesh: (vertices (n, 3), faces (m, 3)) at the neutral pose; a_poses, b_poses (n_frames, 4, 4)
@@ -169,13 +177,13 @@ def surface_gap_mm(a_mesh, b_mesh, a_poses, b_poses) -> np.ndarray:
     return out
 
 
-def sl_gap_mm(model, poses) -> np.ndarray:
+def sl_gap_mm(model: Model, poses: np.ndarray) -> np.ndarray:
     """Scapholunate gap (mm) per frame of a Result's poses (n_frames, 5, 4, 4): bone surface to bone surface."""
     s, l = BONES.index("scaphoid"), BONES.index("lunate")
     return surface_gap_mm(model.part_mesh("scaphoid"), model.part_mesh("lunate"), poses[:, s], poses[:, l])
 
 
-def with_tears(d: design_mod.Design, names) -> design_mod.Design:
+def with_tears(d: design_mod.Design, names: Iterable[str]) -> design_mod.Design:
     """A copy of the design with the named injurable ligaments torn (injury scalar −1)."""
     injury = np.array(d.injury, dtype=np.float64)
     for n in names:
@@ -183,7 +191,7 @@ def with_tears(d: design_mod.Design, names) -> design_mod.Design:
     return dataclasses.replace(d, injury=injury)
 
 
-def at_angle(angle_deg, values, target_deg: float) -> float:
+def at_angle(angle_deg: ArrayLike, values: ArrayLike, target_deg: float) -> float:
     """`values` at the capitate angle `target_deg`, linear between the sweep's frames (NaN outside)."""
     a, v = np.asarray(angle_deg, dtype=np.float64), np.asarray(values, dtype=np.float64)
     order = np.argsort(a)
@@ -212,10 +220,10 @@ def _failure(label, result) -> str | None:
 def validate(
     name: str,
     *,
-    model=None,
+    model: Model | None = None,
     d: design_mod.Design | None = None,
     n_frames: int = 17,
-    params=None,
+    params: BuildParams | None = None,
     load_n: float = IDEALIZED_LOAD_N,
 ) -> Report:
     """Run the published-measurement checks on participant `name` (population design by default).

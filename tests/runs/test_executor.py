@@ -49,7 +49,9 @@ def test_local_workers_die_with_their_parent(tmp_path):
     proc = subprocess.Popen([sys.executable, str(path)], stdout=subprocess.PIPE, text=True)
     try:
         assert proc.stdout.readline().strip() == "ready"
-        workers = [c for c in psutil.Process(proc.pid).children(recursive=True) if "spawn_main" in " ".join(c.cmdline())]
+        workers = [
+            c for c in psutil.Process(proc.pid).children(recursive=True) if "spawn_main" in " ".join(c.cmdline())
+        ]
         assert len(workers) == 2
         os.kill(proc.pid, signal.SIGKILL)
         proc.wait(timeout=30)

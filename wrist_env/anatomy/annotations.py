@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import igl
 import numpy as np
+from numpy.typing import ArrayLike
 
 from wrist_env.anatomy.template import load_template
 from wrist_env.design import ALL_LIGAMENT_NAMES, LIGAMENT_NAMES
@@ -52,7 +53,13 @@ def read_annotation_data() -> dict:
     return json.loads(path.read_text())
 
 
-def facing_within(vertices, normals, partner_vertices, partner_faces, max_gap_mm) -> np.ndarray:
+def facing_within(
+    vertices: ArrayLike,
+    normals: ArrayLike,
+    partner_vertices: np.ndarray,
+    partner_faces: np.ndarray,
+    max_gap_mm: float,
+) -> np.ndarray:
     """Bool mask: vertices within `max_gap_mm` of the partner surface whose normal faces it."""
     d2, _, closest = igl.point_mesh_squared_distance(
         np.ascontiguousarray(vertices, dtype=np.float64), partner_vertices, partner_faces

@@ -22,8 +22,11 @@ volar, y proximal, z radial), mm.
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
+
 import numpy as np
 import trimesh
+from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
 from wrist_env.errors import BuildError
@@ -31,7 +34,9 @@ from wrist_env.errors import BuildError
 SWEEP_STEPS = (9, 5)  # poses per axis of a swept range
 
 
-def fossa_points(row_meshes, radius_mesh, *, facing=0.3, reach_mm=8.0) -> np.ndarray:
+def fossa_points(
+    row_meshes: Iterable[trimesh.Trimesh], radius_mesh: trimesh.Trimesh, *, facing: float = 0.3, reach_mm: float = 8.0
+) -> np.ndarray:
     """Proximal-row vertices that face the radius: normal·y > `facing`, within `reach_mm` of it.
 
     Returns array of shape (n, 3), mm.
@@ -48,7 +53,9 @@ def fossa_points(row_meshes, radius_mesh, *, facing=0.3, reach_mm=8.0) -> np.nda
     return points
 
 
-def offset_heightfield(footprint, row_points, *, joint_space_mm=1.5, spacing_mm=0.5):
+def offset_heightfield(
+    footprint: np.ndarray, row_points: np.ndarray, *, joint_space_mm: float = 1.5, spacing_mm: float = 0.5
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Height y(x, z) of the envelope at `joint_space_mm` proximal to the row.
 
     The envelope is taken over all `row_points` (so no point comes closer than
@@ -79,14 +86,21 @@ def offset_heightfield(footprint, row_points, *, joint_space_mm=1.5, spacing_mm=
     return xs, zs, fill_creases(height.reshape(X.shape), sigma_cells=1.5)
 
 
-def sphere_centre(points) -> np.ndarray:
+def sphere_centre(points: np.ndarray) -> np.ndarray:
     """Centre (3,) mm of the least-squares sphere through `points` (n, 3)."""
     A = np.column_stack([2.0 * points, np.ones(len(points))])
     b = (points**2).sum(axis=1)
     return np.linalg.lstsq(A, b, rcond=None)[0][:3]
 
 
-def swept(points, centre, flexion_deg, deviation_deg, *, steps=SWEEP_STEPS):
+def swept(
+    points: np.ndarray,
+    centre: ArrayLike,
+    flexion_deg: float,
+    deviation_deg: float,
+    *,
+    steps: tuple[int, int] = SWEEP_STEPS,
+) -> np.ndarray:
     """`points` (n, 3) turned about `centre` through a grid of flexion (z) and deviation (x)
     angles (deg), stacked: array of shape (n × poses, 3)."""
     from scipy.spatial.transform import Rotation
@@ -99,7 +113,7 @@ def swept(points, centre, flexion_deg, deviation_deg, *, steps=SWEEP_STEPS):
     return np.concatenate(out)
 
 
-def fill_creases(height, sigma_cells=1.5):
+def fill_creases(height: np.ndarray, sigma_cells: float = 1.5) -> np.ndarray:
     """Smooth the envelope's creases upwards: max(Gaussian-smoothed height, height), NaN kept.
 
     The envelope of balls is the lowest surface that keeps the joint space; its
@@ -125,7 +139,7 @@ def _largest_component(mask: np.ndarray) -> np.ndarray:
     return labels == (1 + int(np.argmax(sizes)))
 
 
-def extrude_heightfield(xs, zs, height, *, depth_mm=4.0) -> trimesh.Trimesh:
+def extrude_heightfield(xs: ArrayLike, zs: ArrayLike, height: np.ndarray, *, depth_mm: float = 4.0) -> trimesh.Trimesh:
     """Watertight solid: the heightfield as top (articular) surface, a flat base `depth_mm` proximal.
 
     Cells with all four corners defined are kept (largest connected patch);
@@ -167,16 +181,16 @@ def extrude_heightfield(xs, zs, height, *, depth_mm=4.0) -> trimesh.Trimesh:
 
 
 def build_radius_cap(
-    row_meshes,
-    radius_mesh,
+    row_meshes: Sequence[trimesh.Trimesh],
+    radius_mesh: trimesh.Trimesh,
     *,
-    joint_space_mm=1.5,
-    spacing_mm=0.4,
-    depth_mm=4.0,
-    sample_mm=0.15,
-    sweep_deg=(0.0, 0.0),
-    swept_sample_mm=0.25,
-):
+    joint_space_mm: float = 1.5,
+    spacing_mm: float = 0.4,
+    depth_mm: float = 4.0,
+    sample_mm: float = 0.15,
+    sweep_deg: tuple[float, float] = (0.0, 0.0),
+    swept_sample_mm: float = 0.25,
+) -> tuple[trimesh.Trimesh, np.ndarray]:
     """The rebuilt distal radius articular solid and its articular (top) vertex mask.
 
     row_meshes: the scaphoid and lunate. sweep_deg: (flexion, deviation) half-ranges of the

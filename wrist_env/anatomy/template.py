@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import trimesh
+from numpy.typing import ArrayLike
 
 from wrist_env.anatomy.midcarpal import DISTAL_ROW, read_seat
 from wrist_env.anatomy.myosim import load_myosim_anatomy
@@ -130,7 +131,9 @@ def carry_parts(bodies: dict, template: "Template") -> dict:
     return compose(parts, True)
 
 
-def rcs_rotation(radius: trimesh.Trimesh, carpus_centroid, flexor_sites, extensor_sites) -> np.ndarray:
+def rcs_rotation(
+    radius: trimesh.Trimesh, carpus_centroid: ArrayLike, flexor_sites: np.ndarray, extensor_sites: np.ndarray
+) -> np.ndarray:
     """Rows x (volar), y (proximal), z (radial) of the RCS in the myo-sim frame."""
     centred = radius.vertices - radius.vertices.mean(axis=0)
     y = np.linalg.svd(centred, full_matrices=False)[2][0]

@@ -2,12 +2,17 @@
 calibrators × seeds (`benchmark`), its Parquet run log (`RunLog`) and the leaderboards
 (`write_leaderboard`). `wrist-bench calibrate | benchmark | leaderboard` are the commands."""
 
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
 from wrist_env.bench.calibrate import CalibrationRun, ResumeError, calibrate
 from wrist_env.bench.log import DuplicateEvaluationError, RunKey, RunLog
 from wrist_env.bench.runner import BenchmarkReport, benchmark
 
 
-def write_leaderboard(runs, out, **kwargs):
+def write_leaderboard(runs: str | Path, out: str | Path, **kwargs: Any) -> Path:
     """Write the leaderboards of the run log in `runs` to the folder `out` (see `leaderboard`)."""
     from wrist_env.bench.leaderboard import write_leaderboard as write
 

@@ -17,16 +17,22 @@ their logged values are told without simulating), then the run continues.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from wrist_env import design as design_vars
 from wrist_env.bench.log import X_COLUMNS, RunKey, RunLog
 from wrist_env.cost import COST_BONES
 from wrist_env.design import N_MATERIAL, Design
 from wrist_env.frames import DOF_NAMES
+
+if TYPE_CHECKING:
+    from optuna.storages import BaseStorage, RDBStorage
 
 REPLAY_TOLERANCE = 1e-9
 """Largest |asked − logged| (normalized units) accepted when replaying a logged batch."""
@@ -36,7 +42,7 @@ class ResumeError(RuntimeError):
     """A calibrator did not ask again for the points it asked before (it is not deterministic)."""
 
 
-def action(x) -> np.ndarray:
+def action(x: ArrayLike) -> np.ndarray:
     """The 27-variable action(s) of 22 normalized materials (..., 22), injury scalars intact (+1)."""
     from wrist_env.envs.wrappers import full_action
 
@@ -63,7 +69,7 @@ def accepts_storage(cls) -> bool:
     return bool(getattr(cls, "accepts_storage", False))
 
 
-def open_storage(url: str):
+def open_storage(url: str) -> str | RDBStorage:
     """An Optuna storage for a URL; SQLite files get WAL journaling and no fsync per commit.
 
     Each commit of Optuna's SQLite storage is otherwise fsynced, which made a
@@ -170,10 +176,10 @@ def calibrate(
     budget: int,
     seed: int,
     *,
-    log=None,
-    storage=None,
+    log: RunLog | str | Path | None = None,
+    storage: str | BaseStorage | None = None,
     options: dict | None = None,
-    callback=None,
+    callback: Callable[[int, int], object] | None = None,
 ) -> CalibrationRun:
     """Calibrate the 22 materials of `participant` with the calibrator `optimizer_name`.
 

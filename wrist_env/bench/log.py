@@ -28,12 +28,15 @@ from __future__ import annotations
 import os
 import re
 import time
+from contextlib import AbstractContextManager
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
+from numpy.typing import ArrayLike
 
 from wrist_env.cost import COST_BONES
 from wrist_env.design import N_MATERIAL, NAMES
@@ -41,6 +44,9 @@ from wrist_env.errors import StoreError
 from wrist_env.frames import DOF_NAMES
 from wrist_env.io import atomic_write
 from wrist_env.runs.store import RunStore, read_parquet
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 KEY_FIELDS = ("participant", "optimizer", "seed", "budget")
 X_COLUMNS = tuple(f"x.{n}" for n in NAMES[:N_MATERIAL])
@@ -107,7 +113,9 @@ class RunLog:
 
     # writing
 
-    def append(self, key: RunKey, batch: int, start: int, x: np.ndarray, cost, failed, rmse: np.ndarray) -> Path:
+    def append(
+        self, key: RunKey, batch: int, start: int, x: np.ndarray, cost: ArrayLike, failed: ArrayLike, rmse: np.ndarray
+    ) -> Path:
         """Log one batch: evaluations start … start + k − 1 of `key`, atomically, never twice.
 
         x (k, 22) normalized materials; cost (k,); failed (k,); rmse (k, 12) in `RMSE_COLUMNS` order.
@@ -161,7 +169,7 @@ class RunLog:
     def write_summary(self, key: RunKey, summary: dict) -> Path:
         return self.store.write_record(key.name, summary)
 
-    def lock(self, key: RunKey):
+    def lock(self, key: RunKey) -> AbstractContextManager[None]:
         """Hold the cell's lock (an flock, released when the process dies) while running it."""
         return self.store.lock(key.name, what=f"cell {key.name}")
 
@@ -232,7 +240,7 @@ class RunLog:
     def _table(self, files) -> pa.Table:
         return pa.concat_tables([read_parquet(p, SCHEMA, advice=RERUN) for p in files])
 
-    def read(self, *, dedupe: bool = True):
+    def read(self, *, dedupe: bool = True) -> pd.DataFrame:
         """Every logged evaluation as a pandas DataFrame (sorted by run key and eval), duplicates dropped."""
         import pandas as pd
 
@@ -244,7 +252,7 @@ class RunLog:
             frame = frame.drop_duplicates(subset=list(KEY_FIELDS) + ["eval"], keep="first")
         return frame.sort_values(list(KEY_FIELDS) + ["eval"], kind="stable").reset_index(drop=True)
 
-    def read_cell(self, key: RunKey):
+    def read_cell(self, key: RunKey) -> pd.DataFrame | None:
         """The cell's rows (DataFrame sorted by eval, duplicates dropped), or None if nothing is logged."""
         files = self._files(key)
         if not files:

@@ -19,11 +19,16 @@ from __future__ import annotations
 import itertools
 import os
 import time
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from wrist_env.bench.log import RunKey, RunLog
 from wrist_env.runs.executor import describe, executor, set_threads
+
+if TYPE_CHECKING:
+    from distributed import Client
 
 
 @dataclass
@@ -45,7 +50,9 @@ class BenchmarkReport:
         return sum(RunLog(self.out_dir).progress().get(k.name, 0) for k in self.cells)
 
 
-def make_cells(participants, optimizers, seeds, budget: int) -> list[RunKey]:
+def make_cells(
+    participants: Sequence[str], optimizers: Sequence[str], seeds: int | Iterable[int], budget: int
+) -> list[RunKey]:
     """The cross product participants × optimizers × seeds (seeds: a count n → 0 … n−1, or a list)."""
     seeds = list(range(seeds)) if isinstance(seeds, int) else [int(s) for s in seeds]
     if budget < 1 or not seeds or not participants or not optimizers:
@@ -59,7 +66,7 @@ STORAGE_PER_CELL = "{cell}"
 """Placeholder in a storage URL, replaced by the cell's key name (one database per cell)."""
 
 
-def default_storage(out_dir) -> str:
+def default_storage(out_dir: str | Path) -> str:
     """The Optuna storage of a run directory: a SQLite file per cell, `optuna/<cell>.db`, whose study is
     named by the cell's key. (One file shared by parallel workers made Optuna cells 2× slower: SQLite's
     writers wait on each other's locks.)"""
@@ -83,7 +90,7 @@ def run_cell(
     options: dict | None = None,
     threads: int | None = None,
     folders: tuple = (),
-    callback=None,
+    callback: Callable[[int, int], object] | None = None,
 ) -> dict:
     """Run (or resume, or skip) one cell; returns {"status": "ran" | "skipped", "summary": {...}}.
 
@@ -116,19 +123,19 @@ def run_cell(
 
 
 def benchmark(
-    participants,
-    optimizers,
-    seeds,
+    participants: Sequence[str],
+    optimizers: Sequence[str],
+    seeds: int | Iterable[int],
     budget: int,
-    out_dir,
+    out_dir: str | Path,
     *,
     workers: int | None = None,
-    scheduler=None,
+    scheduler: str | Client | None = None,
     progress: bool = True,
     storage: str | None = None,
     threads: int | None = None,
     options: dict | None = None,
-    folders=(),
+    folders: Sequence[str | Path] = (),
 ) -> BenchmarkReport:
     """Run every cell of participants × optimizers × seeds with `budget` evaluations into `out_dir`.
 

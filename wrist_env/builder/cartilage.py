@@ -23,6 +23,7 @@ import igl
 import numpy as np
 import scipy.sparse
 import trimesh
+from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
 from wrist_env.errors import BuildError, InputError, MeshError
@@ -94,7 +95,9 @@ def _articulations(vertices: dict, faces: dict, articulations: dict) -> tuple[di
     return v, f, arts
 
 
-def gap_to(vertices_a, cover_a, vertices_b, faces_b, cover_b) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def gap_to(
+    vertices_a: ArrayLike, cover_a: ArrayLike, vertices_b: ArrayLike, faces_b: ArrayLike, cover_b: ArrayLike
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Gap from each covered vertex of A to B's covered triangles (all three vertices covered).
 
     Returns distance (n_cov,) mm, closest points (n_cov, 3) mm and face ids (n_cov,) into `faces_b`.
@@ -109,7 +112,9 @@ def gap_to(vertices_a, cover_a, vertices_b, faces_b, cover_b) -> tuple[np.ndarra
     return np.sqrt(d2), closest, face_ids[i]
 
 
-def grnn_smooth(points, values, bandwidth_mm: float, query=None) -> np.ndarray:
+def grnn_smooth(
+    points: ArrayLike, values: ArrayLike, bandwidth_mm: float, query: ArrayLike | None = None
+) -> np.ndarray:
     """Generalized regression neural network (Gaussian-kernel Nadaraya–Watson) estimate at `query`.
 
     points: (n, 3) mm; values: (n,) or (n, k); query: (q, 3) mm, default `points`; bandwidth_mm:
@@ -141,10 +146,10 @@ def thickness_fields(
     faces: dict,
     articulations: dict,
     *,
-    share=0.5,
-    bandwidth_mm=1.0,
-    min_thickness_mm=0.1,
-    max_thickness_mm=1.1,
+    share: float = 0.5,
+    bandwidth_mm: float = 1.0,
+    min_thickness_mm: float = 0.1,
+    max_thickness_mm: float = 1.1,
 ) -> dict:
     """Cartilage thickness per vertex (mm, shape (n,), zero off coverage) of every articulated bone.
 
@@ -173,14 +178,16 @@ def thickness_fields(
     return thickness
 
 
-def vertex_normals(vertices, faces) -> np.ndarray:
+def vertex_normals(vertices: ArrayLike, faces: ArrayLike) -> np.ndarray:
     """Area-weighted unit vertex normals, shape (n, 3); zero at vertices no face uses."""
     v = _vertices(vertices, "mesh")
     normals = igl.per_vertex_normals(v, _faces(faces, len(v), "mesh"), igl.PER_VERTEX_NORMALS_WEIGHTING_TYPE_AREA)
     return np.nan_to_num(normals)
 
 
-def extrusion_directions(vertices, faces, covered, *, smoothing_mm=NORMAL_SMOOTHING_MM) -> np.ndarray:
+def extrusion_directions(
+    vertices: ArrayLike, faces: ArrayLike, covered: ArrayLike, *, smoothing_mm: float = NORMAL_SMOOTHING_MM
+) -> np.ndarray:
     """Unit extrusion directions, shape (n, 3): area-weighted vertex normals, smoothed over the
     covered vertices (bool (n,)) by a Gaussian kernel of σ = `smoothing_mm` (0: no smoothing)."""
     v = _vertices(vertices, "mesh")
@@ -193,7 +200,9 @@ def extrusion_directions(vertices, faces, covered, *, smoothing_mm=NORMAL_SMOOTH
     return normals
 
 
-def displaced_vertices(vertices, faces, thickness, *, smoothing_mm=NORMAL_SMOOTHING_MM) -> np.ndarray:
+def displaced_vertices(
+    vertices: ArrayLike, faces: ArrayLike, thickness: ArrayLike, *, smoothing_mm: float = NORMAL_SMOOTHING_MM
+) -> np.ndarray:
     """Bone-plus-cartilage vertices, shape (n, 3), mm: each vertex moved outward by its thickness
     (mm, shape (n,)) along its extrusion direction (see `extrusion_directions`)."""
     v = _vertices(vertices, "mesh")
@@ -206,7 +215,7 @@ def displaced_vertices(vertices, faces, thickness, *, smoothing_mm=NORMAL_SMOOTH
     return v + t[:, None] * extrusion_directions(v, faces, t > 0, smoothing_mm=smoothing_mm)
 
 
-def closed_face_mask(faces) -> np.ndarray:
+def closed_face_mask(faces: ArrayLike) -> np.ndarray:
     """Bool (m,): faces of the watertight connected components of a mesh (components joined across
     edges of exactly two faces; one with an edge of one face, or of more than two, is open)."""
     f = np.asarray(faces, dtype=np.int64)
@@ -217,7 +226,7 @@ def closed_face_mask(faces) -> np.ndarray:
     return ~np.isin(component, component[open_edge])
 
 
-def closed_faces(faces) -> np.ndarray:
+def closed_faces(faces: ArrayLike) -> np.ndarray:
     """Faces of the watertight connected components of a mesh, shape (k, 3); all faces if none is watertight."""
     f = np.asarray(faces, dtype=np.int64)
     closed = closed_face_mask(f)
@@ -241,7 +250,13 @@ def _penetration(points, target_vertices, target_faces, target_thickness, reach_
 
 
 def remove_overclosure(
-    vertices: dict, faces: dict, thickness: dict, articulations: dict, *, clearance_mm=0.0, max_iter=20
+    vertices: dict,
+    faces: dict,
+    thickness: dict,
+    articulations: dict,
+    *,
+    clearance_mm: float = 0.0,
+    max_iter: int = 20,
 ) -> tuple[dict, dict]:
     """Thinner cartilage so that no articulation's bone-plus-cartilage surfaces interpenetrate (neutral pose).
 
@@ -298,7 +313,7 @@ def remove_overclosure(
     return t, report
 
 
-def extrude_wedges(vertices, faces, thickness) -> tuple[np.ndarray, np.ndarray]:
+def extrude_wedges(vertices: ArrayLike, faces: ArrayLike, thickness: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """6-node wedges under the triangles whose three vertices carry cartilage.
 
     Returns nodes (2 n_c, 3) mm (bone-surface nodes, then the displaced ones) and wedges (m, 6)
@@ -316,7 +331,7 @@ def extrude_wedges(vertices, faces, thickness) -> tuple[np.ndarray, np.ndarray]:
     return nodes, np.hstack([bottom, bottom + len(ids)]).astype(np.int64)
 
 
-def wedge_quality(nodes, wedges) -> dict:
+def wedge_quality(nodes: ArrayLike, wedges: ArrayLike) -> dict:
     """Mesh quality of 6-node wedges: element count, aspect ratio (max / min edge: min, median, max),
     minimum interior angle of the triangular faces (degrees: min, 5th percentile), inverted elements
     (a sub-tetrahedron with signed volume <= 0) and total volume (mm³)."""
@@ -345,7 +360,7 @@ def _r(x) -> float:
     return round(float(x), 4)
 
 
-def cartilage_layer(bone: str, vertices, faces, thickness) -> CartilageLayer:
+def cartilage_layer(bone: str, vertices: ArrayLike, faces: ArrayLike, thickness: ArrayLike) -> CartilageLayer:
     """One bone's cartilage layer (thickness mm of shape (n,)) with its wedge mesh."""
     nodes, wedges = extrude_wedges(vertices, faces, thickness)
     f = np.asarray(faces, dtype=np.int64)
@@ -359,12 +374,12 @@ def build_cartilage(
     faces: dict,
     articulations: dict,
     *,
-    share=0.5,
-    bandwidth_mm=1.0,
-    min_thickness_mm=0.1,
-    max_thickness_mm=1.1,
-    clearance_mm=0.0,
-    max_iter=20,
+    share: float = 0.5,
+    bandwidth_mm: float = 1.0,
+    min_thickness_mm: float = 0.1,
+    max_thickness_mm: float = 1.1,
+    clearance_mm: float = 0.0,
+    max_iter: int = 20,
 ) -> tuple[dict, dict]:
     """Thickness fields, overclosure removal and wedge meshes of every articulated bone.
 

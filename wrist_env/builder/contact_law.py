@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.optimize import least_squares
 
 from wrist_env.errors import BuildError, InputError
@@ -24,7 +25,7 @@ D1_PER_MPA = 0.0475
 
 
 def mooney_rivlin_confined_pressure(
-    strain, c10: float = C10_MPA, c01: float = C01_MPA, d1: float = D1_PER_MPA
+    strain: ArrayLike, c10: float = C10_MPA, c01: float = C01_MPA, d1: float = D1_PER_MPA
 ) -> np.ndarray:
     """Nominal compressive stress (MPa, positive in compression) of a confined Mooney–Rivlin layer.
 
@@ -72,7 +73,7 @@ class TrilinearLaw:
             if not getattr(self, name) > 0:
                 raise InputError(f"`{name} > 0` must hold, but got {name}={getattr(self, name)}.")
 
-    def pressure(self, strain) -> np.ndarray:
+    def pressure(self, strain: ArrayLike) -> np.ndarray:
         """Contact pressure (MPa) at nominal strain (scalar or array); array of strain's shape."""
         return _trilinear(strain, self.e1, self.e2, self.k1, self.k2, self.k3)
 

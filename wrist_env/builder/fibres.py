@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import igl
 import numpy as np
 import trimesh
+from numpy.typing import ArrayLike
 from scipy.interpolate import make_interp_spline
 from scipy.optimize import linear_sum_assignment
 from scipy.spatial import cKDTree
@@ -95,7 +96,7 @@ def _snap_distinct(targets: np.ndarray, points: np.ndarray) -> np.ndarray:
     return np.asarray(out, dtype=np.int64)
 
 
-def fibre_endpoints(patch_points, n_fibres: int, seed: int | None) -> tuple[np.ndarray, np.ndarray]:
+def fibre_endpoints(patch_points: ArrayLike, n_fibres: int, seed: int | None) -> tuple[np.ndarray, np.ndarray]:
     """Fibre endpoints on one attachment patch: K-means centres snapped to distinct patch points.
 
     patch_points: array of shape (m, 3), mm. Returns (points (n, 3) mm, index (n,)
@@ -111,7 +112,7 @@ def fibre_endpoints(patch_points, n_fibres: int, seed: int | None) -> tuple[np.n
     return p[index].copy(), index
 
 
-def pair_fibres(origins, insertions) -> np.ndarray:
+def pair_fibres(origins: ArrayLike, insertions: ArrayLike) -> np.ndarray:
     """Minimum-total-length pairing (Kuhn–Munkres): insertions[perm[i]] pairs with origins[i].
 
     origins, insertions: arrays of shape (n, 3), mm. Returns perm (n,), int64.
@@ -127,12 +128,12 @@ def pair_fibres(origins, insertions) -> np.ndarray:
 
 def build_bundle(
     name: str,
-    origin_points,
-    insertion_points,
+    origin_points: ArrayLike,
+    insertion_points: ArrayLike,
     n_fibres: int,
     seed: int | None,
-    origin_vertex_ids=None,
-    insertion_vertex_ids=None,
+    origin_vertex_ids: ArrayLike | None = None,
+    insertion_vertex_ids: ArrayLike | None = None,
 ) -> Bundle:
     """A bundle of n_fibres fibres between two attachment patches.
 
@@ -188,8 +189,8 @@ def _outward(mesh: trimesh.Trimesh, points: np.ndarray):
 
 
 def build_membrane(
-    radius_points,
-    capitate_points,
+    radius_points: ArrayLike,
+    capitate_points: ArrayLike,
     scaphoid_mesh: trimesh.Trimesh,
     n_along: int = 9,
     n_across: int = 5,

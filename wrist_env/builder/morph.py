@@ -12,11 +12,13 @@ carried over through it.
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import igl
 import numpy as np
 import trimesh
+from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
 from wrist_env.errors import InputError, MeshError
@@ -99,7 +101,13 @@ def _similarity(template: trimesh.Trimesh, target: trimesh.Trimesh, seed: int | 
 
 
 def morph(
-    template_vertices, template_faces, target_vertices, target_faces, *, steps=None, seed: int | None = 0
+    template_vertices: ArrayLike,
+    template_faces: ArrayLike,
+    target_vertices: ArrayLike,
+    target_faces: ArrayLike,
+    *,
+    steps: Sequence[tuple[float, float, float, int]] | None = None,
+    seed: int | None = 0,
 ) -> MorphResult:
     """Register the template bone onto the target bone (both in mm).
 
@@ -138,7 +146,7 @@ def morph(
     )
 
 
-def transfer_mask(result: MorphResult, template_mask, target_vertices) -> np.ndarray:
+def transfer_mask(result: MorphResult, template_mask: ArrayLike, target_vertices: ArrayLike) -> np.ndarray:
     """Bool mask of shape (p,) on the target vertices (p, 3), mm: the mask of each one's nearest morphed vertex.
 
     template_mask: bool array of shape (n,) on the template vertices.
@@ -159,7 +167,7 @@ def transfer_mask(result: MorphResult, template_mask, target_vertices) -> np.nda
     return mask[nearest]
 
 
-def transfer_points(result: MorphResult, template_vertex_ids) -> np.ndarray:
+def transfer_points(result: MorphResult, template_vertex_ids: ArrayLike) -> np.ndarray:
     """Morphed positions, array of shape (k, 3), mm, of template vertices given by ids of shape (k,)."""
     ids = np.asarray(template_vertex_ids)
     n = len(result.vertices)

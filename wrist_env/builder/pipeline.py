@@ -12,6 +12,7 @@ import json
 import os
 import time
 from dataclasses import asdict, dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import trimesh
@@ -23,6 +24,9 @@ from wrist_env.builder import cartilage, contact_law, fibres, mass, morph, sdf
 from wrist_env.design import ALL_LIGAMENTS, LIGAMENT_NAMES, LIGAMENTS, RSC_INDEX
 from wrist_env.errors import BuildError
 from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model, offsets
+
+if TYPE_CHECKING:
+    import argparse
 
 BUILDER_VERSION = 4  # 2: distal row and triquetrum as body parts, swept fossae; 3: both by default, TC and TH; 4: the distal row seated (anatomy.midcarpal)
 GRID_BONES = ("radius", "scaphoid", "lunate", "capitate")
@@ -68,7 +72,7 @@ class BuildParams:
         return (tuple(float(a) for a in self.fossa_sweep_deg), bool(self.distal_row))
 
 
-def add_anatomy_arguments(parser) -> None:
+def add_anatomy_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the anatomy-variant options (`--fossa-sweep`, `--no-distal-row`) to an argparse parser."""
     d = BuildParams()
     parser.add_argument(
@@ -96,7 +100,7 @@ def add_anatomy_arguments(parser) -> None:
     )
 
 
-def anatomy_params(args) -> BuildParams:
+def anatomy_params(args: argparse.Namespace) -> BuildParams:
     """The `BuildParams` of parsed `add_anatomy_arguments` options."""
     return BuildParams(
         fossa_sweep_deg=tuple(float(a) for a in args.fossa_sweep),

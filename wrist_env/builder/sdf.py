@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import igl
 import numpy as np
+from numpy.typing import ArrayLike
 
 
 @dataclass(frozen=True)
@@ -29,7 +30,9 @@ class DistanceGrid:
     values: np.ndarray
 
 
-def signed_distance_grid(vertices, faces, *, spacing_mm=0.5, margin_mm=3.0, band_mm=5.0) -> DistanceGrid:
+def signed_distance_grid(
+    vertices: ArrayLike, faces: ArrayLike, *, spacing_mm: float = 0.5, margin_mm: float = 3.0, band_mm: float = 5.0
+) -> DistanceGrid:
     """Grid over the surface's bounding box grown by `margin_mm`, at `spacing_mm`."""
     v = np.ascontiguousarray(vertices, dtype=np.float64)
     f = np.ascontiguousarray(faces, dtype=np.int64)
@@ -42,7 +45,7 @@ def signed_distance_grid(vertices, faces, *, spacing_mm=0.5, margin_mm=3.0, band
     return DistanceGrid(origin=lo, spacing_mm=float(spacing_mm), values=values)
 
 
-def trilinear(grid: DistanceGrid, points) -> tuple[np.ndarray, np.ndarray]:
+def trilinear(grid: DistanceGrid, points: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """Trilinear value (mm) and gradient of shape (n, 3) at `points` of shape (n, 3).
 
     Points outside the grid are clamped to its boundary cells (reference

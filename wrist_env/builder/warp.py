@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from wrist_env.errors import InputError, MeshError
 
@@ -99,18 +100,18 @@ class Warp:
 
     __hash__ = None
 
-    def displacement(self, points) -> np.ndarray:
+    def displacement(self, points: ArrayLike) -> np.ndarray:
         """RBF displacement d(x) before scaling, array of shape (n, 3), mm, at points of shape (n, 3), mm."""
         p = _points(points)
         g = self._gaussians(p)
         return g @ self.rbf_weights
 
-    def apply(self, points) -> np.ndarray:
+    def apply(self, points: ArrayLike) -> np.ndarray:
         """Warped points, array of shape (n, 3), mm, of points of shape (n, 3), mm."""
         p = _points(points)
         return self.centre + self.scale * (p - self.centre + self._gaussians(p) @ self.rbf_weights)
 
-    def jacobian(self, points) -> np.ndarray:
+    def jacobian(self, points: ArrayLike) -> np.ndarray:
         """Jacobian dy/dx, array of shape (n, 3, 3), at points of shape (n, 3), mm."""
         p = _points(points)
         g = self._gaussians(p)
@@ -119,7 +120,7 @@ class Warp:
         grad_d = np.einsum("ka,nkb->nab", self.rbf_weights, grad_g)  # d d_a / d x_b
         return self.scale * (np.eye(3) + grad_d)
 
-    def jacobian_det(self, points) -> np.ndarray:
+    def jacobian_det(self, points: ArrayLike) -> np.ndarray:
         """Jacobian determinant (local volume ratio), array of shape (n,), at points of shape (n, 3), mm."""
         return np.linalg.det(self.jacobian(points))
 
@@ -150,12 +151,12 @@ class Warp:
 def random_warp(
     seed: int | None,
     *,
-    scale_sd=0.05,
-    amplitude_mm=1.0,
-    width_mm=15.0,
-    centre=(0.0, 0.0, 0.0),
-    n_centres=6,
-    extent_mm=30.0,
+    scale_sd: float = 0.05,
+    amplitude_mm: float = 1.0,
+    width_mm: float = 15.0,
+    centre: ArrayLike = (0.0, 0.0, 0.0),
+    n_centres: int = 6,
+    extent_mm: float = 30.0,
 ) -> Warp:
     """A random warp, deterministic for a seed.
 
@@ -179,7 +180,7 @@ def random_warp(
     )
 
 
-def apply_to_mesh(vertices, faces, warp: Warp) -> np.ndarray:
+def apply_to_mesh(vertices: ArrayLike, faces: ArrayLike, warp: Warp) -> np.ndarray:
     """Warped vertices, array of shape (n, 3), mm; the faces of shape (m, 3) and their winding are unchanged."""
     v = np.asarray(vertices, dtype=np.float64)
     if v.ndim != 2 or v.shape[1] != 3:

@@ -3,9 +3,15 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+from typing import TYPE_CHECKING
+
 import gymnasium as gym
 
 from wrist_env.participants import builtin, registry
+
+if TYPE_CHECKING:
+    from pathlib import Path
 
 NAMESPACE = "wrist_env"
 MOTION_PREFIX = {"calibrate": "Calibrate", "validate": "Validate", "idealized": "Idealized"}
@@ -16,7 +22,7 @@ def env_id(participant: str, motion: str) -> str:
     return f"{NAMESPACE}/{MOTION_PREFIX[motion]}-{participant}-v0"
 
 
-def register_ids(participant: str, motions=tuple(MOTION_PREFIX)) -> tuple[str, ...]:
+def register_ids(participant: str, motions: Iterable[str] = tuple(MOTION_PREFIX)) -> tuple[str, ...]:
     """Register (once) and return the ids of a known participant's motions."""
     ids = []
     for motion in motions:
@@ -32,7 +38,7 @@ def register_ids(participant: str, motions=tuple(MOTION_PREFIX)) -> tuple[str, .
     return tuple(ids)
 
 
-def register_participant(folder) -> tuple[str, ...]:
+def register_participant(folder: str | Path) -> tuple[str, ...]:
     """Validate a participant folder (see the README's folder format) and register its ids.
 
     Returns the new ids: Calibrate and Idealized always, Validate when the folder

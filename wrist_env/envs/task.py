@@ -8,12 +8,14 @@ designs in, rewards and JSON-ready outputs out. Simulation is `simulate` /
 from __future__ import annotations
 
 import functools
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from wrist_env import design as design_vars
-from wrist_env.cost import COST_BONES, CostWeights, kinematic_cost
+from wrist_env.cost import COST_BONES, CostReport, CostWeights, kinematic_cost
 from wrist_env.design import ALL_LIGAMENT_NAMES, Design
 from wrist_env.model import BONES, PAIRS, Model
 from wrist_env.participants import builtin, registry
@@ -72,13 +74,13 @@ class Task:
         """Simulate one design and score it."""
         return self._score(design, simulate(self.model, design, self.driver, prepared=self.prepared))
 
-    def evaluate_batch(self, designs) -> list[Evaluation]:
+    def evaluate_batch(self, designs: Iterable[Design]) -> list[Evaluation]:
         """Simulate many designs at once (Numba prange); the same numbers as one at a time."""
         designs = list(designs)
         results = simulate_batch(self.model, designs, self.driver, prepared=self.prepared)
         return [self._score(d, r) for d, r in zip(designs, results)]
 
-    def evaluate_action(self, action) -> Evaluation:
+    def evaluate_action(self, action: ArrayLike) -> Evaluation:
         return self.evaluate(design_vars.from_action(action))
 
     def _score(self, design: Design, result: Result) -> Evaluation:
@@ -98,7 +100,7 @@ def _cost_poses(poses: np.ndarray) -> np.ndarray:
     return np.stack([poses[:, BONES.index(b)] for b in COST_BONES])
 
 
-def outputs(result: Result, report=None) -> dict:
+def outputs(result: Result, report: CostReport | None = None) -> dict:
     """JSON-ready, NaN-free per-frame outputs (a failed run's arrays are zeros, `failed` True)."""
 
     def clean(a):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import gymnasium as gym
 import numpy as np
+from numpy.typing import ArrayLike, DTypeLike
 
 from wrist_env import design
 
@@ -21,7 +22,7 @@ def split_variables(frozen: dict | None = None) -> tuple[np.ndarray, np.ndarray,
     return free_index, frozen_index, np.array([index[i] for i in frozen_index])
 
 
-def full_action(free, frozen: dict | None = None, dtype=np.float64) -> np.ndarray:
+def full_action(free: ArrayLike, frozen: dict | None = None, dtype: DTypeLike = np.float64) -> np.ndarray:
     """The 27-variable action(s), shape (..., 27), of the free variables' values (..., n_free) with
     the `frozen` ones (see `split_variables`) filled in."""
     free_index, frozen_index, frozen_value = split_variables(frozen)
@@ -46,5 +47,5 @@ class FreezeVariables(gym.ActionWrapper):
         self.free_index, self.frozen_index, self.frozen_value = split_variables(frozen)
         self.action_space = gym.spaces.Box(-1.0, 1.0, (len(self.free_index),), dtype=np.float32)
 
-    def action(self, action):
+    def action(self, action: ArrayLike) -> np.ndarray:
         return full_action(action, self.frozen, dtype=np.float32)

@@ -12,6 +12,7 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
+from numpy.typing import ArrayLike
 
 from wrist_env import design
 from wrist_env.envs.task import task
@@ -40,11 +41,11 @@ class WristEnv(gym.Env):
         self.task = task(participant, motion)
         self.action_space, self.observation_space = _spaces()
 
-    def reset(self, *, seed=None, options=None):
+    def reset(self, *, seed: int | None = None, options: dict | None = None) -> tuple[np.ndarray, dict]:
         super().reset(seed=seed)
         return OBSERVATION.copy(), {}
 
-    def step(self, action):
+    def step(self, action: ArrayLike) -> tuple[np.ndarray, float, bool, bool, dict]:
         evaluation = self.task.evaluate_action(action)
         return OBSERVATION.copy(), float(evaluation.reward), True, False, evaluation.info
 
@@ -65,11 +66,11 @@ class WristVectorEnv(VectorEnv):
     def _observations(self):
         return np.tile(OBSERVATION, (self.num_envs, 1))
 
-    def reset(self, *, seed=None, options=None):
+    def reset(self, *, seed: int | None = None, options: dict | None = None) -> tuple[np.ndarray, dict]:
         super().reset(seed=seed)
         return self._observations(), {}
 
-    def step(self, actions):
+    def step(self, actions: ArrayLike) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict]:
         actions = np.asarray(actions)
         if actions.shape != (self.num_envs, design.N_DESIGN):
             raise ValueError(f"actions must have shape ({self.num_envs}, {design.N_DESIGN}), but got {actions.shape}")

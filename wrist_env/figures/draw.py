@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import matplotlib
 
@@ -11,8 +12,13 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
+from numpy.typing import ArrayLike  # noqa: E402
 
 from wrist_env.design import ALL_LIGAMENT_NAMES  # noqa: E402
+
+if TYPE_CHECKING:
+    from matplotlib.typing import ColorType
+    from mpl_toolkits.mplot3d import Axes3D
 
 FIGURES = Path(os.environ.get("WRIST_ENV_FIGURES", Path("experiments") / "figures"))
 """Default folder of every figure: `$WRIST_ENV_FIGURES`, else experiments/figures under the working
@@ -28,13 +34,20 @@ VIEWS = (("volar view", 0, 0), ("radial view", 0, 90), ("oblique", 25, 40))
 LIGAMENT_COLOURS = dict(zip(ALL_LIGAMENT_NAMES, plt.get_cmap("tab10").colors + ("#000000", "#7a5195", "#ef5675")))
 
 
-def to_plot(p):
+def to_plot(p: ArrayLike) -> np.ndarray:
     """RCS (x volar, y proximal, z radial) to plot axes (radial right, volar towards the viewer, proximal up)."""
     p = np.asarray(p)
     return np.stack([p[..., 2], -p[..., 0], p[..., 1]], axis=-1)
 
 
-def add_mesh(ax, vertices, faces, colour, alpha=1.0, facecolors=None):
+def add_mesh(
+    ax: Axes3D,
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    colour: ColorType | None,
+    alpha: float = 1.0,
+    facecolors: ArrayLike | None = None,
+) -> None:
     tris = to_plot(vertices[faces])
     coll = Poly3DCollection(
         tris,
@@ -47,7 +60,7 @@ def add_mesh(ax, vertices, faces, colour, alpha=1.0, facecolors=None):
     ax.add_collection3d(coll)
 
 
-def frame_axes(ax, points, title):
+def frame_axes(ax: Axes3D, points: ArrayLike, title: str) -> None:
     p = to_plot(points)
     centre = (p.max(axis=0) + p.min(axis=0)) / 2
     half = (p.max(axis=0) - p.min(axis=0)).max() / 2
@@ -60,5 +73,5 @@ def frame_axes(ax, points, title):
     ax.set_title(title)
 
 
-def crop(vertices, faces, y_max):
+def crop(vertices: np.ndarray, faces: np.ndarray, y_max: float) -> np.ndarray:
     return faces[(vertices[faces][:, :, 1] < y_max).all(axis=1)]

@@ -51,7 +51,7 @@ def _angle_axis(ax):
     ax.grid(True, axis="y", color="0.92")
 
 
-def figure8(frames: pd.DataFrame, fit: stats.Fit, out) -> Path:
+def figure8(frames: pd.DataFrame, fit: stats.Fit, out: str | Path) -> Path:
     participants = sorted(frames["participant"].unique())
     fig, axes = plt.subplots(
         1,
@@ -127,7 +127,7 @@ def full_extension(frames: pd.DataFrame) -> pd.DataFrame:
     return at
 
 
-def figure9(frames: pd.DataFrame, out) -> Path:
+def figure9(frames: pd.DataFrame, out: str | Path) -> Path:
     at = full_extension(frames)
     participants = sorted(at["participant"].unique())
     colors = ["#3b6fb6", "#e07b39", "#4f9d69"]
@@ -180,7 +180,7 @@ def figure9(frames: pd.DataFrame, out) -> Path:
     return _save(fig, out)
 
 
-def figure10(frames: pd.DataFrame, out) -> Path:
+def figure10(frames: pd.DataFrame, out: str | Path) -> Path:
     intact = frames[frames["any_injury"] == 0]
     participants = sorted(intact["participant"].unique())
     fig, axes = plt.subplots(1, len(participants), figsize=(4.8 * len(participants), 4.2), sharey=True, squeeze=False)

@@ -66,7 +66,11 @@ def _fit_note(fit: stats.Fit) -> str:
 
 
 def write_report(
-    runs="runs/montecarlo", out="leaderboards/montecarlo", *, max_runs: int | None = None, seed: int = 0
+    runs: str | Path = "runs/montecarlo",
+    out: str | Path = "leaderboards/montecarlo",
+    *,
+    max_runs: int | None = None,
+    seed: int = 0,
 ) -> dict:
     """Fit, draw and write the report of the study logged in `runs`; returns the summary dict."""
     start = time.perf_counter()

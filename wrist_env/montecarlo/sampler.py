@@ -31,13 +31,21 @@ the log keeps every frame, so the other reading can be recomputed from it.
 from __future__ import annotations
 
 import zlib
+from collections.abc import Iterable
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pyarrow as pa
+from numpy.typing import ArrayLike
 
 from wrist_env import design
 from wrist_env.design import INJURABLE, LIGAMENT_NAMES, N_DESIGN, N_MATERIAL, NAMES, SPAN_SD
 from wrist_env.errors import DesignError
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+    from gymnasium.vector import VectorEnv
 
 TEAR_PROBABILITY = 0.3
 """Chance that each injurable ligament is torn in a Monte Carlo run (preprint 2.3.2)."""
@@ -45,7 +53,9 @@ TORN_ACTION, INTACT_ACTION = -0.5, 1.0
 """Normalized injury scalars the Monte Carlo study gives a torn and an intact ligament."""
 
 
-def monte_carlo_from_unit(u, *, tear_probability: float = TEAR_PROBABILITY, truncate_sd: float = SPAN_SD) -> np.ndarray:
+def monte_carlo_from_unit(
+    u: ArrayLike, *, tear_probability: float = TEAR_PROBABILITY, truncate_sd: float = SPAN_SD
+) -> np.ndarray:
     """Normalized actions of shape (n, 27) from points `u` of shape (n, 27) in [0, 1).
 
     Materials (the first 22 columns): Table 2's normals truncated at ±`truncate_sd` by
@@ -67,7 +77,7 @@ def monte_carlo_from_unit(u, *, tear_probability: float = TEAR_PROBABILITY, trun
     return np.clip(a, -1.0, 1.0)
 
 
-def latin_hypercube(n: int, seed) -> np.ndarray:
+def latin_hypercube(n: int, seed: int | np.random.SeedSequence | np.random.Generator) -> np.ndarray:
     """A seeded Latin hypercube of shape (n, 27) in [0, 1) (`scipy.stats.qmc.LatinHypercube`):
     in every column each of the n strata [k/n, (k+1)/n) holds exactly one point.
     `seed`: an int, a `numpy.random.SeedSequence` or a `Generator`."""
@@ -78,7 +88,12 @@ def latin_hypercube(n: int, seed) -> np.ndarray:
     return qmc.LatinHypercube(d=N_DESIGN, rng=seed).random(int(n))
 
 
-def monte_carlo_actions(n: int, seed, *, tear_probability: float = TEAR_PROBABILITY) -> np.ndarray:
+def monte_carlo_actions(
+    n: int,
+    seed: int | np.random.SeedSequence | np.random.Generator,
+    *,
+    tear_probability: float = TEAR_PROBABILITY,
+) -> np.ndarray:
     """The Monte Carlo study's normalized actions of shape (n, 27) (preprint 2.3.2): a seeded
     Latin hypercube over all 27 variables, mapped by `monte_carlo_from_unit` (materials from
     Table 2's normals truncated at ±3 SD, each injurable ligament torn with `tear_probability`
@@ -131,7 +146,7 @@ def block_actions(
 _ENVS: dict = {}
 
 
-def vector_env(participant: str, num_envs: int):
+def vector_env(participant: str, num_envs: int) -> VectorEnv:
     """The participant's Idealized vector env with `num_envs` slots (one per process and size)."""
     import gymnasium as gym
 
@@ -159,7 +174,13 @@ def _frames(rows: np.ndarray, missing=None) -> pa.Array:
 
 
 def run_chunk(
-    participant: str, sample_ids, blocks, actions, *, exclude_above_mpa: float = EXCLUDE_ABOVE_MPA, folders=()
+    participant: str,
+    sample_ids: ArrayLike,
+    blocks: ArrayLike,
+    actions: ArrayLike,
+    *,
+    exclude_above_mpa: float = EXCLUDE_ABOVE_MPA,
+    folders: Iterable[str | Path] = (),
 ) -> pa.Table:
     """Simulate k runs (actions of shape (k, 27)) in one vector-env step; their log rows (`SCHEMA`).
 

@@ -32,12 +32,14 @@ from __future__ import annotations
 
 import time
 import warnings
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 import pyarrow as pa
 import pyarrow.compute as pc
+from numpy.typing import ArrayLike
 
 from wrist_env.design import INJURABLE
 
@@ -48,7 +50,7 @@ PRESSURE_FORMULA = "rs_mean_mpa ~ s1 + s2 + " + " + ".join(INJURABLE)
 SLIL_FORMULA = "force_n ~ s1 + s2 + proximal + volar + s1:proximal + s2:proximal"
 
 
-def angle_basis(angle, lower: float, upper: float) -> np.ndarray:
+def angle_basis(angle: ArrayLike, lower: float, upper: float) -> np.ndarray:
     """(n, 2): the quadratic B-spline basis on [lower, upper] without interior knots, minus its
     first function (the intercept's): b1 = 2 t (1 − t), b2 = t², t = (angle − lower) / (upper − lower).
     Equal to patsy's `bs(angle, df=2, degree=2)` when [lower, upper] is the data's range."""
@@ -238,7 +240,7 @@ def _fit(table, mean, result, formula, data, runs, available, start, bounds, max
     )
 
 
-def pressure_curve(fit: Fit, angles, torn=()) -> np.ndarray:
+def pressure_curve(fit: Fit, angles: ArrayLike, torn: Iterable[str] = ()) -> np.ndarray:
     """Table 5's fixed-effect prediction of the mean pressure (MPa) at `angles` with ligaments `torn`."""
     est = dict(zip(fit.table["term"], fit.table["estimate"]))
     lower, upper = fit.extra["angle_range_deg"]

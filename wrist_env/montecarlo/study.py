@@ -30,9 +30,10 @@ process), or on a `dask.distributed` scheduler (`scheduler="tcp://…"`, or a
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pyarrow as pa
@@ -42,6 +43,9 @@ from wrist_env.io import read_json, write_json
 from wrist_env.montecarlo import sampler
 from wrist_env.runs.executor import executor
 from wrist_env.runs.store import RunStore
+
+if TYPE_CHECKING:
+    from distributed import Client
 
 MANIFEST = "study.json"
 RUNS = "runs"
@@ -145,12 +149,12 @@ class StudySummary:
 RERUN = "rerun the montecarlo command (same arguments) to simulate its runs again"
 
 
-def runs_log(out) -> RunStore:
+def runs_log(out: str | Path) -> RunStore:
     """The study's run store (parts in `<out>/runs`)."""
     return RunStore(Path(out), parts=RUNS)
 
 
-def repair(out) -> int:
+def repair(out: str | Path) -> int:
     """Before a run: remove killed writers' temporary files and move damaged parts to `<out>/damaged/`
     (their runs are then missing, and simulated again). Returns the parts moved."""
     store = runs_log(out)
@@ -163,7 +167,7 @@ def repair(out) -> int:
     return moved
 
 
-def read_runs(out, columns=None) -> pa.Table | None:
+def read_runs(out: str | Path, columns: list[str] | None = None) -> pa.Table | None:
     """Every logged run of the study in `out`, sorted by (participant, sample_id); None if empty.
     StudyError if a run is logged twice; StoreError naming a damaged part."""
     table = runs_log(out).read_parts(schema=sampler.SCHEMA, columns=columns, advice=RERUN)
@@ -200,7 +204,7 @@ def _manifest(out: Path, config: StudyConfig) -> None:
     write_json(path, {**key, "participants": participants})
 
 
-def read_manifest(out) -> dict:
+def read_manifest(out: str | Path) -> dict:
     path = Path(out) / MANIFEST
     if not path.is_file():
         raise StudyError(f"{out} holds no Monte Carlo study (no {MANIFEST})")
@@ -270,7 +274,14 @@ def part_name(participant: str, ids: tuple[int, ...]) -> str:
 
 
 def run_study(
-    config: StudyConfig, out, *, batch: int = 64, scheduler=None, workers: int = 0, folders=(), progress: bool = False
+    config: StudyConfig,
+    out: str | Path,
+    *,
+    batch: int = 64,
+    scheduler: str | Client | None = None,
+    workers: int = 0,
+    folders: Iterable[str | Path] = (),
+    progress: bool = False,
 ) -> StudySummary:
     """Run (or resume) a study into the folder `out`; returns the counts and the wall time.
 
@@ -377,7 +388,7 @@ def _run_locked(
     return summary
 
 
-def config_of(out, participants=None) -> StudyConfig:
+def config_of(out: str | Path, participants: Sequence[str] | None = None) -> StudyConfig:
     """The StudyConfig recorded in a study folder (optionally for other participants)."""
     m = read_manifest(out)
     return StudyConfig(
@@ -385,7 +396,7 @@ def config_of(out, participants=None) -> StudyConfig:
     )
 
 
-def counts(out) -> dict[str, ParticipantCounts]:
+def counts(out: str | Path) -> dict[str, ParticipantCounts]:
     """Per-participant counts of a study folder, from its log."""
     config = config_of(out)
     outcomes = _logged_outcomes(Path(out), config.participants)

@@ -16,11 +16,15 @@ import importlib.resources
 import json
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from wrist_env.anatomy.template import BoneSurface, load_template
 from wrist_env.builder.warp import Warp
 from wrist_env.design import Design
 from wrist_env.errors import ParticipantError
+
+if TYPE_CHECKING:
+    from wrist_env.participants.folder import ParticipantSource
 
 BUILTIN = ("P1", "P2", "P3")
 
@@ -81,7 +85,7 @@ def bones(name: str, fossa_sweep_deg: tuple = (0.0, 0.0), distal_row: bool = Fal
     return out
 
 
-def source(name: str, fossa_sweep_deg: tuple | None = None):
+def source(name: str, fossa_sweep_deg: tuple | None = None) -> ParticipantSource:
     """The participant as a `folder.ParticipantSource`: its five principal bones (the radius fossae swept
     as in `load_template`; default: `BuildParams()`'s), its trials and Table 1 facts, a right wrist.
 

@@ -98,7 +98,7 @@ class ParticipantSource:
         object.__setattr__(self, "folder", Path(self.folder))
 
 
-def load_participant_folder(path) -> ParticipantSource:
+def load_participant_folder(path: str | Path) -> ParticipantSource:
     """The participant in a folder, validated and mirrored to a right wrist; errors name the file and value."""
     folder = Path(path)
     if not folder.is_dir():
@@ -159,7 +159,7 @@ def load_participant_folder(path) -> ParticipantSource:
     return ParticipantSource(name, meta, bones, trials, folder)
 
 
-def write_participant_folder(source: ParticipantSource, path) -> Path:
+def write_participant_folder(source: ParticipantSource, path: str | Path) -> Path:
     """Write `source` as a participant folder (STL meshes, trial CSVs, participant.toml); returns the folder.
 
     Files are written for meta["side"] (default "right"), so loading the folder gives `source` back
@@ -196,7 +196,7 @@ def mirror_mesh(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np
     return np.asarray(vertices, np.float64) * [1.0, 1.0, -1.0], np.asarray(faces, np.int64)[:, [0, 2, 1]]
 
 
-def read_bone_mesh(path, bone: str) -> tuple[np.ndarray, np.ndarray]:
+def read_bone_mesh(path: str | Path, bone: str) -> tuple[np.ndarray, np.ndarray]:
     """Vertices (n, 3) float64 mm and faces (m, 3) int64 of one bone mesh file, validated; MeshError if unusable.
 
     A file whose header or lines declare more than `MAX_FACES` faces is refused before it is read.

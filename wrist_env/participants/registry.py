@@ -10,12 +10,16 @@ from __future__ import annotations
 import os
 import warnings
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from wrist_env.anatomy.template import BoneSurface, carry_parts, load_template
 from wrist_env.builder.pipeline import BuildParams, build_model, source_hash
 from wrist_env.errors import BuildError, ParticipantError, StoreError
 from wrist_env.model import BONES, Model
 from wrist_env.participants import builtin
+
+if TYPE_CHECKING:
+    from wrist_env.trial import Trial
 
 _FOLDERS: dict[str, Path] = {}
 _SOURCES: dict = {}  # name -> the ParticipantSource read once by add_folder
@@ -49,7 +53,7 @@ def folder(name: str) -> Path:
     return _FOLDERS[name]
 
 
-def add_folder(folder) -> str:
+def add_folder(folder: str | Path) -> str:
     """Validate a participant folder and make it known by its name; returns the name.
 
     The folder is read and checked once, here: edit its files, then add it again."""
@@ -65,7 +69,7 @@ def add_folder(folder) -> str:
     return source.name
 
 
-def ensure_folder(folder) -> str:
+def ensure_folder(folder: str | Path) -> str:
     """`add_folder` unless this folder is registered already (a worker or a runner given the folders a
     caller registered: read once, not again); returns its name."""
     here = Path(folder).resolve()
@@ -97,7 +101,7 @@ def trials(name: str) -> dict:
     return _SOURCES[name].trials
 
 
-def trial(name: str, role: str):
+def trial(name: str, role: str) -> Trial:
     """The participant's first trial with `role` ("calibrate" or "validate")."""
     found = [t for t in trials(name).values() if t.role == role]
     if not found:

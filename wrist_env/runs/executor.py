@@ -18,7 +18,13 @@ import os
 import sys
 import time
 import traceback
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from concurrent.futures import Future
+
+    import distributed
 
 POLL_SECONDS = 0.5
 
@@ -60,11 +66,12 @@ class Executor:
     scheduler: str | None = None
     inline: bool = False
 
-    def submit(self, fn: Callable, *args, **kwargs):
+    def submit(self, fn: Callable, *args: Any, **kwargs: Any) -> Any:
         raise NotImplementedError
 
-    def results(self, handles, on_poll: Callable[[], None] | None = None,
-                poll_seconds: float = POLL_SECONDS) -> Iterator[tuple[object, object, BaseException | None]]:
+    def results(
+        self, handles: Iterable[Any], on_poll: Callable[[], None] | None = None, poll_seconds: float = POLL_SECONDS
+    ) -> Iterator[tuple[object, object, BaseException | None]]:
         """(handle, value, error) for every handle, as each finishes; `on_poll()` every `poll_seconds`."""
         pending = list(handles)
         while pending:
@@ -104,10 +111,12 @@ class Inline(Executor):
         self.threads = threads
         set_threads(threads)
 
-    def submit(self, fn, *args, **kwargs):
+    def submit(self, fn: Callable, *args: Any, **kwargs: Any) -> _Task:
         return _Task(fn, args, kwargs)
 
-    def results(self, handles, on_poll=None, poll_seconds=POLL_SECONDS):
+    def results(
+        self, handles: Iterable[Any], on_poll: Callable[[], None] | None = None, poll_seconds: float = POLL_SECONDS
+    ) -> Iterator[tuple[object, object, BaseException | None]]:
         for task in handles:
             try:
                 value, error = task.fn(*task.args, **task.kwargs), None
@@ -127,13 +136,17 @@ class Processes(Executor):
 
         self.workers = max(1, int(workers))
         self.threads = threads if threads is not None else max(1, (os.cpu_count() or 1) // self.workers)
-        self.pool = ProcessPoolExecutor(self.workers, mp_context=multiprocessing.get_context("spawn"),
-                                        initializer=_init_worker, initargs=(self.threads, os.getpid()))
+        self.pool = ProcessPoolExecutor(
+            self.workers,
+            mp_context=multiprocessing.get_context("spawn"),
+            initializer=_init_worker,
+            initargs=(self.threads, os.getpid()),
+        )
 
-    def submit(self, fn, *args, **kwargs):
+    def submit(self, fn: Callable, *args: Any, **kwargs: Any) -> Future:
         return self.pool.submit(fn, *args, **kwargs)
 
-    def close(self):
+    def close(self) -> None:
         self.pool.shutdown(cancel_futures=True)
 
 
@@ -147,16 +160,17 @@ class Dask(Executor):
         self.client = Client(scheduler) if self.own else scheduler
         self.scheduler = scheduler if isinstance(scheduler, str) else str(scheduler)
 
-    def submit(self, fn, *args, **kwargs):
-        return self.client.submit(fn, *args, pure=False, key=f"wrist-env-{os.getpid()}-{time.time_ns()}",
-                                  **kwargs)
+    def submit(self, fn: Callable, *args: Any, **kwargs: Any) -> distributed.Future:
+        return self.client.submit(fn, *args, pure=False, key=f"wrist-env-{os.getpid()}-{time.time_ns()}", **kwargs)
 
-    def close(self):
+    def close(self) -> None:
         if self.own:
             self.client.close()
 
 
-def executor(scheduler=None, workers: int = 0, threads: int | None = None) -> Executor:
+def executor(
+    scheduler: str | distributed.Client | None = None, workers: int = 0, threads: int | None = None
+) -> Executor:
     """Dask if `scheduler` is given, else `workers` local processes (≥ 2), else this process."""
     if scheduler is not None:
         return Dask(scheduler)

@@ -22,6 +22,7 @@ import fcntl
 import os
 import shutil
 import warnings
+from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -44,13 +45,17 @@ class StoreBusyError(StoreError):
     """Another process holds a lock this one was not allowed to wait for."""
 
 
-def read_parquet(path, schema: pa.Schema | None = None, columns=None, advice: str = "") -> pa.Table:
+def read_parquet(
+    path: str | Path, schema: pa.Schema | None = None, columns: list[str] | None = None, advice: str = ""
+) -> pa.Table:
     """One Parquet file; `StoreError` naming it (and `advice`) if it is truncated, empty or not Parquet."""
     try:
         return pq.read_table(path, schema=schema, columns=columns)
     except (OSError, pa.ArrowException, ValueError) as e:
-        raise StoreError(f"{path}: damaged Parquet file ({type(e).__name__}: {str(e).splitlines()[0][:200]})"
-                         + (f"; {advice}" if advice else "")) from None
+        raise StoreError(
+            f"{path}: damaged Parquet file ({type(e).__name__}: {str(e).splitlines()[0][:200]})"
+            + (f"; {advice}" if advice else "")
+        ) from None
 
 
 class RunStore:
@@ -74,7 +79,9 @@ class RunStore:
         """The parts written so far, sorted by name (temporary files are not parts)."""
         if not self.parts_dir.is_dir():
             return []
-        return sorted(p.name[:-len(".parquet")] for p in self.parts_dir.glob("*.parquet") if not p.name.startswith("."))
+        return sorted(
+            p.name[: -len(".parquet")] for p in self.parts_dir.glob("*.parquet") if not p.name.startswith(".")
+        )
 
     def write_part(self, name: str, table: pa.Table) -> Path:
         """Write one part, atomically and once (`PartExistsError` if `name` is taken)."""
@@ -83,10 +90,18 @@ class RunStore:
             raise PartExistsError(f"{path} is already in the store (parts are written once)")
         return atomic_write(path, lambda p: pq.write_table(table, p))
 
-    def read_part(self, name: str, schema: pa.Schema | None = None, columns=None, advice: str = "") -> pa.Table:
+    def read_part(
+        self, name: str, schema: pa.Schema | None = None, columns: list[str] | None = None, advice: str = ""
+    ) -> pa.Table:
         return read_parquet(self.part_path(name), schema, columns, advice)
 
-    def read_parts(self, names=None, schema: pa.Schema | None = None, columns=None, advice: str = "") -> pa.Table | None:
+    def read_parts(
+        self,
+        names: Iterable[str] | None = None,
+        schema: pa.Schema | None = None,
+        columns: list[str] | None = None,
+        advice: str = "",
+    ) -> pa.Table | None:
         """The parts `names` (default all) concatenated in name order, or None if there are none."""
         names = self.part_names() if names is None else list(names)
         if not names:
@@ -114,10 +129,10 @@ class RunStore:
             raise ValueError(f"a record name must be a plain file name, but got {name!r}")
         return self.records_dir / f"{name}.json"
 
-    def write_record(self, name: str, data) -> Path:
+    def write_record(self, name: str, data: object) -> Path:
         return write_json(self.record_path(name), data)
 
-    def read_record(self, name: str, advice: str = ""):
+    def read_record(self, name: str, advice: str = "") -> dict | list | None:
         """The record `name`, or None if there is none; `StoreError` naming it if it is damaged."""
         path = self.record_path(name)
         return read_json(path, "record", advice) if path.is_file() else None
@@ -129,7 +144,7 @@ class RunStore:
 
     # repair
 
-    def quarantine(self, path, reason: str) -> Path | None:
+    def quarantine(self, path: str | Path, reason: str) -> Path | None:
         """Move a damaged or orphaned file to `damaged/` (kept for inspection) with a warning naming it
         (None if it is already gone)."""
         path = Path(path)
@@ -152,7 +167,7 @@ class RunStore:
     # locks
 
     @contextmanager
-    def lock(self, name: str = STORE_LOCK, *, wait: bool = True, what: str = "this run store"):
+    def lock(self, name: str = STORE_LOCK, *, wait: bool = True, what: str = "this run store") -> Iterator[None]:
         """Hold the flock `locks/<name>.lock` (released when the process dies, even by SIGKILL).
 
         wait=False: `StoreBusyError` naming the holder's process id if another process holds it.
@@ -165,8 +180,10 @@ class RunStore:
             except BlockingIOError:
                 handle.seek(0)
                 holder = handle.read().strip() or "?"
-                raise StoreBusyError(f"{path}: another process (pid {holder}) is running {what}; wait for it to "
-                                     f"finish or stop it (a killed run releases the lock)") from None
+                raise StoreBusyError(
+                    f"{path}: another process (pid {holder}) is running {what}; wait for it to "
+                    f"finish or stop it (a killed run releases the lock)"
+                ) from None
             handle.seek(0)
             handle.truncate()
             handle.write(str(os.getpid()))

@@ -137,7 +137,9 @@ def membrane(model: Model, grd: Grids) -> Membrane:
     )
 
 
-def design_arrays(model: Model, fib: Fibres, mem: Membrane, design: Design):
+def design_arrays(
+    model: Model, fib: Fibres, mem: Membrane, design: Design
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Per-fibre (l0, K) and per-connector (l0, K) of a design; K = 0 for torn ligaments.
 
     l0 = l_ref / reference_strain per fibre (l_ref its neutral length, whose bundle

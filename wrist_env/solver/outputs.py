@@ -7,13 +7,18 @@ own contact law and grids); everything else is read off a `Result`.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from wrist_env.design import ALL_LIGAMENT_NAMES
 from wrist_env.model import BONES, PAIRS, Model
 from wrist_env.solver import arrays, forces
 from wrist_env.solver.forces import CONTACT_FIELDS
+
+if TYPE_CHECKING:
+    from wrist_env.solver.simulate import Result
 
 
 def _state(model: Model, pose_frame):
@@ -26,7 +31,7 @@ def _state(model: Model, pose_frame):
     return R, x
 
 
-def pressure_map(model: Model, pose_frame) -> np.ndarray:
+def pressure_map(model: Model, pose_frame: ArrayLike) -> np.ndarray:
     """Contact pressure (MPa) of every contact sample, shape (n_samples,), at one frame's poses (5, 4, 4).
 
     Samples are in `model.sample_points` order (pair-sorted, `PAIRS`; pair p is
@@ -54,7 +59,7 @@ def pair_slice(model: Model, pair: str) -> slice:
     return slice(int(model.sample_offsets[p]), int(model.sample_offsets[p + 1]))
 
 
-def cardan_deg(poses) -> np.ndarray:
+def cardan_deg(poses: ArrayLike) -> np.ndarray:
     """Cardan Z-X-Y angles (deg, `wrist_env.frames.cardan_angles`) of poses (..., 4, 4) or rotations
     (..., 3, 3): Flex/Ext (about z, flexion +), UlnD/RadD (ulnar +), Pro/Sup; NaN where a pose is not finite."""
     from wrist_env.frames import cardan_angles
@@ -78,7 +83,7 @@ def _matrix(m):
     return [[_num(v) for v in row] for row in np.asarray(m)]
 
 
-def result_to_dict(result, model: Model) -> dict:
+def result_to_dict(result: Result, model: Model) -> dict:
     """JSON-ready per-frame outputs of a `Result` (NaN → None; strict JSON with `allow_nan=False`).
 
     {"status", "ok", "message", "n_frames", "bones", "pairs", "ligaments", "frames": [

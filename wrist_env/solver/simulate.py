@@ -9,10 +9,12 @@ maximum flexion to maximum extension about the RCS z axis.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numba
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
 from wrist_env.design import ALL_LIGAMENT_NAMES, Design
@@ -48,7 +50,7 @@ class Driver:
         return len(self.rotation)
 
 
-def experimental(model: Model, transforms) -> Driver:
+def experimental(model: Model, transforms: ArrayLike) -> Driver:
     """Driver from the capitate's 4×4 transforms (n_frames, 4, 4), neutral → frame, RCS mm."""
     T = np.asarray(transforms, dtype=np.float64)
     com0 = model.com[BONES.index("capitate")]
@@ -57,7 +59,9 @@ def experimental(model: Model, transforms) -> Driver:
     return Driver(arrays.EXPERIMENTAL, rotation, np.ascontiguousarray(com), np.full(len(T), np.nan), np.zeros(len(T)))
 
 
-def loaded(model: Model, rotations, load_n=IDEALIZED_LOAD_N, angle_deg=None) -> Driver:
+def loaded(
+    model: Model, rotations: ArrayLike, load_n: ArrayLike = IDEALIZED_LOAD_N, angle_deg: ArrayLike | None = None
+) -> Driver:
     """Capitate rotations (n_frames, 3, 3) prescribed, its translations free under a
     compressive load `load_n` (N along +y; a scalar or one per frame)."""
     rotation = np.ascontiguousarray(np.asarray(rotations, dtype=np.float64))
@@ -81,7 +85,7 @@ def idealized(
     flexion_deg: float = 40.0,
     extension_deg: float = 40.0,
     n_frames: int = 17,
-    angles_deg=None,
+    angles_deg: ArrayLike | None = None,
     load_n: float = IDEALIZED_LOAD_N,
 ) -> Driver:
     """Idealized flexion–extension (preprint 2.2.3.2): the capitate from `flexion_deg` of
@@ -200,7 +204,7 @@ def simulate(
 
 def simulate_batch(
     model: Model,
-    designs,
+    designs: Iterable[Design],
     driver: Driver,
     settings: arrays.SolverSettings | None = None,
     *,

@@ -33,7 +33,9 @@ from wrist_env.bench.leaderboard.tables import TARGETS, Leaderboard, build, load
 __all__ = ["TARGETS", "Leaderboard", "Reference", "build", "load_runs", "reference", "write_leaderboard"]
 
 
-def write_leaderboard(runs, out, *, references: dict | None = None, title: str | None = None) -> Path:
+def write_leaderboard(
+    runs: str | Path, out: str | Path, *, references: dict[str, Reference] | None = None, title: str | None = None
+) -> Path:
     """Write the leaderboards of the run log in `runs` into the folder `out`; returns out/README.md.
 
     references: {participant: `Reference`} already simulated (the others are simulated here)."""

@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
+import os
+from collections.abc import Iterable
+
 import numpy as np
 
-from wrist_env.bench.leaderboard.tables import hit, runs_of
+from wrist_env.bench.leaderboard.tables import Leaderboard, hit, runs_of
+
+_RGBA = tuple[float, float, float, float]
 
 
-def colors(labels) -> dict:
+def colors(labels: Iterable[str]) -> dict[str, _RGBA]:
     import matplotlib
 
     cmap = matplotlib.colormaps["tab10"]
@@ -21,7 +26,7 @@ def _reference_line(ax, cost: float, text: str, color: str, style: str, *, right
     ax.text(x, cost, text, color=color, fontsize=8, ha=ha, va=va, transform=ax.get_yaxis_transform())
 
 
-def convergence_figure(path, board, colors) -> None:
+def convergence_figure(path: str | os.PathLike, board: Leaderboard, colors: dict[str, _RGBA]) -> None:
     """Best cost so far against evaluations: median and IQR band per calibrator, a panel per participant."""
     import matplotlib.pyplot as plt
 
@@ -89,7 +94,7 @@ def _plain_log_ticks(axis, subs=(1.0, 2.0, 5.0)) -> None:
     axis.set_minor_formatter(NullFormatter())
 
 
-def ecdf_figure(path, board, colors) -> None:
+def ecdf_figure(path: str | os.PathLike, board: Leaderboard, colors: dict[str, _RGBA]) -> None:
     """COCO-style ECDF of (run, target) pairs solved against evaluations."""
     import matplotlib.pyplot as plt
 

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from wrist_env.bench.leaderboard.tables import CSV_FILES
+from wrist_env.bench.leaderboard.tables import CSV_FILES, Leaderboard
 
 
-def fmt(v, digits=3) -> str:
+def fmt(v: float | None, digits: int = 3) -> str:
     if v is None or (isinstance(v, float) and not np.isfinite(v)):
         return "—"
     return f"{v:.{digits}g}" if abs(v) >= 1000 else f"{v:.{digits}f}"
@@ -22,7 +22,7 @@ def md_table(frame: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
-def readme(board, title: str | None = None) -> str:
+def readme(board: Leaderboard, title: str | None = None) -> str:
     """The leaderboard's README.md text (Markdown)."""
     b = board
     runs, summaries, unfinished, participants, labels, budgets = (

@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from numpy.typing import ArrayLike
 
-from wrist_env.bench.leaderboard.reference import reference, rmse_array
+from wrist_env.bench.leaderboard.reference import Reference, reference, rmse_array
 from wrist_env.bench.log import RunLog
 from wrist_env.cost import COST_BONES
 from wrist_env.frames import DOF_NAMES, DOF_UNITS
@@ -24,7 +26,7 @@ PREPRINT_SHARE_IMPROVED = {"calibrate": 66.7, "validate": 61.1}
 """Share of DOF (%) with lower RMSE after calibration in the preprint's Tables 3 and 4."""
 
 
-def quantile(values, q):
+def quantile(values: Iterable[float | None], q: float) -> float:
     values = np.asarray([v for v in values if v is not None and np.isfinite(v)], dtype=np.float64)
     return float(np.quantile(values, q)) if len(values) else np.nan
 
@@ -38,7 +40,7 @@ def calibrator_label(optimizer: str, budget: int, budgets: set) -> str:
     return optimizer if len(budgets) == 1 else f"{optimizer} (budget {budget})"
 
 
-def load_runs(runs) -> tuple[pd.DataFrame, list[dict], int]:
+def load_runs(runs: str | Path) -> tuple[pd.DataFrame, list[dict], int]:
     """(evaluations of finished cells, their summaries, number of unfinished cells) of a run log."""
     log = RunLog(runs)
     evals = log.read()
@@ -64,12 +66,14 @@ def hit(curve: np.ndarray, target: float) -> int | None:
     return int(idx[0]) + 1 if len(idx) else None
 
 
-def spread(values, prefix: str = "") -> dict:
+def spread(values: ArrayLike, prefix: str = "") -> dict[str, float]:
     """{prefix + "median", "q25", "q75"} of `values` (NaN-free quantiles, see `quantile`)."""
     return {f"{prefix}{name}": quantile(values, q) for name, q in (("median", 0.5), ("q25", 0.25), ("q75", 0.75))}
 
 
-def best_cost(runs_frame, refs, participants, labels) -> pd.DataFrame:
+def best_cost(
+    runs_frame: pd.DataFrame, refs: dict[str, Reference], participants: Iterable[str], labels: Sequence[str]
+) -> pd.DataFrame:
     rows = []
     for p in participants:
         for label in labels:
@@ -92,7 +96,13 @@ def best_cost(runs_frame, refs, participants, labels) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def evals_to_target(runs_frame, targets, participants, labels, curves) -> pd.DataFrame:
+def evals_to_target(
+    runs_frame: pd.DataFrame,
+    targets: pd.DataFrame,
+    participants: Sequence[str],
+    labels: Sequence[str],
+    curves: dict[tuple[str, str, int, int], np.ndarray],
+) -> pd.DataFrame:
     """COCO's expected running time: evaluations spent over all runs (nfev for an unsolved run,
     the hitting count for a solved one) divided by the number of solved runs."""
     rows = []
@@ -122,7 +132,9 @@ def evals_to_target(runs_frame, targets, participants, labels, curves) -> pd.Dat
     return pd.DataFrame(rows)
 
 
-def recovery(runs_frame, summaries, participants, labels) -> pd.DataFrame:
+def recovery(
+    runs_frame: pd.DataFrame, summaries: Iterable[dict], participants: Iterable[str], labels: Sequence[str]
+) -> pd.DataFrame:
     population = {s["participant"]: s["recovery_z_population"] for s in summaries}
     rows = []
     for p in participants:
@@ -143,7 +155,9 @@ def recovery(runs_frame, summaries, participants, labels) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def heldout(runs_frame, refs, participants, labels) -> pd.DataFrame:
+def heldout(
+    runs_frame: pd.DataFrame, refs: dict[str, Reference], participants: Iterable[str], labels: Sequence[str]
+) -> pd.DataFrame:
     rows = []
     for p in participants:
         r = refs[p]
@@ -183,7 +197,7 @@ def heldout(runs_frame, refs, participants, labels) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def best_runs(summaries) -> dict:
+def best_runs(summaries: Iterable[dict]) -> dict[str, dict]:
     """Per participant, the run with the lowest calibration cost over all calibrators and seeds
     (ties: the first in participant, optimizer, budget, seed order) — as the preprint reports its one
     optimization per participant."""
@@ -195,7 +209,9 @@ def best_runs(summaries) -> dict:
     return chosen
 
 
-def rmse_table(chosen, refs, participants, trial) -> pd.DataFrame:
+def rmse_table(
+    chosen: dict[str, dict], refs: dict[str, Reference], participants: Iterable[str], trial: str
+) -> pd.DataFrame:
     rows = []
     for p in participants:
         r, s = refs[p], chosen[p]
@@ -213,7 +229,7 @@ def rmse_table(chosen, refs, participants, trial) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def share_improved(pairs) -> float:
+def share_improved(pairs: Iterable[tuple[np.ndarray, np.ndarray]]) -> float:
     """Percent of DOF entries with calibrated RMSE < population RMSE; pairs: [(population (2, 6), calibrated (2, 6))]."""
     better = total = 0
     for pop, cal in pairs:
@@ -223,7 +239,14 @@ def share_improved(pairs) -> float:
     return 100.0 * better / total if total else np.nan
 
 
-def dof_improved(summaries, chosen, refs, participants, labels, budgets) -> pd.DataFrame:
+def dof_improved(
+    summaries: Sequence[dict],
+    chosen: dict[str, dict],
+    refs: dict[str, Reference],
+    participants: Sequence[str],
+    labels: Iterable[str],
+    budgets: set[int],
+) -> pd.DataFrame:
     rows = []
 
     def row(name, trial_pairs, runs):
@@ -348,7 +371,7 @@ def _runs_frame(summaries, curves_by_key, targets, budgets) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def build(runs, references: dict | None = None) -> Leaderboard:
+def build(runs: str | Path, references: dict[str, Reference] | None = None) -> Leaderboard:
     """The leaderboard of the finished cells of the run log in `runs` (`references`: {participant:
     `Reference`} already simulated; the others are simulated here)."""
     evals, summaries, unfinished = load_runs(runs)
