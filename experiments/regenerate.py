@@ -20,6 +20,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+FIGURES = "experiments/figures"  # the README's figures (the commands' own default is runs/figures)
 
 
 def _commit() -> str:
@@ -30,11 +31,11 @@ def _commit() -> str:
 def steps(runs: Path, figures_only: bool) -> list[list[str]]:
     """The commands, in order (argv lists for `wrist-bench`)."""
     figures = [
-        ["figure", "annotations"],
-        ["figure", "model", "P1"],
-        ["figure", "pressure", "P1"],
-        ["figure", "kinematics", "P1"],
-        ["validate", "P1", "--out", "experiments/figures"],
+        ["figure", "annotations", "--out", f"{FIGURES}/template_annotations.png"],
+        ["figure", "model", "P1", "--out", f"{FIGURES}/model_P1.png"],
+        ["figure", "pressure", "P1", "--out", f"{FIGURES}/pressure_P1.png"],
+        ["figure", "kinematics", "P1", "--out", f"{FIGURES}/kinematics_P1.png"],
+        ["validate", "P1", "--out", FIGURES],
     ]
     if figures_only:
         return figures

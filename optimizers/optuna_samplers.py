@@ -46,7 +46,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from optimizers.base import Optimizer
-from optimizers.registry import register
+from optimizers.registry import register, unavailable
 
 if TYPE_CHECKING:
     import optuna
@@ -189,3 +189,5 @@ class OptunaGP(OptunaOptimizer):
 HAS_TORCH = importlib.util.find_spec("torch") is not None
 if HAS_TORCH:
     register("optuna-gp")(OptunaGP)
+else:
+    unavailable("optuna-gp", 'it needs PyTorch; install the extra: pip install -e ".[gp]"')

@@ -19,6 +19,7 @@ if TYPE_CHECKING:
 
 ENTRY_POINT_GROUP = "wrist_env.optimizers"
 _REGISTRY: dict[str, type] = {}
+_UNAVAILABLE: dict[str, str] = {}  # name -> why it is not registered here (what to install)
 
 
 class UnknownOptimizerError(WristEnvError, KeyError):
@@ -41,6 +42,11 @@ def register(name: str) -> Callable[[type], type]:
     return decorate
 
 
+def unavailable(name: str, reason: str) -> None:
+    """Record a calibrator that exists but cannot run here, and why (e.g. an optional extra to install)."""
+    _UNAVAILABLE[name] = reason
+
+
 def _load_plugins() -> None:
     for ep in entry_points(group=ENTRY_POINT_GROUP):
         if ep.name not in _REGISTRY:
@@ -58,6 +64,8 @@ def get(name: str) -> type:
     """The calibrator class registered as `name`."""
     if name not in _REGISTRY:
         _load_plugins()
+    if name in _UNAVAILABLE and name not in _REGISTRY:
+        raise UnknownOptimizerError(f"optimizer {name!r} is not available here: {_UNAVAILABLE[name]}")
     if name not in _REGISTRY:
         raise UnknownOptimizerError(f"unknown optimizer {name!r}; available: {', '.join(available())}")
     return _REGISTRY[name]

@@ -1,4 +1,10 @@
 import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
 
 from wrist_env.cli import main
 
@@ -175,3 +181,48 @@ def test_an_unknown_calibrator_is_one_line_and_exit_2(capsys):
     assert main(["calibrate", "P1", "--optimizer", "nope", "--budget", "2"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("wrist-bench: error: unknown optimizer 'nope'") and len(err.strip().splitlines()) == 1
+
+
+def test_no_command_writes_into_the_committed_results_by_default():
+    """User commands write under runs/ (git-ignored) unless told otherwise; leaderboards/ and
+    experiments/figures/ are written only by experiments/regenerate.py, with explicit paths."""
+    from wrist_env.cli import parser
+
+    sub = next(a for a in parser()._actions if a.dest == "command")
+    outputs = {}
+    for name, command in sub.choices.items():
+        for action in command._actions:
+            if action.dest in ("out", "leaderboard") and action.default is not None:
+                outputs[f"{name} --{action.dest}"] = action.default
+    assert outputs, "no output defaults found"
+    assert all(str(d).startswith("runs/") for d in outputs.values()), outputs
+    env = {k: v for k, v in os.environ.items() if k != "WRIST_ENV_FIGURES"}
+    code = "from wrist_env.figures.draw import FIGURES; print(FIGURES.as_posix())"
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "runs/figures"
+
+
+@pytest.mark.slow
+def test_export_build_evaluate_and_make_an_env_from_a_clean_folder(tmp_path, capsys):
+    import gymnasium as gym
+
+    import wrist_env
+
+    folder = tmp_path / "my_wrist"
+    assert main(["export", "P1", str(folder)]) == 0
+    assert (folder / "participant.toml").is_file() and len(list((folder / "bones").glob("*.stl"))) == 5
+    assert main(["export", "P1", str(folder)]) == 2  # not over a folder already written
+    assert "not empty" in capsys.readouterr().err
+    assert main(["build", "my_wrist", "--folder", str(folder)]) == 0
+    assert "my_wrist: built in" in capsys.readouterr().out
+    assert main(["evaluate", "my_wrist", "--folder", str(folder), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["failed"] is False and 0 < out["cost"] < 100
+    ids = wrist_env.register_participant(folder)
+    assert "wrist_env/Calibrate-my_wrist-v0" in ids
+    env = gym.make("wrist_env/Calibrate-my_wrist-v0")
+    env.reset(seed=0)
+    from wrist_env import design
+
+    _, reward, terminated, _, info = env.step(design.to_action(design.population()).astype(np.float32))
+    assert terminated and reward == -out["cost"] and not info["failed"]

@@ -38,6 +38,12 @@ def test_registered_as_available():
     assert ("optuna-gp" in names) == HAS_TORCH
 
 
+@pytest.mark.skipif(HAS_TORCH, reason="PyTorch is installed: optuna-gp is available")
+def test_optuna_gp_without_torch_names_the_extra():
+    with pytest.raises(optimizers.UnknownOptimizerError, match=r"needs PyTorch.*\[gp\]"):
+        optimizers.make("optuna-gp", 3, 10)
+
+
 @pytest.mark.parametrize("name", SAMPLERS)
 @pytest.mark.parametrize("budget", [1, 5, 17])
 def test_budget_exact_and_bounds(name, budget):

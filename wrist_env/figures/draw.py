@@ -20,9 +20,9 @@ if TYPE_CHECKING:
     from matplotlib.typing import ColorType
     from mpl_toolkits.mplot3d import Axes3D
 
-FIGURES = Path(os.environ.get("WRIST_ENV_FIGURES", Path("experiments") / "figures"))
-"""Default folder of every figure: `$WRIST_ENV_FIGURES`, else experiments/figures under the working
-directory (the repository's, where the README's figures live)."""
+FIGURES = Path(os.environ.get("WRIST_ENV_FIGURES", Path("runs") / "figures"))
+"""Default folder of every figure: `$WRIST_ENV_FIGURES`, else runs/figures under the working directory
+(never the committed README figures in experiments/figures: `experiments/regenerate.py` writes those)."""
 BONE_COLOUR = {
     "radius": "#d9cfc1",
     "ulna": "#d9cfc1",

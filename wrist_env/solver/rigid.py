@@ -29,7 +29,8 @@ def matrix_to_rotvec(R):
 def orthonormalize(R):
     """Nearest rotation to R by Gram–Schmidt on its columns (R is (3, 3))."""
     x = R[:, 0] / np.linalg.norm(R[:, 0])
-    y = R[:, 1] - np.dot(x, R[:, 1]) * x
+    column = np.ascontiguousarray(R[:, 1])  # np.dot of a strided column warns (NumbaPerformanceWarning)
+    y = column - np.dot(x, column) * x
     y = y / np.linalg.norm(y)
     z = np.cross(x, y)
     out = np.empty((3, 3))

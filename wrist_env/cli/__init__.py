@@ -1,0 +1,49 @@
+"""`wrist-bench`: the command line of wrist-env (a thin shell over the package)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from collections.abc import Sequence
+
+from wrist_env.cli import participant_commands, study_commands
+
+
+def parser() -> argparse.ArgumentParser:
+    """The `wrist-bench` argument parser: every command, each with `--folder`."""
+    p = argparse.ArgumentParser(prog="wrist-bench", description=__doc__)
+    sub = p.add_subparsers(dest="command", required=True)
+    folders = argparse.ArgumentParser(add_help=False)
+    folders.add_argument(
+        "--folder",
+        action="append",
+        help="register this participant folder first (repeatable; registered in every worker too)",
+    )
+
+    def command(name: str, *, folders_option: bool = True, **kwargs) -> argparse.ArgumentParser:
+        return sub.add_parser(name, parents=[folders] if folders_option else [], **kwargs)
+
+    participant_commands.add_commands(command)
+    study_commands.add_commands(command)
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run one `wrist-bench` command; returns the exit status (2 for a project error, one line on stderr)."""
+    args = parser().parse_args(argv)
+    from wrist_env.errors import WristEnvError
+
+    try:
+        if getattr(args, "folder", None):
+            from wrist_env.participants import registry
+
+            for folder in args.folder:
+                registry.add_folder(folder)
+        return args.run(args)
+    except WristEnvError as exc:  # every project error (unknown calibrators too): one line, exit 2
+        print(f"wrist-bench: error: {exc}", file=sys.stderr)
+        return 2
+    except BrokenPipeError:  # `wrist-bench ... --json | head`: the reader left; say nothing more
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0

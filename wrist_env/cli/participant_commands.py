@@ -1,0 +1,382 @@
+"""`wrist-bench` commands on one participant: participants, build, export, simulate, evaluate, validate, figure."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from wrist_env.design import Design
+    from wrist_env.model import Model
+    from wrist_env.solver.simulate import Driver
+
+FIGURES_HELP = "$WRIST_ENV_FIGURES or runs/figures"  # wrist_env.figures.draw.FIGURES (no matplotlib import here)
+PARTICIPANT_HELP = "participant: built-in P1, P2, P3 or a registered folder's name (see `wrist-bench participants`)"
+
+
+def _participants(args) -> int:
+    from wrist_env.participants import builtin, registry
+
+    for name in registry.participants():
+        if name in builtin.BUILTIN:
+            i = builtin.info(name)
+            print(f"{name}  built-in (synthetic)  {i.sex}, {i.age} y, facet type {i.facet_type}, task: {i.task}")
+        else:
+            print(f"{name}  folder {registry.folder(name)}")
+    return 0
+
+
+def _build(args) -> int:
+    from wrist_env.participants import registry
+
+    start = time.perf_counter()
+    model = registry.load_model(args.participant, cache=not args.no_cache)
+    summary = dict(model.report)
+    summary["wall_seconds"] = round(time.perf_counter() - start, 2)
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        print(
+            f"{model.name}: built in {summary['build_seconds']} s "
+            f"(this call {summary['wall_seconds']} s); morph error (mm): "
+            + ", ".join(f"{b} {e['mean']:.2f}/{e['max']:.2f}" for b, e in summary["morph_error_mm"].items())
+        )
+    return 0
+
+
+def _export(args: argparse.Namespace) -> int:
+    import dataclasses
+    import re
+
+    from wrist_env.errors import ParticipantError
+    from wrist_env.participants import builtin
+    from wrist_env.participants.folder import PARTICIPANT_FILE, write_participant_folder
+
+    if args.participant not in builtin.BUILTIN:
+        raise ParticipantError(
+            f"export takes a built-in participant {list(builtin.BUILTIN)}, but got {args.participant!r} "
+            "(a folder participant is a folder already)"
+        )
+    out = Path(args.out_folder)
+    name = args.name or out.resolve().name
+    if name in builtin.BUILTIN or not re.fullmatch(r"[A-Za-z0-9_.-]+", name):
+        raise ParticipantError(
+            f"the exported participant needs a name of letters, digits, '_', '.' or '-' that is not a built-in "
+            f"one, but got {name!r} (give --name)"
+        )
+    if out.exists() and any(out.iterdir()):
+        raise ParticipantError(f"{out} exists and is not empty; export writes a new folder")
+    source = dataclasses.replace(builtin.source(args.participant), name=name)
+    folder = write_participant_folder(source, out)
+    print(
+        f"wrote {args.participant} as participant {name!r} to {folder} ({PARTICIPANT_FILE}, bones/*.stl, "
+        f"trials/*.csv); use it with --folder {folder}"
+    )
+    return 0
+
+
+def load_design(spec: str, participant: str) -> Design:
+    """`population`, `truth` (a built-in participant's hidden ground truth) or a JSON file of a Design."""
+    from wrist_env import design
+    from wrist_env.errors import DesignError
+    from wrist_env.participants import builtin
+
+    if spec == "population":
+        return design.population()
+    if spec == "truth":
+        if participant not in builtin.BUILTIN:
+            raise DesignError(
+                f"--design truth needs a built-in participant {list(builtin.BUILTIN)}, but got {participant!r}"
+            )
+        return builtin.truth(participant)
+    if not Path(spec).is_file():
+        raise DesignError(
+            f"--design must be 'population', 'truth' or a JSON file of a design, but {spec!r} is none of these"
+        )
+    return design.read_json(spec)
+
+
+def make_driver(model: Model, motion: str, frames: int | None, flexion: float, extension: float) -> Driver:
+    """The capitate driver of `simulate`: an idealized sweep or the capitate held at neutral."""
+    from wrist_env.solver import simulate
+
+    if motion == "idealized":
+        return simulate.idealized(model, flexion_deg=flexion, extension_deg=extension, n_frames=frames or 17)
+    return simulate.static(model, frames or 3)
+
+
+def _simulate(args) -> int:
+    from wrist_env.model import BONES, PAIRS
+    from wrist_env.participants import registry
+    from wrist_env.solver import simulate
+    from wrist_env.solver.outputs import cardan_deg, result_to_dict
+
+    if args.frames is not None and args.frames < 1:
+        raise SystemExit("wrist-bench simulate: --frames must be at least 1")
+    start = time.perf_counter()
+    model = registry.load_model(args.participant)
+    load_seconds = time.perf_counter() - start
+    d = load_design(args.design, args.participant)
+    driver = make_driver(model, args.motion, args.frames, args.flexion, args.extension)
+    compile_seconds = None
+    if args.warm_up:
+        start = time.perf_counter()
+        simulate.simulate(model, d, make_driver(model, args.motion, 1, 0.0, 0.0))
+        compile_seconds = time.perf_counter() - start
+    start = time.perf_counter()
+    result = simulate.simulate(model, d, driver)
+    wall = time.perf_counter() - start
+    if args.json:
+        out = {
+            "participant": model.name,
+            "motion": args.motion,
+            "design": args.design,
+            "wall_seconds": round(wall, 4),
+            "compile_seconds": None if compile_seconds is None else round(compile_seconds, 4),
+            "load_seconds": round(load_seconds, 4),
+        }
+        out.update(result_to_dict(result, model))
+        print(json.dumps(out, indent=1, allow_nan=False))
+        return 0 if result.ok else 1
+    flex = cardan_deg(result.poses)[..., 0].round(2) + 0.0  # + 0.0: no "-0.00"
+    c, s, l = (BONES.index(b) for b in ("capitate", "scaphoid", "lunate"))
+    rs = PAIRS.index("radioscaphoid")
+    print(f"{model.name}, {args.motion} motion, design {args.design}: flexion (+) about the RCS z axis, deg")
+    print(f"{'frame':>5}  {'capitate':>8}  {'scaphoid':>8}  {'lunate':>8}  {'RS mean MPa':>11}  {'RS peak MPa':>11}")
+    for f in range(len(result.poses)):
+        print(
+            f"{f:>5}  {flex[f, c]:8.2f}  {flex[f, s]:8.2f}  {flex[f, l]:8.2f}  "
+            f"{result.contact[f, rs, 0]:11.3f}  {result.contact[f, rs, 1]:11.3f}"
+        )
+    timing = f"simulate {wall:.3f} s" + ("" if compile_seconds is None else f" (warm-up {compile_seconds:.3f} s)")
+    print(f"status: {result.message}; {timing}; model load {load_seconds:.2f} s")
+    return 0 if result.ok else 1
+
+
+def _evaluate(args) -> int:
+    from wrist_env.envs.task import task
+    from wrist_env.frames import DOF_NAMES, DOF_UNITS
+    from wrist_env.participants import registry
+
+    registry.require(args.participant)
+    d = load_design(args.design, args.participant)
+    start = time.perf_counter()
+    t = task(args.participant, args.motion)
+    load_seconds = time.perf_counter() - start
+    start = time.perf_counter()
+    evaluation = t.evaluate(d)
+    wall = time.perf_counter() - start
+    info = evaluation.info
+    out = {
+        "participant": args.participant,
+        "motion": args.motion,
+        "design": args.design,
+        "failed": bool(evaluation.failed),
+        "status": info["status"],
+        "cost": evaluation.cost,
+        "error_p75": info.get("error_p75"),
+        "rmse": info.get("rmse"),
+        "cost_terms": info.get("cost_terms"),
+        "units": dict(zip(DOF_NAMES, DOF_UNITS)),
+        "n_frames": len(evaluation.result.poses),
+        "wall_seconds": round(wall, 4),
+        "load_seconds": round(load_seconds, 4),
+    }
+    if args.json:
+        print(json.dumps(out, indent=1, allow_nan=False))
+        return 1 if evaluation.failed else 0
+    print(f"{args.participant}, {args.motion} motion ({out['n_frames']} frames), design {args.design}")
+    if out["error_p75"] is None:
+        print("no reference kinematics (a user participant's idealized sweep): cost 0 by definition")
+    else:
+        print(f"{'bone':<9} {'DOF':<10} {'p75 error':>9} {'RMSE':>8}  unit")
+        for bone, errors in out["error_p75"].items():
+            for dof, unit in zip(DOF_NAMES, DOF_UNITS):
+                p75, rmse = errors[dof], out["rmse"][bone][dof]
+                p75, rmse = ("nan" if x is None else f"{x:.3f}" for x in (p75, rmse))
+                print(f"{bone:<9} {dof:<10} {p75:>9} {rmse:>8}  {unit}")
+    print(
+        f"cost {evaluation.cost:.4f}{' (failed)' if evaluation.failed else ''}; status: {info['status']}; "
+        f"evaluate {wall:.3f} s; task setup {load_seconds:.2f} s"
+    )
+    return 1 if evaluation.failed else 0
+
+
+def _validate(args) -> int:
+    from wrist_env import validation
+    from wrist_env.builder.pipeline import BuildParams, anatomy_params
+    from wrist_env.participants import registry
+    from wrist_env.solver.simulate import IDEALIZED_LOAD_N
+
+    registry.require(args.participant)
+    params = anatomy_params(args)
+    report = validation.validate(
+        args.participant, params=params, load_n=IDEALIZED_LOAD_N if args.load is None else args.load
+    )
+    variant = "" if params == BuildParams() and args.load is None else "_variant"
+    from wrist_env.figures.draw import FIGURES as figures_dir
+
+    out = Path(args.out or figures_dir) / f"validation_{report.participant}{variant}.png"
+    figure = validation.validation_figure(report, out)
+    if args.json:
+        print(json.dumps(dict(report.to_dict(), figure=str(figure)), indent=1, allow_nan=False))
+    else:
+        print(validation.format_table(report))
+        print(f"figure: {figure}")
+    return 0 if report.passed else 1
+
+
+def _figure(args) -> int:
+    from wrist_env import figures
+
+    out = Path(args.out) if args.out else None
+    if args.kind == "model":
+        path = figures.model_figure(args.participant or "P1", out)
+    elif args.kind == "annotations":
+        path = figures.annotations_figure(out)
+    elif args.kind == "pressure":
+        path = figures.pressure_figure(args.participant or "P1", out, static=args.static)
+    elif args.kind == "kinematics":
+        path = figures.kinematics_figure(args.participant or "P1", out)
+    else:
+        raise SystemExit(f"unknown figure {args.kind!r}")
+    print(path)
+    return 0
+
+
+def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
+    """Add these commands; `command(name, **kwargs)` makes a subcommand's parser."""
+    from wrist_env.builder.pipeline import add_anatomy_arguments
+
+    s = command(
+        "participants",
+        help="list the known participants",
+        description="List the participants this command can use: the built-in P1-P3 (synthetic, with their "
+        "Table 1 facts) and the participant folders registered with --folder.",
+    )
+    s.set_defaults(run=_participants)
+
+    s = command(
+        "build",
+        help="build (or load from cache) a participant model",
+        description="Build a participant's model (morph the template, cartilage, ligament fibres, contact law, "
+        "signed-distance grids; ~30-45 s on first use) and cache it by the hash of its inputs; later "
+        "calls load the cache. Prints the build summary.",
+    )
+    s.add_argument("participant", help=PARTICIPANT_HELP)
+    s.add_argument("--json", action="store_true", help="print the build summary as JSON")
+    s.add_argument("--no-cache", action="store_true", help="rebuild even if a cached model exists")
+    s.set_defaults(run=_build)
+
+    s = command(
+        "export",
+        help="write a built-in participant as a participant folder (a template for your own)",
+        description="Write a built-in participant (its five bone meshes as STL, RCS mm; its trials as CSV; "
+        "participant.toml) as a participant folder that build, evaluate, calibrate and "
+        "wrist_env.register_participant accept unchanged: the starting point for a folder of your own. "
+        "The folder's participant is named after the folder (or --name).",
+    )
+    s.add_argument("participant", help="built-in participant to export: P1, P2 or P3")
+    s.add_argument("out_folder", metavar="folder", help="new folder to write (must not exist or be empty)")
+    s.add_argument("--name", help="the exported participant's name (default: the folder's name)")
+    s.set_defaults(run=_export)
+
+    s = command(
+        "simulate",
+        help="simulate a participant and print the per-frame outputs",
+        description="Simulate one participant and design; print per-frame kinematics, contact, ligament "
+        "forces and the wall time of the simulate call. The first call in a fresh environment "
+        "includes Numba compilation (later calls read Numba's on-disk cache; each new process "
+        "still pays ~0.2 s to load it): --warm-up runs a one-frame simulation first and reports "
+        "its time as compile_seconds, so that wall_seconds is the solver alone.",
+    )
+    s.add_argument("participant", help=PARTICIPANT_HELP)
+    s.add_argument(
+        "--motion",
+        choices=["idealized", "static"],
+        default="idealized",
+        help="idealized: capitate swept from --flexion to --extension about the RCS z axis under a "
+        "small compressive load (default); static: capitate held at neutral (experimental "
+        "driver with identity transforms)",
+    )
+    s.add_argument(
+        "--design",
+        default="population",
+        help="'population' (Table 2 means, default), 'truth' (a built-in participant's hidden "
+        "ground truth) or a JSON file of a design (Design.as_dict)",
+    )
+    s.add_argument("--frames", type=int, help="number of output frames (default 17 idealized, 3 static)")
+    s.add_argument("--flexion", type=float, default=40.0, help="idealized: first frame's flexion, deg (default 40)")
+    s.add_argument("--extension", type=float, default=40.0, help="idealized: last frame's extension, deg (default 40)")
+    s.add_argument("--warm-up", action="store_true", help="run a one-frame simulation first (compile_seconds)")
+    s.add_argument("--json", action="store_true", help="print all per-frame outputs as JSON")
+    s.set_defaults(run=_simulate)
+
+    s = command(
+        "evaluate",
+        help="score one design on a participant's task (cost, per-DOF errors)",
+        description="Simulate one design on a participant's task and print its kinematic cost with the 75th "
+        "percentile |error| and the RMSE of each scaphoid and lunate DOF (mm, deg) against the "
+        "reference: the calibration trial (default), the held-out validation trial, or the idealized "
+        "sweep (reference: the hidden truth's sweep for built-in participants; none, cost 0, for "
+        "user participants). Exit status 1 if the simulation failed.",
+    )
+    s.add_argument("participant", help=PARTICIPANT_HELP)
+    s.add_argument(
+        "--motion",
+        choices=["calibrate", "validate", "idealized"],
+        default="calibrate",
+        help="calibrate: the trial with role calibrate (default); validate: the trial with role "
+        "validate; idealized: the flexion-extension sweep",
+    )
+    s.add_argument(
+        "--design",
+        default="population",
+        help="'population' (Table 2 means, default), 'truth' (a built-in participant's hidden "
+        "ground truth) or a JSON file of a design (Design.as_dict)",
+    )
+    s.add_argument("--json", action="store_true", help="print the cost, per-DOF errors and timings as JSON")
+    s.set_defaults(run=_evaluate)
+
+    s = command(
+        "validate",
+        help="check the model against published wrist measurements (exit 1 if any check fails)",
+        description="Simulate the population design (idealized +-40 deg sweep intact and with all three SLIL bundles "
+        "torn, and the capitate held at neutral) and compare carpal kinematics, radiocarpal load share, "
+        "SL gap after SLIL tear, radioscaphoid pressure and SLIL force with published bands (each row "
+        "cites its source). Prints the table (or JSON) and writes a figure; exit status 1 if any check "
+        "fails.",
+    )
+    s.add_argument("participant", help=PARTICIPANT_HELP)
+    s.add_argument("--json", action="store_true", help="print the checks and series as JSON")
+    s.add_argument("--out", help=f"figure folder (default {FIGURES_HELP})")
+    add_anatomy_arguments(s)
+    s.add_argument(
+        "--load",
+        type=float,
+        help="compressive load on the capitate in the sweeps, N (default: the idealized "
+        "driver's; the load-share check always takes 100 N)",
+    )
+    s.set_defaults(run=_validate)
+
+    s = command(
+        "figure",
+        help="write a figure (PNG)",
+        description="model: bones, cartilage, ligaments; annotations: the template; pressure: "
+        "contact pressure at the neutral pose viewed from distal (population design); "
+        "kinematics: scaphoid and lunate rotations over an idealized sweep.",
+    )
+    s.add_argument("kind", choices=["model", "annotations", "pressure", "kinematics"])
+    s.add_argument("participant", nargs="?", help=PARTICIPANT_HELP + " (default P1)")
+    s.add_argument("--out", help=f"output PNG path (default: a file named after the figure in {FIGURES_HELP})")
+    s.add_argument(
+        "--static",
+        action="store_true",
+        help="pressure: capitate held at neutral without load, instead of the 0° frame of the "
+        "idealized sweep (10 N compressive load)",
+    )
+    s.set_defaults(run=_figure)
