@@ -54,7 +54,7 @@ def _export(args: argparse.Namespace) -> int:
 
     from wrist_env.errors import ParticipantError
     from wrist_env.participants import builtin
-    from wrist_env.participants.folder import PARTICIPANT_FILE, write_participant_folder
+    from wrist_env.participants.folder import NAME_PATTERN, PARTICIPANT_FILE, write_participant_folder
 
     if args.participant not in builtin.BUILTIN:
         raise ParticipantError(
@@ -63,10 +63,10 @@ def _export(args: argparse.Namespace) -> int:
         )
     out = Path(args.out_folder)
     name = args.name or out.resolve().name
-    if name in builtin.BUILTIN or not re.fullmatch(r"[A-Za-z0-9_.-]+", name):
+    if name in builtin.BUILTIN or not re.fullmatch(NAME_PATTERN, name):
         raise ParticipantError(
-            f"the exported participant needs a name of letters, digits, '_', '.' or '-' that is not a built-in "
-            f"one, but got {name!r} (give --name)"
+            f"the exported participant needs a name matching {NAME_PATTERN} that is not a built-in one, "
+            f"but got {name!r} (give --name)"
         )
     if out.exists() and any(out.iterdir()):
         raise ParticipantError(f"{out} exists and is not empty; export writes a new folder")

@@ -95,12 +95,12 @@ def _plain_log_ticks(axis, subs=(1.0, 2.0, 5.0)) -> None:
 
 
 def ecdf_figure(path: str | os.PathLike, board: Leaderboard, colors: dict[str, _RGBA]) -> None:
-    """COCO-style ECDF of (run, target) pairs solved against evaluations."""
+    """COCO-style ECDF of (run, target) pairs solved against evaluations (`tables.ECDF_TARGETS` per participant)."""
     import matplotlib.pyplot as plt
 
     runs_frame, targets, curves, participants, labels, budgets = (
         board.runs_frame,
-        board.targets,
+        board.ecdf_targets,
         board.curves,
         board.participants,
         board.labels,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from wrist_env.bench.leaderboard.tables import CSV_FILES, Leaderboard
+from wrist_env.bench.leaderboard.tables import CSV_FILES, ECDF_TARGETS, Leaderboard
 
 
 def fmt(v: float | None, digits: int = 3) -> str:
@@ -110,7 +110,9 @@ def readme(board: Leaderboard, title: str | None = None) -> str:
         "![ECDF](ecdf.png)",
         "",
         "ECDF in the style of COCO: for each calibrator, the fraction of all (run, target) pairs whose target "
-        "the run's best-so-far cost had reached after a given number of evaluations.",
+        "the run's best-so-far cost had reached after a given number of evaluations; "
+        f"{ECDF_TARGETS} targets per participant, log-spaced from the population design's cost down to "
+        "a thousandth of its distance to the best cost any run reached (`ecdf_targets.csv`).",
         "",
     ]
 

@@ -22,6 +22,13 @@ uncalibrated model; 1.1 × the hidden truth's cost is "as good as the truth, wit
 is not cost 0: the reference kinematics carry tracking noise and come from a finer model). A target
 below what any design can reach (0.5 × population can be below the truth's cost) stays unsolved."""
 
+ECDF_TARGETS = 51
+ECDF_DECADES = 3.0
+"""The ECDF's targets per participant, as COCO's (51 log-spaced precisions, Hansen et al. 2021,
+Optim Methods Softw 36:114): f* + (f_pop − f*)·10^(−3k/50), k = 0..50, from the population design's
+cost f_pop down to a thousandth of its distance to f*, the best cost any run of the log reached
+(the optimum is unknown: COCO's "best known" convention)."""
+
 PREPRINT_SHARE_IMPROVED = {"calibrate": 66.7, "validate": 61.1}
 """Share of DOF (%) with lower RMSE after calibration in the preprint's Tables 3 and 4."""
 
@@ -311,6 +318,7 @@ class Leaderboard:
     refs: dict
     curves: dict
     targets: pd.DataFrame
+    ecdf_targets: pd.DataFrame
     runs_frame: pd.DataFrame
     best: pd.DataFrame
     ert: pd.DataFrame
@@ -340,6 +348,21 @@ def _targets(participants, refs) -> pd.DataFrame:
                     }
                 )
     return pd.DataFrame(rows)
+
+
+def ecdf_targets(participants: Iterable[str], refs: dict[str, Reference], curves_by_key: dict) -> pd.DataFrame:
+    """`ECDF_TARGETS` log-spaced cost targets per participant (see `ECDF_TARGETS`): participant, k, value."""
+    rows = []
+    for p in participants:
+        ends = [float(np.min(c)) for key, c in curves_by_key.items() if key[0] == p and len(c)]
+        start = refs[p].population["calibrate"]["cost"]
+        if not ends:
+            continue
+        best = min(ends)
+        for k in range(ECDF_TARGETS):
+            precision = 10.0 ** (-ECDF_DECADES * k / (ECDF_TARGETS - 1))
+            rows.append({"participant": p, "k": k, "value": best + (start - best) * precision})
+    return pd.DataFrame(rows, columns=["participant", "k", "value"])
 
 
 def _runs_frame(summaries, curves_by_key, targets, budgets) -> pd.DataFrame:
@@ -399,6 +422,7 @@ def build(runs: str | Path, references: dict[str, Reference] | None = None) -> L
         refs,
         by_key,
         targets,
+        ecdf_targets(participants, refs, by_key),
         runs_frame,
         best_cost(runs_frame, refs, participants, labels),
         evals_to_target(runs_frame, targets, participants, labels, by_key),
@@ -414,6 +438,7 @@ def build(runs: str | Path, references: dict[str, Reference] | None = None) -> L
 CSV_FILES = {
     "best_cost.csv": ("best", "%.6g"),
     "targets.csv": ("targets", "%.6g"),
+    "ecdf_targets.csv": ("ecdf_targets", "%.6g"),
     "evals_to_target.csv": ("ert", "%.6g"),
     "recovery.csv": ("recovery", "%.6g"),
     "heldout.csv": ("heldout", "%.6g"),
