@@ -15,6 +15,10 @@ if TYPE_CHECKING:
     from wrist_env.solver.simulate import Driver
 
 FIGURES_HELP = "$WRIST_ENV_FIGURES or runs/figures"  # wrist_env.figures.draw.FIGURES (no matplotlib import here)
+DESIGN_HELP = (
+    "'population' (Table 2 means, default), 'truth' (a built-in participant's hidden ground truth) "
+    "or a JSON file of a design (Design.as_dict; calibrate --out writes one)"
+)
 PARTICIPANT_HELP = "participant: built-in P1, P2, P3 or a registered folder's name (see `wrist-bench participants`)"
 
 
@@ -303,12 +307,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "small compressive load (default); static: capitate held at neutral (experimental "
         "driver with identity transforms)",
     )
-    s.add_argument(
-        "--design",
-        default="population",
-        help="'population' (Table 2 means, default), 'truth' (a built-in participant's hidden "
-        "ground truth) or a JSON file of a design (Design.as_dict)",
-    )
+    s.add_argument("--design", default="population", help=DESIGN_HELP)
     s.add_argument("--frames", type=int, help="number of output frames (default 17 idealized, 3 static)")
     s.add_argument("--flexion", type=float, default=40.0, help="idealized: first frame's flexion, deg (default 40)")
     s.add_argument("--extension", type=float, default=40.0, help="idealized: last frame's extension, deg (default 40)")
@@ -333,12 +332,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         help="calibrate: the trial with role calibrate (default); validate: the trial with role "
         "validate; idealized: the flexion-extension sweep",
     )
-    s.add_argument(
-        "--design",
-        default="population",
-        help="'population' (Table 2 means, default), 'truth' (a built-in participant's hidden "
-        "ground truth) or a JSON file of a design (Design.as_dict)",
-    )
+    s.add_argument("--design", default="population", help=DESIGN_HELP)
     s.add_argument("--json", action="store_true", help="print the cost, per-DOF errors and timings as JSON")
     s.set_defaults(run=_evaluate)
 
