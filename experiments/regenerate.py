@@ -2,7 +2,7 @@
 and `leaderboards/montecarlo/` (the maintainer's one command after a model change).
 
 Runs, from the repository root, each step as the README documents it and prints its wall time:
-the figures (`wrist-bench figure ...`, `wrist-bench validate P1`), the full default benchmark
+the built-in models shipped with the package (`experiments/ship_models.py`), the figures (`wrist-bench figure ...`, `wrist-bench validate P1`), the full default benchmark
 and its leaderboard (3 participants × 7 calibrators × 5 seeds × 300 evaluations), and the full
 Monte Carlo study (P1 + P2, 2 × 12,500) with its report. The studies' run logs go to a fresh
 folder `runs/regenerate-<commit>/` (a killed run resumes there when rerun at the same commit).
@@ -51,6 +51,11 @@ def main(argv=None) -> None:
     parser.add_argument("--figures-only", action="store_true", help="skip the benchmark and the Monte Carlo study")
     args = parser.parse_args(argv)
     runs = ROOT / "runs" / f"regenerate-{_commit()}"
+    start = time.perf_counter()
+    print("$ python experiments/ship_models.py", flush=True)
+    if subprocess.run([sys.executable, str(ROOT / "experiments" / "ship_models.py")], cwd=ROOT).returncode:
+        sys.exit("experiments/ship_models.py failed")
+    print(f"  {time.perf_counter() - start:.0f} s", flush=True)
     for argv_ in steps(runs, args.figures_only):
         print("$ wrist-bench " + " ".join(argv_), flush=True)
         start = time.perf_counter()

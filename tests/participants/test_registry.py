@@ -98,3 +98,35 @@ def test_ensure_folder_reads_a_registered_folder_once(tmp_path, monkeypatch):
     assert registry.ensure_folder(path) == "U3" and registry.ensure_folder(tmp_path / "u3" / ".." / "u3") == "U3"
     assert len(calls) == 1
     assert registry.add_folder(path) == "U3" and len(calls) == 2  # add_folder re-reads (files may have changed)
+
+
+def test_a_fresh_install_reads_the_shipped_builtin_model(tmp_path, monkeypatch):
+    """With an empty cache the built-ins load from the models shipped in the package, not by a build."""
+    from wrist_env.participants import builtin
+
+    monkeypatch.setenv("WRIST_ENV_CACHE", str(tmp_path))
+
+    def no_build(*args, **kwargs):
+        raise AssertionError("built instead of reading the shipped model")
+
+    monkeypatch.setattr(registry, "build_model", no_build)
+    for name in builtin.BUILTIN:
+        model = registry.load_model(name)
+        assert model.name == name and model.source_hash == builtin.shipped_source_hash(name)
+
+
+def test_the_shipped_model_is_what_a_build_gives(tmp_path, monkeypatch):
+    """Rebuilding P1 from scratch gives the shipped model: same inputs' hash, same arrays."""
+    from dataclasses import fields
+
+    from wrist_env.model import Model
+    from wrist_env.participants import builtin
+
+    monkeypatch.setenv("WRIST_ENV_CACHE", str(tmp_path))
+    built = registry.load_model("P1", cache=False)
+    shipped = Model.load(builtin.shipped_model_path("P1"))
+    assert built.source_hash == shipped.source_hash
+    for f in fields(Model):
+        a, b = getattr(built, f.name), getattr(shipped, f.name)
+        if isinstance(a, np.ndarray):
+            assert a.shape == b.shape and np.allclose(a, b, rtol=1e-9, atol=1e-9, equal_nan=True), f.name

@@ -85,6 +85,31 @@ def bones(name: str, fossa_sweep_deg: tuple = (0.0, 0.0), distal_row: bool = Fal
     return out
 
 
+SHIPPED_MODEL = "model"
+"""The built model shipped beside a built-in participant's data (`model.npz` + `model.json`, written by
+`python experiments/regenerate.py`); `registry.load_model` uses it when its source hash is the one
+it would build, and builds otherwise (a changed builder, template or platform)."""
+
+
+def shipped_model_path(name: str) -> Path | None:
+    """The base path of the model shipped with built-in participant `name`, or None if none ships."""
+    if name not in BUILTIN:
+        return None
+    path = Path(str(importlib.resources.files("wrist_env.participants") / "data" / name / SHIPPED_MODEL))
+    return path if path.with_suffix(".json").is_file() else None
+
+
+def shipped_source_hash(name: str) -> str | None:
+    """The source hash of the shipped model of `name` (read from its JSON), or None."""
+    path = shipped_model_path(name)
+    if path is None:
+        return None
+    try:
+        return json.loads(path.with_suffix(".json").read_text())["fields"]["source_hash"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
 def source(name: str, fossa_sweep_deg: tuple | None = None) -> ParticipantSource:
     """The participant as a `folder.ParticipantSource`: its five principal bones (the radius fossae swept
     as in `load_template`; default: `BuildParams()`'s), its trials and Table 1 facts, a right wrist.

@@ -113,7 +113,8 @@ def trial(name: str, role: str) -> Trial:
 
 
 def load_model(name: str, params: BuildParams | None = None, *, cache: bool = True) -> Model:
-    """The participant's model, built on first use and cached by the hash of its inputs."""
+    """The participant's model, built on first use and cached by the hash of its inputs (a built-in
+    participant's shipped model is used when its hash is that of the inputs: `builtin.SHIPPED_MODEL`)."""
     params = params or BuildParams()
     b = bones(name, params)
     digest = source_hash(name, b, params)
@@ -128,6 +129,11 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
             return model
         except StoreError as e:
             warnings.warn(f"rebuilding a damaged cached model: {e}", stacklevel=2)
+    if cache and builtin.shipped_source_hash(name) == digest:
+        try:
+            return Model.load(builtin.shipped_model_path(name))
+        except StoreError as e:
+            warnings.warn(f"building instead of reading a damaged shipped model: {e}", stacklevel=2)
     try:
         model = build_model(name, b, params, digest=digest)
     except BuildError as e:
