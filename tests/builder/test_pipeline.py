@@ -87,14 +87,20 @@ def test_model_round_trips_through_npz_and_json(built, tmp_path):
         assert "grid_values" in data.files
 
 
-def test_load_model_uses_the_cache(built, model_cache):
-    from wrist_env.participants.registry import load_model
+def test_load_model_uses_the_cache(built, tmp_path, monkeypatch):
+    """A built model is written to the cache and read back from it (the shipped models set aside)."""
+    from wrist_env.participants import builtin, registry
 
-    built("P1")
-    files = sorted(p.name for p in model_cache.iterdir())
-    assert any(f.startswith("P1-") and f.endswith(".npz") for f in files)
-    again = load_model("P1")
-    assert again.report["build_seconds"] == built("P1").report["build_seconds"]  # read back, not rebuilt
+    model = built("P1")
+    monkeypatch.setenv("WRIST_ENV_CACHE", str(tmp_path))
+    monkeypatch.setattr(builtin, "shipped_source_hash", lambda name: None)
+    builds = []
+    monkeypatch.setattr(registry, "build_model", lambda name, *a, **k: builds.append(name) or model)
+    assert registry.load_model("P1") is model and builds == ["P1"]
+    assert [p.name for p in tmp_path.iterdir() if p.suffix == ".npz"] == [f"P1-{model.source_hash}.npz"]
+    again = registry.load_model("P1")
+    assert again is not model and builds == ["P1"]  # read back, not rebuilt
+    assert again.report["build_seconds"] == model.report["build_seconds"]
 
 
 @pytest.mark.parametrize("name", PARTICIPANTS)
