@@ -35,6 +35,7 @@ def steps(runs: Path, figures_only: bool) -> list[list[str]]:
         ["figure", "model", "P1", "--out", f"{FIGURES}/model_P1.png"],
         ["figure", "pressure", "P1", "--out", f"{FIGURES}/pressure_P1.png"],
         ["figure", "kinematics", "P1", "--out", f"{FIGURES}/kinematics_P1.png"],
+        ["figure", "animation", "P1", "--out", f"{FIGURES}/animation_P1.gif"],
         ["validate", "P1", "--out", FIGURES],
     ]
     if figures_only:

@@ -115,6 +115,24 @@ def test_figure_commands_write_pngs(capsys, built, tmp_path):
         assert out.stat().st_size > 10_000 and out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+@pytest.mark.slow
+def test_the_animation_is_a_gif_of_the_sweep_whose_frames_differ(capsys, built, tmp_path):
+    from PIL import Image
+
+    built("P1")
+    out = tmp_path / "sweep.gif"
+    assert main(["figure", "animation", "P1", "--out", str(out)]) == 0
+    assert capsys.readouterr().out.strip() == str(out)
+    with Image.open(out) as gif:
+        assert gif.format == "GIF" and gif.n_frames == 17
+        frames = []
+        for k in (0, 8, 16):
+            gif.seek(k)
+            frames.append(np.asarray(gif.convert("L"), dtype=float))
+    assert np.abs(frames[0] - frames[2]).mean() > 1.0  # the bones moved between full flexion and extension
+    assert np.abs(frames[0] - frames[1]).mean() > 0.5
+
+
 def test_evaluate_json_truth_beats_population(capsys, built):
     import math
 

@@ -246,6 +246,8 @@ def _figure(args) -> int:
         path = figures.pressure_figure(args.participant or "P1", out, static=args.static)
     elif args.kind == "kinematics":
         path = figures.kinematics_figure(args.participant or "P1", out)
+    elif args.kind == "animation":
+        path = figures.animation_figure(args.participant or "P1", out)
     else:
         raise SystemExit(f"unknown figure {args.kind!r}")
     print(path)
@@ -362,9 +364,10 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         help="write a figure (PNG)",
         description="model: bones, cartilage, ligaments; annotations: the template; pressure: "
         "contact pressure at the neutral pose viewed from distal (population design); "
-        "kinematics: scaphoid and lunate rotations over an idealized sweep.",
+        "kinematics: scaphoid and lunate rotations over an idealized sweep; animation: a GIF of that sweep "
+        "(radial view: bones, ligament fibres coloured by force, radiocarpal contact pressure).",
     )
-    s.add_argument("kind", choices=["model", "annotations", "pressure", "kinematics"])
+    s.add_argument("kind", choices=["model", "annotations", "pressure", "kinematics", "animation"])
     s.add_argument("participant", nargs="?", help=PARTICIPANT_HELP + " (default P1)")
     s.add_argument("--out", help=f"output PNG path (default: a file named after the figure in {FIGURES_HELP})")
     s.add_argument(

@@ -1,0 +1,105 @@
+"""An animated idealized sweep (GIF): bones, ligament fibres coloured by force, radiocarpal pressure."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.animation import FuncAnimation, PillowWriter
+from matplotlib.collections import LineCollection, PolyCollection
+
+from wrist_env import design
+from wrist_env.figures import draw
+from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model
+from wrist_env.participants.registry import load_model
+from wrist_env.solver import simulate as sim
+from wrist_env.solver.outputs import pair_slice, pressure_map
+
+_LIGHT = np.array([0.3, 0.5, 1.0]) / np.linalg.norm([0.3, 0.5, 1.0])  # from the radial side, above
+_CROP_MM = 12.0  # radius and ulna: only their distal end (RCS y below this)
+RADIOCARPAL = ("radioscaphoid", "radiolunate")
+
+
+def _bone_polygons(model: Model, poses_frame: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Triangles of every bone at one frame seen from the radial side: (n, 3, 2) in (volar x, proximal y)
+    mm, painter-sorted (far first), and their shaded colours (n, 4)."""
+    tris, colours, depth = [], [], []
+    for b, bone in enumerate(BONES):
+        v = model.vertices[model.vertex_offsets[b] : model.vertex_offsets[b + 1]]
+        f = model.faces[model.face_offsets[b] : model.face_offsets[b + 1]]
+        if bone in ("radius", "ulna"):
+            f = f[(v[f][:, :, 1] < _CROP_MM).all(axis=1)]
+        w = v @ poses_frame[b, :3, :3].T + poses_frame[b, :3, 3]
+        t = w[f]
+        normal = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+        normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-12)
+        shade = 0.45 + 0.55 * np.clip(normal @ _LIGHT, 0.0, 1.0)
+        base = np.array(plt.matplotlib.colors.to_rgb(draw.BONE_COLOUR[bone]))
+        tris.append(t[:, :, :2])
+        colours.append(np.column_stack([shade[:, None] * base, np.ones(len(t))]))
+        depth.append(t[:, :, 2].mean(axis=1))
+    order = np.argsort(np.concatenate(depth))  # radial view: +z towards the viewer, far (ulnar) first
+    return np.concatenate(tris)[order], np.concatenate(colours)[order]
+
+
+def animation_figure(name: str, out: Path | None = None, *, n_frames: int = 17, fps: float = 4.0) -> Path:
+    """Write a GIF of the population design's idealized sweep of `name` (radial view): returns its path."""
+    model = load_model(name)
+    driver = sim.idealized(model, n_frames=n_frames)
+    result = sim.simulate(model, design.population(), driver)
+    if not result.ok:
+        raise RuntimeError(f"{name}: the population design's sweep failed ({result.message})")
+    out = Path(out) if out else draw.FIGURES / f"animation_{name}.gif"
+    out.parent.mkdir(parents=True, exist_ok=True)
+    radiocarpal = np.r_[tuple(pair_slice(model, p) for p in RADIOCARPAL)]
+    samples = model.sample_points[radiocarpal]
+    sample_body = np.concatenate(  # the bone each sample lies on (the pair's sample body)
+        [np.full(len(model.sample_points[pair_slice(model, p)]), PAIR_BONES[PAIRS.index(p)][0]) for p in RADIOCARPAL]
+    )
+    pressures = [pressure_map(model, result.poses[f])[radiocarpal] for f in range(n_frames)]
+    p_max = max(float(np.percentile(p[p > 0], 99)) if (p > 0).any() else 1.0 for p in pressures)
+    f_max = max(float(np.nanmax(result.bundle_force)), 1.0)
+    force_map, pressure_cmap = plt.get_cmap("viridis"), plt.get_cmap("inferno")
+
+    fig, ax = plt.subplots(figsize=(6.4, 6.4), constrained_layout=True)
+    ax.set_aspect("equal")
+    ax.set_xlim(-25, 25)
+    ax.set_ylim(-38, 14)
+    ax.set_xlabel("dorsal  ←  x (mm)  →  volar")
+    ax.set_ylabel("distal  ←  y (mm)  →  proximal")
+    bones = PolyCollection([], linewidths=0.3, edgecolors="face")  # edges in the face colour: no seams
+    fibres = LineCollection([], linewidths=1.6, cmap=force_map, norm=plt.Normalize(0, f_max))
+    contact = ax.scatter([], [], s=6, c=[], cmap=pressure_cmap, vmin=0, vmax=p_max, zorder=4)
+    ax.add_collection(bones)
+    ax.add_collection(fibres)
+    fibres.set_zorder(3)
+    fig.colorbar(fibres, ax=ax, shrink=0.6, label="ligament fibre force: its bundle's (N)")
+    fig.colorbar(contact, ax=ax, shrink=0.6, label="radiocarpal contact pressure (MPa)")
+    title = ax.set_title("")
+
+    def show(f: int):
+        poses = result.poses[f]
+        polygons, colours = _bone_polygons(model, poses)
+        bones.set_verts(polygons)
+        bones.set_facecolor(colours)
+        a = np.einsum("nij,nj->ni", poses[model.fibre_bones[:, 0], :3, :3], model.fibre_origin)
+        a += poses[model.fibre_bones[:, 0], :3, 3]
+        b = np.einsum("nij,nj->ni", poses[model.fibre_bones[:, 1], :3, :3], model.fibre_insertion)
+        b += poses[model.fibre_bones[:, 1], :3, 3]
+        fibres.set_segments(np.stack([a[:, :2], b[:, :2]], axis=1))
+        fibres.set_array(result.bundle_force[f][model.fibre_ligament])
+        world = np.einsum("nij,nj->ni", poses[sample_body, :3, :3], samples) + poses[sample_body, :3, 3]
+        on = pressures[f] > 0
+        contact.set_offsets(world[on, :2])
+        contact.set_array(pressures[f][on])
+        angle = driver.angle_deg[f]
+        title.set_text(
+            f"{name}, population design, radial view\ncapitate {abs(angle):.0f}° "
+            f"{'flexion' if angle >= 0 else 'extension'} (frame {f + 1}/{n_frames})"
+        )
+        return bones, fibres, contact, title
+
+    FuncAnimation(fig, show, frames=n_frames, blit=False).save(out, writer=PillowWriter(fps=fps), dpi=90)
+    plt.close(fig)
+    return out
