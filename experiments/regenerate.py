@@ -29,8 +29,9 @@ def _commit() -> str:
 
 
 def steps(runs: Path, figures_only: bool) -> list[list[str]]:
-    """The commands, in order (argv lists for `wrist-bench`)."""
+    """The commands, in order: `wrist-bench` argv lists, and the model-shipping script first."""
     figures = [
+        ["python", "experiments/ship_models.py"],
         ["figure", "annotations", "--out", f"{FIGURES}/template_annotations.png"],
         ["figure", "model", "P1", "--out", f"{FIGURES}/model_P1.png"],
         ["figure", "pressure", "P1", "--out", f"{FIGURES}/pressure_P1.png"],
@@ -52,18 +53,16 @@ def main(argv=None) -> None:
     parser.add_argument("--figures-only", action="store_true", help="skip the benchmark and the Monte Carlo study")
     args = parser.parse_args(argv)
     runs = ROOT / "runs" / f"regenerate-{_commit()}"
-    start = time.perf_counter()
-    print("$ python experiments/ship_models.py", flush=True)
-    if subprocess.run([sys.executable, str(ROOT / "experiments" / "ship_models.py")], cwd=ROOT).returncode:
-        sys.exit("experiments/ship_models.py failed")
-    print(f"  {time.perf_counter() - start:.0f} s", flush=True)
-    for argv_ in steps(runs, args.figures_only):
-        print("$ wrist-bench " + " ".join(argv_), flush=True)
+    for step in steps(runs, args.figures_only):
+        script = step[0] == "python"
+        shown = " ".join(step) if script else "wrist-bench " + " ".join(step)
+        print(f"$ {shown}", flush=True)
         start = time.perf_counter()
+        command = [sys.executable, *step[1:]] if script else [sys.executable, "-m", "wrist_env.cli", *step]
+        done = subprocess.run(command, cwd=ROOT)
         # validate exits 1 when a published check fails: its figure and table are still the result
-        done = subprocess.run([sys.executable, "-m", "wrist_env.cli", *argv_], cwd=ROOT)
-        if done.returncode not in (0, 1) or (done.returncode == 1 and argv_[0] != "validate"):
-            sys.exit(f"`wrist-bench {' '.join(argv_)}` failed (exit status {done.returncode})")
+        if done.returncode not in (0, 1) or (done.returncode == 1 and step[0] != "validate"):
+            sys.exit(f"`{shown}` failed (exit status {done.returncode})")
         print(f"  {time.perf_counter() - start:.0f} s", flush=True)
 
 

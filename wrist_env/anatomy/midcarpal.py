@@ -71,11 +71,12 @@ def facet_gaps(meshes: dict, T: np.ndarray | None = None, facets: list | None = 
     return np.array(gaps)
 
 
-def seat_distal_row(meshes: dict, joint_space_mm: float) -> np.ndarray:
+def seat_distal_row(meshes: dict, joint_space_mm: float, facets: list | None = None) -> np.ndarray:
     """The rigid transform (4×4, mm) of the distal row that seats it at `joint_space_mm` (see module).
 
-    meshes: part name -> trimesh in one frame (mm), the proximal row and the distal row's bones."""
-    facets = _facets(meshes)
+    meshes: part name -> trimesh in one frame (mm), the proximal row and the distal row's bones;
+    facets: their `_facets` if already found."""
+    facets = _facets(meshes) if facets is None else facets
     centre = np.mean([meshes[b].centroid for b in DISTAL_ROW], axis=0)
 
     def misfit(x):
@@ -97,14 +98,15 @@ def read_seat() -> np.ndarray:
 
 def seat_record(meshes: dict, joint_space_mm: float) -> dict:
     """The fit as plain data: the transform, its rotation (deg) and translation (mm), the facet gaps before and after."""
-    T = seat_distal_row(meshes, joint_space_mm)
+    facets = _facets(meshes)
+    T = seat_distal_row(meshes, joint_space_mm, facets)
     return {
         "about": "the distal row's rigid seating at one midcarpal joint space (wrist_env.anatomy.midcarpal); "
         "written by experiments/make_annotations.py",
         "joint_space_mm": joint_space_mm,
         "facets": [list(f) for f in FACETS],
-        "facet_gaps_before_mm": np.round(facet_gaps(meshes), 3).tolist(),
-        "facet_gaps_after_mm": np.round(facet_gaps(meshes, T), 3).tolist(),
+        "facet_gaps_before_mm": np.round(facet_gaps(meshes, None, facets), 3).tolist(),
+        "facet_gaps_after_mm": np.round(facet_gaps(meshes, T, facets), 3).tolist(),
         "rotation_vector_deg": np.round(np.degrees(Rotation.from_matrix(T[:3, :3]).as_rotvec()), 3).tolist(),
         "transform": T.tolist(),
     }

@@ -8,6 +8,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.animation import FuncAnimation, PillowWriter
 from matplotlib.collections import LineCollection, PolyCollection
+from matplotlib.colors import to_rgb
 
 from wrist_env import design
 from wrist_env.figures import draw
@@ -17,25 +18,30 @@ from wrist_env.solver import simulate as sim
 from wrist_env.solver.outputs import pair_slice, pressure_map
 
 _LIGHT = np.array([0.3, 0.5, 1.0]) / np.linalg.norm([0.3, 0.5, 1.0])  # from the radial side, above
-_CROP_MM = 12.0  # radius and ulna: only their distal end (RCS y below this)
 RADIOCARPAL = ("radioscaphoid", "radiolunate")
 
 
-def _bone_polygons(model: Model, poses_frame: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Triangles of every bone at one frame seen from the radial side: (n, 3, 2) in (volar x, proximal y)
-    mm, painter-sorted (far first), and their shaded colours (n, 4)."""
-    tris, colours, depth = [], [], []
+def _bone_surfaces(model: Model) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Per bone: its neutral vertices (mm), the faces drawn (radius and ulna cropped) and its RGB colour."""
+    surfaces = []
     for b, bone in enumerate(BONES):
         v = model.vertices[model.vertex_offsets[b] : model.vertex_offsets[b + 1]]
         f = model.faces[model.face_offsets[b] : model.face_offsets[b + 1]]
         if bone in ("radius", "ulna"):
-            f = f[(v[f][:, :, 1] < _CROP_MM).all(axis=1)]
-        w = v @ poses_frame[b, :3, :3].T + poses_frame[b, :3, 3]
-        t = w[f]
+            f = draw.crop(v, f, draw.DISTAL_CROP_MM)
+        surfaces.append((v, f, np.array(to_rgb(draw.BONE_COLOUR[bone]))))
+    return surfaces
+
+
+def _bone_polygons(surfaces: list, poses_frame: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Triangles of every bone at one frame seen from the radial side: (n, 3, 2) in (volar x, proximal y)
+    mm, painter-sorted (far first), and their shaded colours (n, 4)."""
+    tris, colours, depth = [], [], []
+    for b, (v, f, base) in enumerate(surfaces):
+        t = (v @ poses_frame[b, :3, :3].T + poses_frame[b, :3, 3])[f]
         normal = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
         normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-12)
         shade = 0.45 + 0.55 * np.clip(normal @ _LIGHT, 0.0, 1.0)
-        base = np.array(plt.matplotlib.colors.to_rgb(draw.BONE_COLOUR[bone]))
         tris.append(t[:, :, :2])
         colours.append(np.column_stack([shade[:, None] * base, np.ones(len(t))]))
         depth.append(t[:, :, 2].mean(axis=1))
@@ -52,15 +58,16 @@ def animation_figure(name: str, out: Path | None = None, *, n_frames: int = 17, 
         raise RuntimeError(f"{name}: the population design's sweep failed ({result.message})")
     out = Path(out) if out else draw.FIGURES / f"animation_{name}.gif"
     out.parent.mkdir(parents=True, exist_ok=True)
-    radiocarpal = np.r_[tuple(pair_slice(model, p) for p in RADIOCARPAL)]
+    slices = [pair_slice(model, p) for p in RADIOCARPAL]
+    radiocarpal = np.r_[tuple(slices)]
     samples = model.sample_points[radiocarpal]
-    sample_body = np.concatenate(  # the bone each sample lies on (the pair's sample body)
-        [np.full(len(model.sample_points[pair_slice(model, p)]), PAIR_BONES[PAIRS.index(p)][0]) for p in RADIOCARPAL]
-    )
+    # the bone each sample lies on: its pair's sample body
+    sample_body = np.repeat([PAIR_BONES[PAIRS.index(p)][0] for p in RADIOCARPAL], [s.stop - s.start for s in slices])
     pressures = [pressure_map(model, result.poses[f])[radiocarpal] for f in range(n_frames)]
     p_max = max(float(np.percentile(p[p > 0], 99)) if (p > 0).any() else 1.0 for p in pressures)
     f_max = max(float(np.nanmax(result.bundle_force)), 1.0)
     force_map, pressure_cmap = plt.get_cmap("viridis"), plt.get_cmap("inferno")
+    surfaces = _bone_surfaces(model)
 
     fig, ax = plt.subplots(figsize=(6.4, 6.4), constrained_layout=True)
     ax.set_aspect("equal")
@@ -80,7 +87,7 @@ def animation_figure(name: str, out: Path | None = None, *, n_frames: int = 17, 
 
     def show(f: int):
         poses = result.poses[f]
-        polygons, colours = _bone_polygons(model, poses)
+        polygons, colours = _bone_polygons(surfaces, poses)
         bones.set_verts(polygons)
         bones.set_facecolor(colours)
         a = np.einsum("nij,nj->ni", poses[model.fibre_bones[:, 0], :3, :3], model.fibre_origin)

@@ -17,7 +17,7 @@ MODEL_PANELS = (("volar view", 0, 0), ("radial view", 0, 90), ("dorsal view", 0,
 
 def _display_faces(bone: str, vertices, faces, thickness):
     """Faces worth drawing: cropped to the wrist, without the radius solid's walls and base."""
-    faces = draw.crop(vertices, faces, 12.0)
+    faces = draw.crop(vertices, faces, draw.DISTAL_CROP_MM)
     if bone == "radius":
         v = vertices[faces]
         n = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])

@@ -52,7 +52,6 @@ PRESSURE_PANELS = (
     ),
 )
 _BONE_FILL, _CARTILAGE_FILL, _OUTLINE = "#e6e1d8", "#c9d3de", "#4d4d4d"
-_DISTAL_CROP_MM = 12.0  # radius and ulna: only the distal end (RCS y below this)
 
 
 def pressure_figure(name: str, out: Path | None = None, *, static: bool = False) -> Path:
@@ -120,7 +119,7 @@ def pressure_figure(name: str, out: Path | None = None, *, static: bool = False)
             b = BONES.index(bone)
             v, _ = model.bone_mesh(bone)
             w = _world(poses, b, v)
-            keep = w[:, 1] < _DISTAL_CROP_MM if bone in ("radius", "ulna") else np.ones(len(w), bool)
+            keep = w[:, 1] < draw.DISTAL_CROP_MM if bone in ("radius", "ulna") else np.ones(len(w), bool)
             _silhouette(ax, xz(w[keep]), _BONE_FILL, filled=True, zorder=0)
             drawn.append((bone, xz(w[keep])))
             met = [pair_slice(model, p) for p in pairs if PAIR_BONES[PAIRS.index(p)][1] == b]
