@@ -5,12 +5,13 @@ builds one; `optimizers.minimize(opt, fun_batch)` runs it. Built in: one
 module each (imported here so they register).
 """
 
-from optimizers import (  # noqa: F401  (register)  # noqa: F401  (register; "optuna-gp" only with torch)
+from optimizers import (  # noqa: F401  (register; "optuna-gp" only with torch, "ng-*" only with nevergrad)
     cmaes,
     latin_hypercube,
     nelder_mead,
+    nevergrad_optimizers,
     optuna_samplers,
-    random_search,  # noqa: F401  (registers)
+    random_search,
     surrogate,
 )
 from optimizers.base import Optimizer, OptimizeResult, OptionError, minimize

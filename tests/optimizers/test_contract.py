@@ -35,8 +35,10 @@ CONVEX_FRACTION = {"random": 0.3, "lhs": 0.3, THIRD_PARTY_NAME: 0.3}  # default 
 
 # Calibrators whose first run does not depend on the seed: Nelder–Mead starts
 # from the box centre with a fixed simplex; only its restarts are random (tested
-# in test_adapters.py::test_nelder_mead_restarts).
-SEED_FREE_FIRST_RUN = {"nelder-mead"}
+# in test_adapters.py::test_nelder_mead_restarts). Nevergrad's NGOpt chooses a
+# deterministic method from x0 for small budgets (e.g. COBYLA; tested in
+# test_nevergrad.py::test_ngopt_is_seeded_where_its_choice_is_random).
+SEED_FREE_FIRST_RUN = {"nelder-mead", "ng-ngopt"}
 
 
 @pytest.fixture(params=NAMES)

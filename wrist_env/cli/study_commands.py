@@ -1,4 +1,4 @@
-"""`wrist-bench` studies: calibrate, benchmark, leaderboard, montecarlo, montecarlo-report."""
+"""`wrist-bench` studies: calibrate, benchmark, leaderboard, iohanalyzer, montecarlo, montecarlo-report."""
 
 from __future__ import annotations
 
@@ -118,6 +118,18 @@ def _leaderboard(args) -> int:
     return 0
 
 
+def _iohanalyzer(args) -> int:
+    try:
+        from wrist_env.bench.iohanalyzer import export
+    except ImportError as error:
+        raise SystemExit(f'wrist-bench iohanalyzer needs ioh ({error}): pip install -e ".[ioh]"') from None
+    if not Path(args.runs).is_dir():
+        raise SystemExit(f"wrist-bench iohanalyzer: no run log at {args.runs}")
+    for folder in export(args.runs, args.out):
+        print(folder)
+    return 0
+
+
 def _montecarlo(args) -> int:
     from wrist_env.montecarlo.study import StudyConfig, run_study
     from wrist_env.participants import registry
@@ -226,6 +238,17 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     s.add_argument("--out", default="runs/leaderboard", help="output folder (default runs/leaderboard)")
     s.add_argument("--title", help="title of the README.md")
     s.set_defaults(run=_leaderboard)
+
+    s = command(
+        "iohanalyzer",
+        help="write a benchmark run log in IOHanalyzer's format (through ioh's logger)",
+        description="Replays every logged evaluation through ioh's Analyzer logger (nothing is simulated): "
+        "one folder per calibrator, one problem per participant (wrist-<participant>), one run per seed. "
+        "Zip the output folder and upload it to IOHanalyzer. Needs the [ioh] extra.",
+    )
+    s.add_argument("--runs", default="runs/benchmark", help="run-log folder (default runs/benchmark)")
+    s.add_argument("--out", default="runs/iohanalyzer", help="output folder (default runs/iohanalyzer)")
+    s.set_defaults(run=_iohanalyzer)
 
     s = command(
         "montecarlo",

@@ -1,0 +1,87 @@
+"""The wrist problems in IOHexperimenter, and a benchmark run log in IOHanalyzer's format through ioh's logger."""
+
+import json
+
+import numpy as np
+import pytest
+
+from wrist_env.bench import RunLog, benchmark
+from wrist_env.bench.log import X_COLUMNS
+from wrist_env.cli import main
+
+ioh = pytest.importorskip("ioh")
+iohanalyzer = pytest.importorskip("wrist_env.bench.iohanalyzer")
+
+
+def _dat_blocks(path):
+    """The runs of an IOHanalyzer .dat file: one (n, columns) array per header line."""
+    blocks, rows = [], None
+    for line in path.read_text().splitlines():
+        if line.startswith("evaluations"):
+            header = line.split()
+            rows = []
+            blocks.append((header, rows))
+        else:
+            rows.append([float(v) for v in line.split()])
+    return [(header, np.array(rows)) for header, rows in blocks]
+
+
+def test_problem_is_the_calibration_cost_and_takes_ioh_loggers(built, tmp_path):
+    from wrist_env import design
+    from wrist_env.bench.calibrate import action
+    from wrist_env.envs.task import task
+
+    built("P1")
+    f = iohanalyzer.problem("P1")
+    assert f.meta_data.name == "wrist-P1" and f.meta_data.n_variables == 22
+    assert np.all(f.bounds.lb == -1.0) and np.all(f.bounds.ub == 1.0)
+    logger = ioh.logger.Analyzer(root=str(tmp_path), folder_name="mine", algorithm_name="mine")
+    f.attach_logger(logger)
+    x = np.random.default_rng(0).uniform(-1, 1, (3, 22))
+    values = [f(xi) for xi in x]
+    logger.close()
+    expected = [e.cost for e in task("P1", "calibrate").evaluate_batch([design.from_action(a) for a in action(x)])]
+    np.testing.assert_allclose(values, expected, rtol=0, atol=1e-12)
+    assert f.state.evaluations == 3 and f.state.current_best.y == min(values)
+    assert (tmp_path / "mine" / f"IOHprofiler_f{f.meta_data.problem_id}_wrist-P1.json").is_file()
+
+
+def test_a_benchmark_exports_in_iohanalyzer_format(built, tmp_path):
+    built("P1")
+    runs = tmp_path / "runs"
+    report = benchmark(["P1"], ["random", "cmaes"], 2, 8, runs, workers=1, progress=False)
+    assert not report.failed
+    out = tmp_path / "ioh"
+    assert main(["iohanalyzer", "--runs", str(runs), "--out", str(out)]) == 0
+    assert main(["iohanalyzer", "--runs", str(runs), "--out", str(out)]) == 0  # replaces, not "cmaes-1"
+    assert sorted(p.name for p in out.iterdir()) == ["cmaes", "random"]
+    log = RunLog(runs).read()
+    for optimizer in ("random", "cmaes"):
+        (meta_path,) = (out / optimizer).glob("IOHprofiler_f*_wrist-P1.json")
+        meta = json.loads(meta_path.read_text())
+        assert meta["algorithm"]["name"] == optimizer and meta["maximization"] is False
+        assert meta["function_name"] == "wrist-P1"
+        (scenario,) = meta["scenarios"]
+        assert scenario["dimension"] == 22 and len(scenario["runs"]) == 2
+        blocks = _dat_blocks(out / optimizer / scenario["path"])
+        assert len(blocks) == 2
+        for seed, (run, (header, rows)) in enumerate(zip(scenario["runs"], blocks)):
+            logged = log[(log.optimizer == optimizer) & (log.seed == seed)].sort_values("eval")
+            costs = logged["cost"].to_numpy()
+            assert run["evals"] == 8 and run["best"]["y"] == pytest.approx(costs.min(), abs=1e-9)
+            assert run["best"]["evals"] == int(np.argmin(costs)) + 1
+            np.testing.assert_allclose(run["best"]["x"], logged[list(X_COLUMNS)].to_numpy()[np.argmin(costs)])
+            # the evaluations that improved on the logged costs, and the run's last (ioh closes a run with it)
+            assert header[:2] == ["evaluations", "raw_y"] and len(header) == 2 + 22
+            rows_at = sorted({i for i in range(8) if costs[i] < costs[:i].min(initial=np.inf)} | {7})
+            assert rows[:, 0].astype(int).tolist() == [i + 1 for i in rows_at]
+            np.testing.assert_allclose(rows[:, 1], costs[rows_at], atol=1e-9)
+            np.testing.assert_allclose(
+                rows[:, 2:], logged[list(X_COLUMNS)].to_numpy()[rows_at], atol=1e-6
+            )  # ioh: 6 decimals
+
+
+def test_an_empty_run_log_is_named(tmp_path):
+    (tmp_path / "runs").mkdir()
+    with pytest.raises(Exception, match="no evaluations are logged"):
+        iohanalyzer.export(tmp_path / "runs", tmp_path / "out")
