@@ -3,7 +3,8 @@ and `leaderboards/montecarlo/` (the maintainer's one command after a model chang
 
 Runs, from the repository root, each step as the README documents it and prints its wall time:
 the built-in models shipped with the package (`experiments/ship_models.py`), the figures (`wrist-bench figure ...`, `wrist-bench validate P1`), the full default benchmark
-and its leaderboard (3 participants × 7 calibrators × 5 seeds × 300 evaluations), and the full
+and its leaderboard (3 participants × 11 calibrators × 5 seeds × 300 evaluations; Nevergrad's four
+need the `[nevergrad]` extra) with its IOHanalyzer files (`[ioh]`), and the full
 Monte Carlo study (P1 + P2, 2 × 12,500) with its report. The studies' run logs go to a fresh
 folder `runs/regenerate-<commit>/` (a killed run resumes there when rerun at the same commit).
 
@@ -43,15 +44,30 @@ def steps(runs: Path, figures_only: bool) -> list[list[str]]:
         return figures
     return figures + [
         ["benchmark", "--storage", "memory", "--out", str(runs / "benchmark"), "--leaderboard", "leaderboards"],
+        ["iohanalyzer", "--runs", str(runs / "benchmark"), "--out", "leaderboards/iohanalyzer"],
         ["montecarlo", "P1", "P2", "--n", "12500", "--seed", "0", "--out", str(runs / "montecarlo")],
         ["montecarlo-report", "--runs", str(runs / "montecarlo"), "--out", "leaderboards/montecarlo"],
     ]
+
+
+def _require_extras() -> None:
+    """The committed leaderboard includes Nevergrad's calibrators and IOHanalyzer files: refuse without them."""
+    import importlib.util
+
+    missing = [name for name in ("nevergrad", "ioh") if importlib.util.find_spec(name) is None]
+    if missing:
+        sys.exit(
+            f"regenerate needs {', '.join(missing)} (the leaderboard's calibrators and files): "
+            'pip install -e ".[nevergrad,ioh]"'
+        )
 
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--figures-only", action="store_true", help="skip the benchmark and the Monte Carlo study")
     args = parser.parse_args(argv)
+    if not args.figures_only:
+        _require_extras()
     runs = ROOT / "runs" / f"regenerate-{_commit()}"
     for step in steps(runs, args.figures_only):
         script = step[0] == "python"

@@ -1,10 +1,12 @@
 """The wrist problems in IOHexperimenter, and a benchmark run log in IOHanalyzer's format through ioh's logger."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+import wrist_env
 from wrist_env.bench import RunLog, benchmark
 from wrist_env.bench.log import X_COLUMNS
 from wrist_env.cli import main
@@ -85,3 +87,14 @@ def test_an_empty_run_log_is_named(tmp_path):
     (tmp_path / "runs").mkdir()
     with pytest.raises(Exception, match="no evaluations are logged"):
         iohanalyzer.export(tmp_path / "runs", tmp_path / "out")
+
+
+def test_the_readme_example_runs(built, tmp_path, monkeypatch, capsys):
+    """The README's ioh snippet, as printed there, from a fresh working directory."""
+    built("P1")
+    blocks = (Path(wrist_env.__file__).resolve().parent.parent / "README.md").read_text().split("```python\n")[1:]
+    (code,) = [b.split("```")[0] for b in blocks if "wrist_env.bench.iohanalyzer import problem" in b]
+    monkeypatch.chdir(tmp_path)
+    exec(compile(code, "README.md", "exec"), {})
+    assert float(capsys.readouterr().out.split()[-1]) > 0
+    assert len(list((tmp_path / "runs" / "ioh").rglob("IOHprofiler_f*_DIM22.dat"))) == 1

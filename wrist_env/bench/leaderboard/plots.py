@@ -13,10 +13,12 @@ _RGBA = tuple[float, float, float, float]
 
 
 def colors(labels: Iterable[str]) -> dict[str, _RGBA]:
+    """A distinct colour per label: tab10's ten, then black, then tab20's ten light hues (cycled beyond 21)."""
     import matplotlib
 
-    cmap = matplotlib.colormaps["tab10"]
-    return {label: cmap(i % 10) for i, label in enumerate(labels)}
+    tab10, tab20 = matplotlib.colormaps["tab10"], matplotlib.colormaps["tab20"]
+    palette = [tab10(i) for i in range(10)] + [(0.0, 0.0, 0.0, 1.0)] + [tab20(2 * i + 1) for i in range(10)]
+    return {label: palette[i % len(palette)] for i, label in enumerate(labels)}
 
 
 def _reference_line(ax, cost: float, text: str, color: str, style: str, *, right: bool) -> None:
