@@ -32,6 +32,11 @@ METHODS = {"ng-ngopt": "NGOpt", "ng-twopointsde": "TwoPointsDE", "ng-pso": "PSO"
 """Calibrator name → Nevergrad optimizer (`nevergrad.optimizers.registry` key)."""
 
 
+# NGOpt's COBYLA runs in Nevergrad's background thread, outside `_quiet`; its notices about
+# the settings Nevergrad passes (MAXFUN, RHOEND) are not the user's to act on
+warnings.filterwarnings("ignore", message=r"COBYLA: Invalid (MAXFUN|RHOEND)", category=UserWarning)
+
+
 @contextlib.contextmanager
 def _quiet():
     """Nevergrad's and its solvers' warnings (inefficient settings, infinite losses, COBYLA's RHOEND) off."""

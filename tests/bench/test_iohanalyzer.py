@@ -98,3 +98,12 @@ def test_the_readme_example_runs(built, tmp_path, monkeypatch, capsys):
     exec(compile(code, "README.md", "exec"), {})
     assert float(capsys.readouterr().out.split()[-1]) > 0
     assert len(list((tmp_path / "runs" / "ioh").rglob("IOHprofiler_f*_DIM22.dat"))) == 1
+
+
+def test_without_ioh_the_command_says_which_extra_to_install(tmp_path, monkeypatch):
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "ioh" else real(name, *a))
+    with pytest.raises(SystemExit, match=r"needs ioh.*\[ioh\]"):
+        main(["iohanalyzer", "--runs", str(tmp_path), "--out", str(tmp_path / "out")])

@@ -119,10 +119,12 @@ def _leaderboard(args) -> int:
 
 
 def _iohanalyzer(args) -> int:
-    try:
-        from wrist_env.bench.iohanalyzer import export
-    except ImportError as error:
-        raise SystemExit(f'wrist-bench iohanalyzer needs ioh ({error}): pip install -e ".[ioh]"') from None
+    import importlib.util
+
+    from wrist_env.bench.iohanalyzer import export
+
+    if importlib.util.find_spec("ioh") is None:
+        raise SystemExit('wrist-bench iohanalyzer needs ioh, which is not installed: pip install -e ".[ioh]"')
     if not Path(args.runs).is_dir():
         raise SystemExit(f"wrist-bench iohanalyzer: no run log at {args.runs}")
     for folder in export(args.runs, args.out):
@@ -173,6 +175,12 @@ def _montecarlo_report(args) -> int:
         f"report {summary['report_seconds']} s; written to {args.out}"
     )
     return 0
+
+
+def _run_log_arguments(s: argparse.ArgumentParser, *, out: str) -> None:
+    """--runs (a benchmark run log) and --out (an output folder, default `out`) of a command that reads a log."""
+    s.add_argument("--runs", default="runs/benchmark", help="run-log folder (default runs/benchmark)")
+    s.add_argument("--out", default=out, help=f"output folder (default {out})")
 
 
 def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
@@ -234,8 +242,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "at the budget, evaluations to cost targets, ECDF and convergence plots, "
         "parameter recovery, the held-out trial, the preprint's Tables 3-4.",
     )
-    s.add_argument("--runs", default="runs/benchmark", help="run-log folder (default runs/benchmark)")
-    s.add_argument("--out", default="runs/leaderboard", help="output folder (default runs/leaderboard)")
+    _run_log_arguments(s, out="runs/leaderboard")
     s.add_argument("--title", help="title of the README.md")
     s.set_defaults(run=_leaderboard)
 
@@ -246,8 +253,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "one folder per calibrator, one problem per participant (wrist-<participant>), one run per seed. "
         "Zip the output folder and upload it to IOHanalyzer. Needs the [ioh] extra.",
     )
-    s.add_argument("--runs", default="runs/benchmark", help="run-log folder (default runs/benchmark)")
-    s.add_argument("--out", default="runs/iohanalyzer", help="output folder (default runs/iohanalyzer)")
+    _run_log_arguments(s, out="runs/iohanalyzer")
     s.set_defaults(run=_iohanalyzer)
 
     s = command(
