@@ -1,0 +1,113 @@
+"""Probes of the radiocarpal load share (issue 10): what moves RS/RL at neutral, and where the row gives way.
+
+For each participant (population design, capitate held at neutral, translations free):
+
+- the load ladder, 1-300 N: RS/RL, the capitate's translation (mm) and the scaphoid's and lunate's
+  rotation (deg) from their neutral poses — where the proximal row collapses under axial load;
+- a congruent STT: the distal row's scaphotrapezial and scaphotrapezoidal contact samples moved
+  onto the scaphoid's cartilage (neutral gap 0 where it was up to 3 mm), as if the STT surfaces
+  conformed like the capitolunate; the STT's contact force and RS/RL at 100 N;
+- the RSC three times stiffer (30 N/mm against Table 2's 10): the scaphoid's volar sling.
+
+Each probe changes only the built model's arrays or the design (nothing in the solver). Run:
+`python experiments/load_share_probes.py P1 P2`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import sys
+
+import numpy as np
+from scipy.interpolate import RegularGridInterpolator
+from scipy.spatial import cKDTree
+from scipy.spatial.transform import Rotation
+
+from wrist_env import design
+from wrist_env.model import BODY_PARTS, BONES, PAIR_BONES, PAIRS
+from wrist_env.participants.registry import load_model
+from wrist_env.solver import simulate as sim
+from wrist_env.solver.outputs import pressure_map
+
+LADDER_N = (1.0, 10.0, 100.0, 200.0, 250.0, 300.0)
+PROBE_N = 100.0
+STT_GAP_MM = 3.0
+RS, RL, SC = (PAIRS.index(p) for p in ("radioscaphoid", "radiolunate", "scaphocapitate"))
+
+
+def _neutral(model, d, load_n):
+    return sim.simulate(model, d, sim.loaded(model, [np.eye(3)], load_n=load_n))
+
+
+def _ratio(result) -> float:
+    return float(result.contact[0, RS, 3] / result.contact[0, RL, 3])
+
+
+def _stt_samples(model):
+    """Indices (into the scaphocapitate pair's samples) on the trapezium or trapezoid, and the pair's slice."""
+    body = PAIR_BONES[SC][0]
+    s = slice(model.sample_offsets[SC], model.sample_offsets[SC + 1])
+    vertices = model.vertices[model.vertex_offsets[body] : model.vertex_offsets[body + 1]]
+    part = model.vertex_part[model.vertex_offsets[body] : model.vertex_offsets[body + 1]]
+    owner = part[cKDTree(vertices).query(model.sample_points[s])[1]]
+    parts = BODY_PARTS[BONES[body]]
+    return np.isin(owner, [parts.index("trapezium"), parts.index("trapezoid")]), s
+
+
+def congruent_stt(model):
+    """The model with the STT contact samples moved onto the scaphoid's cartilage surface."""
+    grid_body = PAIR_BONES[SC][1]
+    shape, origin, h = model.grid_shape[grid_body], model.grid_origin[grid_body], model.grid_spacing[grid_body]
+    values = model.grid_values[model.grid_offsets[grid_body] : model.grid_offsets[grid_body + 1]].reshape(shape)
+    sdf = RegularGridInterpolator(
+        [origin[i] + h * np.arange(shape[i]) for i in range(3)], values, bounds_error=False, fill_value=np.nan
+    )
+    stt, s = _stt_samples(model)
+    points = model.sample_points[s].copy()
+    gap = sdf(points)
+    grad = np.stack([(sdf(points + 1e-3 * e) - sdf(points - 1e-3 * e)) / 2e-3 for e in np.eye(3)], axis=1)
+    move = stt & np.isfinite(gap) & (gap > 0) & (gap <= STT_GAP_MM)
+    points[move] -= gap[move, None] * grad[move] / np.linalg.norm(grad[move], axis=1, keepdims=True)
+    all_points = model.sample_points.copy()
+    all_points[s] = points
+    return dataclasses.replace(model, sample_points=all_points)
+
+
+def stt_force(model, result) -> float:
+    stt, s = _stt_samples(model)
+    return float((pressure_map(model, result.poses[0])[s] * model.sample_area[s])[stt].sum())
+
+
+def main(names) -> None:
+    pop = design.population()
+    for name in names:
+        model = load_model(name)
+        print(f"\n{name}: load ladder at neutral (population design)")
+        print("| load (N) | RS/RL | capitate translation (mm) | scaphoid / lunate rotation (deg) |\n|---|---|---|---|")
+        for load in LADDER_N:
+            r = _neutral(model, pop, load)
+            if not r.ok:
+                print(f"| {load:g} | {r.message} | | |")
+                continue
+            cap = np.linalg.norm(r.poses[0, BONES.index("capitate"), :3, 3])
+            rot = [
+                np.linalg.norm(Rotation.from_matrix(r.poses[0, BONES.index(b), :3, :3]).as_rotvec(degrees=True))
+                for b in ("scaphoid", "lunate")
+            ]
+            print(f"| {load:g} | {_ratio(r):.2f} | {cap:.2f} | {rot[0]:.1f} / {rot[1]:.1f} |")
+        rsc = design.LIGAMENT_NAMES.index("RSC")
+        stiff = pop.stiffness.copy()
+        stiff[rsc] *= 3.0
+        stt_model = congruent_stt(model)
+        print(f"\n{name}: probes at neutral, {PROBE_N:g} N\n| probe | RS/RL | STT force (N) |\n|---|---|---|")
+        for label, m, d in (
+            ("as built", model, pop),
+            (f"congruent STT (samples moved onto the scaphoid, gaps ≤ {STT_GAP_MM:g} mm)", stt_model, pop),
+            ("RSC × 3 (30 N/mm)", model, dataclasses.replace(pop, stiffness=stiff)),
+        ):
+            r = _neutral(m, d, PROBE_N)
+            print(f"| {label} | {_ratio(r):.2f} | {stt_force(m, r):.1f} |")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:] or ["P1"])
