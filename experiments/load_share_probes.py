@@ -4,9 +4,10 @@ For each participant (population design, capitate held at neutral, translations 
 
 - the load ladder, 1-300 N: RS/RL, the capitate's translation (mm) and the scaphoid's and lunate's
   rotation (deg) from their neutral poses — where the proximal row collapses under axial load;
-- a congruent STT: the distal row's scaphotrapezial and scaphotrapezoidal contact samples moved
-  onto the scaphoid's cartilage (neutral gap 0 where it was up to 3 mm), as if the STT surfaces
-  conformed like the capitolunate; the STT's contact force and RS/RL at 100 N;
+- conforming STT and triquetrohamate (TH) joints: the distal row's contact samples of the joint
+  (trapezium and trapezoid; hamate) moved onto the opposing cartilage (neutral gap 0 where it was
+  up to 3 mm), as if those surfaces conformed like the capitolunate; RS/RL and the joints'
+  contact forces at 100 N (Viegas 1993: STT 23 %, TH 20 % of the midcarpal load);
 - the RSC three times stiffer (30 N/mm against Table 2's 10): the scaphoid's volar sling.
 
 Each probe changes only the built model's arrays or the design (nothing in the solver). Run:
@@ -31,8 +32,10 @@ from wrist_env.solver.outputs import pressure_map
 
 LADDER_N = (1.0, 10.0, 100.0, 200.0, 250.0, 300.0)
 PROBE_N = 100.0
-STT_GAP_MM = 3.0
-RS, RL, SC = (PAIRS.index(p) for p in ("radioscaphoid", "radiolunate", "scaphocapitate"))
+CLOSED_GAP_MM = 3.0  # neutral gaps up to this are closed by a conforming joint
+RS, RL, SC, LC = (PAIRS.index(p) for p in ("radioscaphoid", "radiolunate", "scaphocapitate", "lunocapitate"))
+STT = (SC, ("trapezium", "trapezoid"))  # the distal row's samples of the STT joint: (pair, parts)
+TH = (LC, ("hamate",))  # of the triquetrohamate joint
 
 
 def _neutral(model, d, load_n):
@@ -43,39 +46,41 @@ def _ratio(result) -> float:
     return float(result.contact[0, RS, 3] / result.contact[0, RL, 3])
 
 
-def _stt_samples(model):
-    """Indices (into the scaphocapitate pair's samples) on the trapezium or trapezoid, and the pair's slice."""
-    body = PAIR_BONES[SC][0]
-    s = slice(model.sample_offsets[SC], model.sample_offsets[SC + 1])
+def _joint_samples(model, joint):
+    """Mask over the pair's samples on the joint's distal-row parts, and the pair's slice."""
+    pair, names = joint
+    body = PAIR_BONES[pair][0]
+    s = slice(model.sample_offsets[pair], model.sample_offsets[pair + 1])
     vertices = model.vertices[model.vertex_offsets[body] : model.vertex_offsets[body + 1]]
     part = model.vertex_part[model.vertex_offsets[body] : model.vertex_offsets[body + 1]]
     owner = part[cKDTree(vertices).query(model.sample_points[s])[1]]
     parts = BODY_PARTS[BONES[body]]
-    return np.isin(owner, [parts.index("trapezium"), parts.index("trapezoid")]), s
+    return np.isin(owner, [parts.index(n) for n in names]), s
 
 
-def congruent_stt(model):
-    """The model with the STT contact samples moved onto the scaphoid's cartilage surface."""
-    grid_body = PAIR_BONES[SC][1]
+def conforming(model, joint):
+    """The model with the joint's distal-row contact samples moved onto the opposing cartilage surface."""
+    grid_body = PAIR_BONES[joint[0]][1]
     shape, origin, h = model.grid_shape[grid_body], model.grid_origin[grid_body], model.grid_spacing[grid_body]
     values = model.grid_values[model.grid_offsets[grid_body] : model.grid_offsets[grid_body + 1]].reshape(shape)
     sdf = RegularGridInterpolator(
         [origin[i] + h * np.arange(shape[i]) for i in range(3)], values, bounds_error=False, fill_value=np.nan
     )
-    stt, s = _stt_samples(model)
+    mask, s = _joint_samples(model, joint)
     points = model.sample_points[s].copy()
     gap = sdf(points)
     grad = np.stack([(sdf(points + 1e-3 * e) - sdf(points - 1e-3 * e)) / 2e-3 for e in np.eye(3)], axis=1)
-    move = stt & np.isfinite(gap) & (gap > 0) & (gap <= STT_GAP_MM)
+    move = mask & np.isfinite(gap) & (gap > 0) & (gap <= CLOSED_GAP_MM)
     points[move] -= gap[move, None] * grad[move] / np.linalg.norm(grad[move], axis=1, keepdims=True)
     all_points = model.sample_points.copy()
     all_points[s] = points
     return dataclasses.replace(model, sample_points=all_points)
 
 
-def stt_force(model, result) -> float:
-    stt, s = _stt_samples(model)
-    return float((pressure_map(model, result.poses[0])[s] * model.sample_area[s])[stt].sum())
+def joint_force(model, result, joint) -> float:
+    """Contact force (N, Σ pressure × area) on the joint's distal-row samples."""
+    mask, s = _joint_samples(model, joint)
+    return float((pressure_map(model, result.poses[0])[s] * model.sample_area[s])[mask].sum())
 
 
 def main(names) -> None:
@@ -98,15 +103,17 @@ def main(names) -> None:
         rsc = design.LIGAMENT_NAMES.index("RSC")
         stiff = pop.stiffness.copy()
         stiff[rsc] *= 3.0
-        stt_model = congruent_stt(model)
-        print(f"\n{name}: probes at neutral, {PROBE_N:g} N\n| probe | RS/RL | STT force (N) |\n|---|---|---|")
+        print(f"\n{name}: probes at neutral, {PROBE_N:g} N")
+        print("| probe | RS/RL | STT force (N) | TH force (N) |\n|---|---|---|---|")
         for label, m, d in (
             ("as built", model, pop),
-            (f"congruent STT (samples moved onto the scaphoid, gaps ≤ {STT_GAP_MM:g} mm)", stt_model, pop),
+            (f"conforming STT (gaps ≤ {CLOSED_GAP_MM:g} mm closed)", conforming(model, STT), pop),
+            (f"conforming TH (gaps ≤ {CLOSED_GAP_MM:g} mm closed)", conforming(model, TH), pop),
+            ("conforming STT and TH", conforming(conforming(model, STT), TH), pop),
             ("RSC × 3 (30 N/mm)", model, dataclasses.replace(pop, stiffness=stiff)),
         ):
             r = _neutral(m, d, PROBE_N)
-            print(f"| {label} | {_ratio(r):.2f} | {stt_force(m, r):.1f} |")
+            print(f"| {label} | {_ratio(r):.2f} | {joint_force(m, r, STT):.1f} | {joint_force(m, r, TH):.1f} |")
 
 
 if __name__ == "__main__":
