@@ -11,22 +11,37 @@ from __future__ import annotations
 import sys
 
 import numpy as np
-from scipy.interpolate import RegularGridInterpolator
 from scipy.spatial import cKDTree
 
 from wrist_env import design
 from wrist_env.model import BODY_PARTS, BONES, PAIR_BONES, PAIRS
 from wrist_env.participants.registry import load_model
 from wrist_env.solver import simulate as sim
+from wrist_env.solver.contact import OUTSIDE_MM, sdf_lookup
 from wrist_env.solver.outputs import pressure_map
 from wrist_env.validation import NEUTRAL_LOAD_N
 
 
-def _grid(model, b: int) -> RegularGridInterpolator:
-    shape, origin, h = model.grid_shape[b], model.grid_origin[b], model.grid_spacing[b]
-    values = model.grid_values[model.grid_offsets[b] : model.grid_offsets[b + 1]].reshape(shape)
-    axes = [origin[i] + h * np.arange(shape[i]) for i in range(3)]
-    return RegularGridInterpolator(axes, values, bounds_error=False, fill_value=np.nan)
+def signed_distance(model, b: int, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Signed distance (mm, NaN off the grid) and its gradient (n, 3) of body b's contact grid (cartilage
+    folded in) at neutral-pose points (n, 3): the solver's own trilinear look-up."""
+    shape, origin, h = model.grid_shape[b], model.grid_origin[b], float(model.grid_spacing[b])
+    values = np.ascontiguousarray(model.grid_values, dtype=np.float32)
+    offset = int(model.grid_offsets[b])
+    d, grad = np.empty(len(points)), np.empty((len(points), 3))
+    for i, q in enumerate(np.asarray(points, dtype=np.float64)):
+        d[i], grad[i] = sdf_lookup(values, offset, shape, origin, h, q)
+    d[d >= OUTSIDE_MM] = np.nan
+    return d, grad
+
+
+def sample_parts(model, k: int) -> tuple[np.ndarray, slice]:
+    """The part (index into `BODY_PARTS` of the pair's sample body) of each sample of pair k, and the pair's slice."""
+    body = PAIR_BONES[k][0]
+    s = slice(model.sample_offsets[k], model.sample_offsets[k + 1])
+    vertices = model.vertices[model.vertex_offsets[body] : model.vertex_offsets[body + 1]]
+    part = model.vertex_part[model.vertex_offsets[body] : model.vertex_offsets[body + 1]]
+    return part[cKDTree(vertices).query(model.sample_points[s])[1]], s
 
 
 def load_paths(name: str) -> list[dict]:
@@ -38,12 +53,9 @@ def load_paths(name: str) -> list[dict]:
     rows = []
     for k, pair in enumerate(PAIRS):
         body, grid_body = PAIR_BONES[k]
-        s = slice(model.sample_offsets[k], model.sample_offsets[k + 1])
-        vertices = model.vertices[model.vertex_offsets[body] : model.vertex_offsets[body + 1]]
-        part = model.vertex_part[model.vertex_offsets[body] : model.vertex_offsets[body + 1]]
-        owner = part[cKDTree(vertices).query(model.sample_points[s])[1]]
+        owner, s = sample_parts(model, k)
         force = (pressure[s] * model.sample_area[s])[:, None] * (model.sample_normals[s] @ poses[body, :3, :3].T)
-        gap = _grid(model, grid_body)(model.sample_points[s])
+        gap = signed_distance(model, grid_body, model.sample_points[s])[0]
         for q, part_name in enumerate(BODY_PARTS[BONES[body]]):
             mine = owner == q
             if mine.any():

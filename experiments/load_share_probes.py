@@ -20,8 +20,7 @@ import dataclasses
 import sys
 
 import numpy as np
-from scipy.interpolate import RegularGridInterpolator
-from scipy.spatial import cKDTree
+from load_paths import sample_parts, signed_distance  # this folder's script (on sys.path when run)
 from scipy.spatial.transform import Rotation
 
 from wrist_env import design
@@ -49,27 +48,16 @@ def _ratio(result) -> float:
 def _joint_samples(model, joint):
     """Mask over the pair's samples on the joint's distal-row parts, and the pair's slice."""
     pair, names = joint
-    body = PAIR_BONES[pair][0]
-    s = slice(model.sample_offsets[pair], model.sample_offsets[pair + 1])
-    vertices = model.vertices[model.vertex_offsets[body] : model.vertex_offsets[body + 1]]
-    part = model.vertex_part[model.vertex_offsets[body] : model.vertex_offsets[body + 1]]
-    owner = part[cKDTree(vertices).query(model.sample_points[s])[1]]
-    parts = BODY_PARTS[BONES[body]]
+    owner, s = sample_parts(model, pair)
+    parts = BODY_PARTS[BONES[PAIR_BONES[pair][0]]]
     return np.isin(owner, [parts.index(n) for n in names]), s
 
 
 def conforming(model, joint):
     """The model with the joint's distal-row contact samples moved onto the opposing cartilage surface."""
-    grid_body = PAIR_BONES[joint[0]][1]
-    shape, origin, h = model.grid_shape[grid_body], model.grid_origin[grid_body], model.grid_spacing[grid_body]
-    values = model.grid_values[model.grid_offsets[grid_body] : model.grid_offsets[grid_body + 1]].reshape(shape)
-    sdf = RegularGridInterpolator(
-        [origin[i] + h * np.arange(shape[i]) for i in range(3)], values, bounds_error=False, fill_value=np.nan
-    )
     mask, s = _joint_samples(model, joint)
     points = model.sample_points[s].copy()
-    gap = sdf(points)
-    grad = np.stack([(sdf(points + 1e-3 * e) - sdf(points - 1e-3 * e)) / 2e-3 for e in np.eye(3)], axis=1)
+    gap, grad = signed_distance(model, PAIR_BONES[joint[0]][1], points)
     move = mask & np.isfinite(gap) & (gap > 0) & (gap <= CLOSED_GAP_MM)
     points[move] -= gap[move, None] * grad[move] / np.linalg.norm(grad[move], axis=1, keepdims=True)
     all_points = model.sample_points.copy()

@@ -87,8 +87,8 @@ def bones(name: str, fossa_sweep_deg: tuple = (0.0, 0.0), distal_row: bool = Fal
 
 SHIPPED_MODEL = "model"
 """The built model shipped beside a built-in participant's data (`model.npz` + `model.json`, written by
-`python experiments/regenerate.py`); `registry.load_model` uses it when its source hash is the one
-it would build, and builds otherwise (a changed builder, template or platform)."""
+`python experiments/ship_models.py`, a step of `experiments/regenerate.py`); `registry.load_model`
+uses it when its source hash is the one it would build, and builds otherwise (a changed builder, template or platform)."""
 
 
 def shipped_model_path(name: str) -> Path | None:
