@@ -128,6 +128,7 @@ def test_result_to_dict_of_a_failed_run_has_nulls(p1, sweep):
         nan(sweep.energy),
         nan(sweep.residual),
         sweep.steps,
+        nan(sweep.membrane_nodes),
         np.full(5, np.nan),
         1,
         "failed: NaN in the state",

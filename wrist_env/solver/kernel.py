@@ -220,10 +220,11 @@ Stiffness = namedtuple("Stiffness", ["f_l0", "f_K", "m_l0", "m_K"])
 Frames = namedtuple("Frames", ["rotation", "com", "load"])
 """The capitate's targets per frame: rotation (n_frames, 3, 3), centre of mass (n_frames, 3) mm (for the
 loaded driver only the start: the centre is free), compressive load (n_frames,) N along +y."""
-Outputs = namedtuple("Outputs", ["poses", "contact", "bundle", "energy", "residual", "steps", "status"])
+Outputs = namedtuple("Outputs", ["poses", "contact", "bundle", "energy", "residual", "steps", "nodes", "status"])
 """What a run fills: poses (n_frames, 5, 4, 4); contact (n_frames, n_pairs, 4) (`forces.CONTACT_FIELDS`);
 bundle forces (n_frames, n_ligaments) N; kinetic and internal energy (n_frames, 2) N·mm; largest net
-force (N) and moment (N·mm) on the free bones (n_frames, 2); steps per frame (n_frames,); status (1,)."""
+force (N) and moment (N·mm) on the free bones (n_frames, 2); steps per frame (n_frames,); RSC membrane
+node positions (n_frames, M, 3) mm; status (1,)."""
 
 SETTLE, MOVE = -2, -1
 """The stages before frame 0: settle with the capitate at its static pose, then move it to the first pose."""
@@ -252,7 +253,7 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
     at most settle_steps).
     """
     frame_R, frame_x, frame_load = frames
-    poses, contact, bundle_out, energy_out, residual_out, steps_out, status = out
+    poses, contact, bundle_out, energy_out, residual_out, steps_out, nodes_out, status = out
     com0 = bod.com0
     n_frames = frame_R.shape[0]
     R = np.zeros((N_BONES, 3, 3))
@@ -332,6 +333,7 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
         residual_out[f, 0] = max(np.linalg.norm(F[SCAPHOID]), np.linalg.norm(F[LUNATE]))
         residual_out[f, 1] = max(np.linalg.norm(T[SCAPHOID]), np.linalg.norm(T[LUNATE]))
         steps_out[f] = taken
+        nodes_out[f] = nodes
         taken = 0
 
 
@@ -341,6 +343,13 @@ def run_batch(bod, grids, law, fib, stiffness, mem, st, frames, out):
     for i in prange(stiffness.f_l0.shape[0]):
         design = Stiffness(stiffness.f_l0[i], stiffness.f_K[i], stiffness.m_l0[i], stiffness.m_K[i])
         filled = Outputs(
-            out.poses[i], out.contact[i], out.bundle[i], out.energy[i], out.residual[i], out.steps[i], out.status[i]
+            out.poses[i],
+            out.contact[i],
+            out.bundle[i],
+            out.energy[i],
+            out.residual[i],
+            out.steps[i],
+            out.nodes[i],
+            out.status[i],
         )
         run(bod, grids, law, fib, design, mem, st, frames, filled)

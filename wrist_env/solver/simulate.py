@@ -108,6 +108,7 @@ class Result:
     residual (n_frames, 2): largest net force (N) and moment (N·mm) on the free bones.
     steps (n_frames,): explicit steps since the previous frame (ramp + hold to equilibrium;
         frame 0 includes settling and the move to the first pose).
+    membrane_nodes (n_frames, M, 3): the RSC membrane's nodes (`model.membrane_nodes` order), RCS mm.
     status: 0 ok, otherwise failed (see `message`); a failed run's frames are NaN.
     """
 
@@ -117,6 +118,7 @@ class Result:
     energy: np.ndarray
     residual: np.ndarray
     steps: np.ndarray
+    membrane_nodes: np.ndarray
     angle_deg: np.ndarray
     status: int
     message: str
@@ -126,7 +128,7 @@ class Result:
         return self.status == kernel.OK
 
 
-def _outputs(n: int, n_frames: int) -> kernel.Outputs:
+def _outputs(n: int, n_frames: int, n_nodes: int) -> kernel.Outputs:
     shape = (n,) if n else ()
     return kernel.Outputs(
         np.full(shape + (n_frames, 5, 4, 4), np.nan),
@@ -135,6 +137,7 @@ def _outputs(n: int, n_frames: int) -> kernel.Outputs:
         np.full(shape + (n_frames, 2), np.nan),
         np.full(shape + (n_frames, 2), np.nan),
         np.zeros(shape + (n_frames,), np.int64),
+        np.full(shape + (n_frames, n_nodes, 3), np.nan),
         np.zeros(shape + (1,), np.int64),
     )
 
@@ -197,7 +200,7 @@ def simulate(
     prepared: `prepare(model, settings, driver.mode)`, to skip rebuilding the kernel arrays."""
     p = _prepared(model, settings, driver, prepared)
     f_l0, f_K, m_l0, m_K = arrays.design_arrays(model, p.fibres, p.membrane, design)
-    out = _outputs(0, len(driver.rotation))
+    out = _outputs(0, len(driver.rotation), len(model.membrane_nodes))
     _run(kernel.run, p, kernel.Stiffness(f_l0, f_K, m_l0, m_K), driver, out)
     return _result(out, driver, int(out.status[0]))
 
@@ -214,7 +217,7 @@ def simulate_batch(
     p = _prepared(model, settings, driver, prepared)
     per = [arrays.design_arrays(model, p.fibres, p.membrane, d) for d in designs]
     f_l0, f_K, m_l0, m_K = (np.ascontiguousarray(np.stack([q[i] for q in per])) for i in range(4))
-    out = _outputs(len(per), len(driver.rotation))
+    out = _outputs(len(per), len(driver.rotation), len(model.membrane_nodes))
     previous = numba.set_parallel_chunksize(1)  # designs differ in cost: hand them out one at a time
     try:
         _run(kernel.run_batch, p, kernel.Stiffness(f_l0, f_K, m_l0, m_K), driver, out)
@@ -230,8 +233,8 @@ def _run(entry, p: Prepared, stiffness: kernel.Stiffness, driver: Driver, out: k
 
 
 def _result(out: kernel.Outputs, driver: Driver, status: int) -> Result:
-    poses, contact, bundle, energy, residual, steps, _ = out
+    poses, contact, bundle, energy, residual, steps, nodes, _ = out
     if status != kernel.OK:
-        for a in (poses, contact, bundle, energy, residual):
+        for a in (poses, contact, bundle, energy, residual, nodes):
             a[...] = np.nan
-    return Result(poses, contact, bundle, energy, residual, steps, driver.angle_deg, status, STATUS[status])
+    return Result(poses, contact, bundle, energy, residual, steps, nodes, driver.angle_deg, status, STATUS[status])

@@ -1,0 +1,143 @@
+"""How close the explicit solver's answers are to converged ones (issue 13's accuracy yardstick).
+
+For each participant and motion (the idealized sweep, the 15-frame calibration
+trial), the population design and N Monte Carlo designs (Table 2 normals at
+±3 SD, each injurable ligament torn with probability 0.3) are simulated with
+the solver settings under test and with a reference (half the time step, a 10×
+tighter equilibrium tolerance, 8× longer holds). Printed per motion: steps per
+simulation, frames that ran out of hold steps, and the largest centre-of-mass
+distance (mm) and rotation (°) of a moving bone from the reference — median,
+95th percentile, maximum, and the share of designs within 0.1 mm and 0.5°.
+With --newton K, the population design and the first K−1 Monte Carlo designs
+are also polished by the quasi-static Newton reference
+(`wrist_env.solver.equilibrium.nearest`): the distance from each explicit
+answer to the equilibrium nearest it, and the net force left there.
+
+Run: `python experiments/solver_accuracy.py [P1 P2 P3] [--designs 100] [--newton 3] [--set dt_s=9e-5 ...]`
+(--set changes the settings under test; the reference stays the default's).
+References are cached in runs/solver_accuracy/ (delete to recompute).
+Reference runs take ~2 min per participant for 100 designs on 2 cores.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from wrist_env import design
+from wrist_env.model import BONES
+from wrist_env.participants import registry
+from wrist_env.participants.registry import load_model
+from wrist_env.solver.arrays import SolverSettings
+from wrist_env.solver.equilibrium import nearest
+from wrist_env.solver.simulate import experimental, idealized, simulate_batch
+
+CACHE = Path("runs/solver_accuracy")
+MOVING = [BONES.index(b) for b in ("scaphoid", "lunate", "capitate")]
+TOLERANCE = (0.1, 0.5)  # mm, degrees: issue 13's "answer unchanged"
+
+
+def reference_settings(base: SolverSettings) -> SolverSettings:
+    """Half the time step, a 10× tighter tolerance and force floor, 8× longer holds."""
+    s = base.halved()
+    return replace(
+        s, tolerance=s.tolerance / 10, force_floor_n=s.force_floor_n / 10, max_hold_steps=8 * s.max_hold_steps
+    )
+
+
+def monte_carlo_designs(n: int, seed: int = 0) -> list[design.Design]:
+    """The population design, then n Monte Carlo designs (the benchmark scripts' draw)."""
+    rng = np.random.default_rng(seed)
+    materials = design.sample_materials(n, seed)
+    injury = np.where(rng.random((n, 5)) < 0.3, -0.5, 0.5)
+    return [design.population()] + [design.from_action(np.r_[m, i]) for m, i in zip(materials, injury)]
+
+
+def distance(a: np.ndarray, b: np.ndarray, com0: np.ndarray) -> tuple[float, float]:
+    """Largest centre-of-mass distance (mm) and rotation (deg) of a moving bone between two pose arrays."""
+    dx = dr = 0.0
+    for k in MOVING:
+        ca = np.einsum("fij,j->fi", a[:, k, :3, :3], com0[k]) + a[:, k, :3, 3]
+        cb = np.einsum("fij,j->fi", b[:, k, :3, :3], com0[k]) + b[:, k, :3, 3]
+        dx = max(dx, float(np.linalg.norm(ca - cb, axis=1).max()))
+        cos = (np.einsum("fij,fij->f", a[:, k, :3, :3], b[:, k, :3, :3]) - 1.0) / 2.0
+        dr = max(dr, float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))).max()))
+    return dx, dr
+
+
+def drivers(name: str, model):
+    return {
+        "sweep": idealized(model),
+        "trial": experimental(model, registry.trial(name, "calibrate").pose("capitate")),
+    }
+
+
+def reference(name: str, model, designs, base: SolverSettings) -> dict[str, np.ndarray]:
+    path = CACHE / f"{name}_{len(designs) - 1}.npz"
+    if path.exists():
+        return dict(np.load(path))
+    out = {}
+    for motion, driver in drivers(name, model).items():
+        runs = simulate_batch(model, designs, driver, reference_settings(base))
+        out[motion] = np.stack([r.poses for r in runs])
+        out[motion + "_ok"] = np.array([r.ok for r in runs])
+    path.parent.mkdir(parents=True, exist_ok=True)
+    np.savez_compressed(path, **out)
+    return out
+
+
+def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int) -> None:
+    model = load_model(name)
+    designs = monte_carlo_designs(n_designs)
+    ref = reference(name, model, designs, SolverSettings())
+    for motion, driver in drivers(name, model).items():
+        runs = simulate_batch(model, designs, driver, settings)
+        both = [i for i, r in enumerate(runs) if r.ok and ref[motion + "_ok"][i]]
+        d = np.array([distance(runs[i].poses, ref[motion][i], model.com) for i in both])
+        within = np.mean((d[:, 0] <= TOLERANCE[0]) & (d[:, 1] <= TOLERANCE[1]))
+        steps = np.array([r.steps.sum() for r in runs])
+        capped = sum(int(np.sum(r.steps[1:] >= settings.ramp_steps + settings.max_hold_steps)) for r in runs)
+        frames = sum(len(r.steps) - 1 for r in runs)
+        pop = distance(runs[0].poses, ref[motion][0], model.com)
+        print(
+            f"{name} {motion}: {steps[0]} steps (population), {steps.mean():.0f} mean; "
+            f"{capped}/{frames} frames ran out of hold steps; failed {sum(not r.ok for r in runs)} "
+            f"(reference {int((~ref[motion + '_ok']).sum())})\n"
+            f"  from the reference: population {pop[0]:.3f} mm {pop[1]:.2f}°; designs median "
+            f"{np.median(d[:, 0]):.3f} mm {np.median(d[:, 1]):.2f}°, 95th pct {np.percentile(d[:, 0], 95):.3f} mm "
+            f"{np.percentile(d[:, 1], 95):.2f}°, max {d[:, 0].max():.3f} mm {d[:, 1].max():.2f}°; "
+            f"within 0.1 mm and 0.5°: {100 * within:.0f} %"
+        )
+        for i in tqdm(range(min(n_newton, len(runs))), desc=f"{name} {motion} Newton", leave=False):
+            if not runs[i].ok:
+                continue
+            eq = nearest(model, designs[i], driver, runs[i], settings)
+            label = "population" if i == 0 else f"design {i}"
+            tqdm.write(
+                f"  Newton, {label}: explicit answer {eq.distance[:, 0].max():.3f} mm {eq.distance[:, 1].max():.2f}° "
+                f"from its nearest equilibrium; net force left {eq.residual[:, 0].max():.2g} N "
+                f"(explicit {runs[i].residual[:, 0].max():.2g} N)"
+            )
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("participants", nargs="*", default=["P1", "P2", "P3"])
+    parser.add_argument("--designs", type=int, default=100, help="Monte Carlo designs besides the population's")
+    parser.add_argument("--newton", type=int, default=3, help="designs polished by the Newton reference")
+    parser.add_argument("--set", nargs="*", default=[], metavar="FIELD=VALUE", help="settings under test")
+    args = parser.parse_args(argv)
+    changes = {k: ast.literal_eval(v) for k, v in (item.split("=", 1) for item in args.set)}
+    settings = replace(SolverSettings(), **changes)
+    print(f"settings under test: {changes or 'the defaults'}; reference: {reference_settings(SolverSettings())}")
+    for name in args.participants:
+        report(name, args.designs, settings, args.newton)
+
+
+if __name__ == "__main__":
+    main()

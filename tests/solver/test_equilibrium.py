@@ -1,0 +1,81 @@
+"""The quasi-static Newton reference (`equilibrium.nearest`) against closed-form equilibria and the explicit solver."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+from test_verification import EPSILON_L, OSCILLATORS, oscillator, undamped
+
+from wrist_env import design
+from wrist_env.design import LIGAMENT_NAMES
+from wrist_env.solver.arrays import SolverSettings
+from wrist_env.solver.equilibrium import nearest
+from wrist_env.solver.simulate import experimental, idealized, simulate
+
+SCAPHOID = 2
+AXIS = np.array([1.0, 2.0, 2.0]) / 3.0
+CENTRE = np.array([3.0, -1.0, 2.0])
+
+
+@pytest.fixture(scope="module")
+def p1(built):
+    return built("P1")
+
+
+def tension(K, strain):
+    """Blankevoort tension (N), DESIGN.md."""
+    if strain <= 0.0:
+        return 0.0
+    return K * strain * strain / (4 * EPSILON_L) if strain <= 2 * EPSILON_L else K * (strain - EPSILON_L)
+
+
+def test_two_opposed_bundles_reach_the_closed_form_equilibrium():
+    """A free scaphoid between two opposed fibre bundles on one line, left mid-oscillation by a
+    few undamped steps: the Newton reference lands where the two tensions balance (brentq on
+    the force balance written here), to 1e-6 mm, with no net force left."""
+    fib, materials = OSCILLATORS["two bundles opposed"]
+    model = oscillator(fib)
+    vector = design.population().vector.copy()
+    for lig, (k, r) in materials.items():
+        vector[lig], vector[len(LIGAMENT_NAMES) + lig] = k, r
+    dsg = design.Design.from_vector(vector)
+    a = np.array([p for _, p in fib])
+    l0 = np.array([abs(p) / materials[g][1] for g, p in fib])
+    K = np.array([materials[g][0] * l for (g, _), l in zip(fib, l0)])
+
+    def net(y):  # force along the line on the body at y
+        return sum(-tension(Ki, abs(y - ai) / l0i - 1.0) * np.sign(y - ai) for ai, l0i, Ki in zip(a, l0, K))
+
+    y_star = brentq(net, a.min() + 1e-3, a.max() - 1e-3)
+    settings = replace(
+        undamped(SolverSettings()),
+        dt_s=1e-6,
+        settle_steps=0,
+        move_steps=0,
+        ramp_steps=0,
+        min_hold_steps=7,
+        max_hold_steps=7,
+        inertia_scale=1.0,
+        max_disp_mm=1e3,
+    )
+    driver = experimental(model, np.tile(np.eye(4), (2, 1, 1)))
+    result = simulate(model, dsg, driver, settings)
+    assert result.ok
+    start = result.poses[-1, SCAPHOID, :3, 3] @ AXIS
+    eq = nearest(model, dsg, driver, result, settings)
+    y = eq.poses[-1, SCAPHOID, :3, 3] @ AXIS
+    assert abs(start - y_star) > 0.05, "the explicit state must start away from equilibrium"
+    assert abs(y - y_star) < 1e-6, (y, y_star)
+    assert eq.residual[-1, 0] < 1e-6
+    assert abs(eq.distance[-1, 0] - abs(start - y_star)) < 1e-6
+
+
+def test_population_sweep_is_near_its_equilibrium(p1):
+    """The explicit answer of P1's population sweep (3 frames) is within 0.1 mm and 0.5° of the
+    equilibrium the Newton reference finds from it, which leaves less net force than the explicit run."""
+    driver = idealized(p1, n_frames=3)
+    result = simulate(p1, design.population(), driver)
+    eq = nearest(p1, design.population(), driver, result)
+    assert eq.distance[:, 0].max() < 0.1 and eq.distance[:, 1].max() < 0.5, eq.distance
+    assert eq.residual[:, 0].max() < result.residual[:, 0].max(), (eq.residual, result.residual)

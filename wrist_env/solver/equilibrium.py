@@ -1,0 +1,164 @@
+"""A quasi-static Newton reference: the equilibrium nearest each frame of an explicit run.
+
+With the capitate where the frame put it, solves net force = 0 on the free
+bodies (scaphoid and lunate in 6 DOF, the capitate's translations under the
+loaded driver) and on the RSC membrane's free nodes, by SciPy's
+Levenberg–Marquardt (`least_squares`, finite-difference Jacobian), starting
+from the explicit answer. No masses, damping or time step enter: only the
+force kernels the explicit solver uses. How far the explicit answer is from
+this equilibrium is the explicit solver's error (`experiments/solver_accuracy.py`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+from scipy.optimize import least_squares
+
+from wrist_env.design import ALL_LIGAMENT_NAMES, Design
+from wrist_env.model import BONES, Model
+from wrist_env.solver import arrays, kernel
+from wrist_env.solver.kernel import CAPITATE, LEVER_MM, LUNATE, SCAPHOID
+from wrist_env.solver.rigid import rotate_in_place
+
+JACOBIAN_STEP = 1e-6  # finite-difference step of the Jacobian (rad, mm)
+
+
+@njit(cache=True, error_model="numpy")
+def _residual(q, R0, x0, nodes0, free_nodes, bod, grids, law, fib, stiffness, mem, st, load, out):
+    """Net forces (N) and moments / LEVER_MM (N) on the unknowns at the state moved by q: rotation
+    vectors (rad) and shifts (mm) of the scaphoid and lunate, the capitate's shift (loaded driver),
+    the free nodes' shifts (mm)."""
+    R = R0.copy()
+    x = x0.copy()
+    nodes = nodes0.copy()
+    k = 0
+    for b in (SCAPHOID, LUNATE):
+        rotate_in_place(R[b], q[k], q[k + 1], q[k + 2])
+        for i in range(3):
+            x[b, i] += q[k + 3 + i]
+        k += 6
+    loaded = st.driver == arrays.LOADED
+    if loaded:
+        for i in range(3):
+            x[CAPITATE, i] += q[k + i]
+        k += 3
+    for n in free_nodes:
+        for i in range(3):
+            nodes[n, i] += q[k + i]
+        k += 3
+    n_bones = R.shape[0]
+    state = kernel.State(R, x, np.zeros((n_bones, 3)), np.zeros((n_bones, 3)), nodes, np.zeros_like(nodes))
+    work = kernel.Work(
+        np.zeros(grids.points.shape[0], np.int64),
+        np.zeros(grids.pair_bones.shape[0], np.int64),
+        np.zeros((n_bones, 3)),
+        np.zeros((n_bones, 3)),
+        np.zeros_like(nodes),
+        np.zeros((grids.pair_bones.shape[0], 3)),
+        np.zeros(len(ALL_LIGAMENT_NAMES)),
+    )
+    kernel._forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, True)
+    F, T, node_force = work.F, work.T, work.node_force
+    k = 0
+    for b in (SCAPHOID, LUNATE):
+        for i in range(3):
+            out[k + i] = F[b, i]
+            out[k + 3 + i] = T[b, i] / LEVER_MM
+        k += 6
+    if loaded:
+        for i in range(3):
+            out[k + i] = F[CAPITATE, i]
+        k += 3
+    for n in free_nodes:
+        for i in range(3):
+            out[k + i] = node_force[n, i]
+        k += 3
+    return out
+
+
+@njit(cache=True, error_model="numpy")
+def _jacobian(q, R0, x0, nodes0, free_nodes, bod, grids, law, fib, stiffness, mem, st, load, step):
+    """Central-difference Jacobian of `_residual` (n, n) with steps `step` (rad or mm)."""
+    n = q.shape[0]
+    J = np.empty((n, n))
+    plus = np.empty(n)
+    minus = np.empty(n)
+    for j in range(n):
+        qj = q[j]
+        q[j] = qj + step
+        _residual(q, R0, x0, nodes0, free_nodes, bod, grids, law, fib, stiffness, mem, st, load, plus)
+        q[j] = qj - step
+        _residual(q, R0, x0, nodes0, free_nodes, bod, grids, law, fib, stiffness, mem, st, load, minus)
+        q[j] = qj
+        for i in range(n):
+            J[i, j] = (plus[i] - minus[i]) / (2.0 * step)
+    return J
+
+
+@dataclass(frozen=True)
+class Equilibrium:
+    """The equilibria nearest an explicit run's frames.
+
+    poses (n_frames, 5, 4, 4): neutral → frame transforms at equilibrium, RCS mm.
+    residual (n_frames, 2): largest net force (N) and moment (N·mm) left on the free bones.
+    distance (n_frames, 2): largest centre-of-mass distance (mm) and rotation (deg) of a moving
+        bone (scaphoid, lunate, capitate) between the explicit answer and the equilibrium.
+    """
+
+    poses: np.ndarray
+    residual: np.ndarray
+    distance: np.ndarray
+
+
+def nearest(model: Model, design: Design, driver, result, settings: arrays.SolverSettings | None = None) -> Equilibrium:
+    """The equilibrium nearest each frame of `result` (a successful `simulate(model, design, driver)`)."""
+    from wrist_env.solver.simulate import prepare
+
+    if not result.ok:
+        raise ValueError(f"the run failed ({result.message}); there is no state to start from")
+    p = prepare(model, settings, driver.mode)
+    f_l0, f_K, m_l0, m_K = arrays.design_arrays(model, p.fibres, p.membrane, design)
+    stiffness = kernel.Stiffness(f_l0, f_K, m_l0, m_K)
+    free_nodes = np.flatnonzero(np.asarray(model.membrane_bone) < 0).astype(np.int64)
+    n_unknown = 12 + (3 if driver.mode == arrays.LOADED else 0) + 3 * len(free_nodes)
+    com0 = model.com
+    moving = [BONES.index(b) for b in ("scaphoid", "lunate", "capitate")]
+    poses = result.poses.copy()
+    residual = np.zeros((driver.n_frames, 2))
+    distance = np.zeros((driver.n_frames, 2))
+    out = np.zeros(n_unknown)
+    for f in range(driver.n_frames):
+        R0 = np.ascontiguousarray(result.poses[f, :, :3, :3])
+        x0 = np.ascontiguousarray(np.einsum("bij,bj->bi", R0, com0) + result.poses[f, :, :3, 3])
+        nodes0 = np.ascontiguousarray(result.membrane_nodes[f])
+        load = float(driver.load_n[f])
+
+        args = (R0, x0, nodes0, free_nodes, p.bodies, p.grids, p.law, p.fibres, stiffness, p.membrane, p.settings, load)
+
+        def fun(q):
+            return _residual(q, *args, out).copy()
+
+        def jac(q):
+            return _jacobian(q.copy(), *args, JACOBIAN_STEP)
+
+        q = least_squares(fun, np.zeros(n_unknown), jac=jac, method="lm", xtol=1e-12, ftol=1e-12, gtol=1e-12).x
+        r = fun(q)
+        R = R0.copy()
+        x = x0.copy()
+        for i, b in enumerate((SCAPHOID, LUNATE)):
+            rotate_in_place(R[b], *q[6 * i : 6 * i + 3])
+            x[b] += q[6 * i + 3 : 6 * i + 6]
+        if driver.mode == arrays.LOADED:
+            x[CAPITATE] += q[12:15]
+        poses[f, :, :3, :3] = R
+        poses[f, :, :3, 3] = x - np.einsum("bij,bj->bi", R, com0)
+        residual[f] = (
+            max(np.linalg.norm(r[0:3]), np.linalg.norm(r[6:9])),
+            LEVER_MM * max(np.linalg.norm(r[3:6]), np.linalg.norm(r[9:12])),
+        )
+        distance[f, 0] = max(np.linalg.norm(x[b] - x0[b]) for b in moving)
+        distance[f, 1] = max(np.degrees(np.arccos(np.clip((np.trace(R[b] @ R0[b].T) - 1) / 2, -1, 1))) for b in moving)
+    return Equilibrium(poses, residual, distance)
