@@ -27,6 +27,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+from bench_solver import monte_carlo_designs  # this folder's script (on sys.path when run)
 from tqdm import tqdm
 
 from wrist_env import design
@@ -48,14 +49,6 @@ def reference_settings(base: SolverSettings) -> SolverSettings:
     return replace(
         s, tolerance=s.tolerance / 10, force_floor_n=s.force_floor_n / 10, max_hold_steps=8 * s.max_hold_steps
     )
-
-
-def monte_carlo_designs(n: int, seed: int = 0) -> list[design.Design]:
-    """The population design, then n Monte Carlo designs (the benchmark scripts' draw)."""
-    rng = np.random.default_rng(seed)
-    materials = design.sample_materials(n, seed)
-    injury = np.where(rng.random((n, 5)) < 0.3, -0.5, 0.5)
-    return [design.population()] + [design.from_action(np.r_[m, i]) for m, i in zip(materials, injury)]
 
 
 def distance(a: np.ndarray, b: np.ndarray, com0: np.ndarray) -> tuple[float, float]:
@@ -93,7 +86,7 @@ def reference(name: str, model, designs, base: SolverSettings) -> dict[str, np.n
 
 def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int) -> None:
     model = load_model(name)
-    designs = monte_carlo_designs(n_designs)
+    designs = [design.population()] + monte_carlo_designs(n_designs)
     ref = reference(name, model, designs, SolverSettings())
     for motion, driver in drivers(name, model).items():
         runs = simulate_batch(model, designs, driver, settings)

@@ -24,6 +24,7 @@ from wrist_env.solver.kernel import CAPITATE, LEVER_MM, LUNATE, SCAPHOID
 from wrist_env.solver.rigid import rotate_in_place
 
 JACOBIAN_STEP = 1e-6  # finite-difference step of the Jacobian (rad, mm)
+MAX_EVALUATIONS = 60  # residual evaluations per frame (each with a Jacobian): where contact stalls it, stop
 
 
 @njit(cache=True, error_model="numpy")
@@ -144,7 +145,9 @@ def nearest(model: Model, design: Design, driver, result, settings: arrays.Solve
         def jac(q):
             return _jacobian(q.copy(), *args, JACOBIAN_STEP)
 
-        q = least_squares(fun, np.zeros(n_unknown), jac=jac, method="lm", xtol=1e-12, ftol=1e-12, gtol=1e-12).x
+        q = least_squares(
+            fun, np.zeros(n_unknown), jac=jac, method="lm", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=MAX_EVALUATIONS
+        ).x
         r = fun(q)
         R = R0.copy()
         x = x0.copy()
