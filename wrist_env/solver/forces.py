@@ -132,8 +132,8 @@ def sample_pressures(R, x, com0, grids, law, pressure):
 
 
 @njit(cache=True, error_model="numpy")
-def contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats):
-    """Contact forces of all pairs' active samples; returns contact energy (N·mm).
+def contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, want_energy=True):
+    """Contact forces of all pairs' active samples; returns contact energy (N·mm; 0 unless `want_energy`).
 
     Each pair's forces and moments are summed in the grid bone's neutral frame
     and applied to both bodies once. stats (n_pairs, 3) receives per pair:
@@ -167,7 +167,8 @@ def contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats):
             mx += qy * sz - qz * sy
             my += qz * sx - qx * sz
             mz += qx * sy - qy * sx
-            energy += area * h * law_energy(law, strain)
+            if want_energy:
+                energy += area * h * law_energy(law, strain)
             force += pressure * area
             area_sum += area
             if pressure > peak:
@@ -201,8 +202,8 @@ def contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats):
 
 
 @njit(cache=True, error_model="numpy")
-def fibre_forces(R, x, v, w, com0, fibres, l0, K, damping_s, F, T, bundle_force):
-    """Blankevoort fibre forces; returns strain energy (N·mm).
+def fibre_forces(R, x, v, w, com0, fibres, l0, K, damping_s, F, T, bundle_force, want_energy=True):
+    """Blankevoort fibre forces; returns strain energy (N·mm; 0 unless `want_energy`).
 
     l0, K: per-fibre zero-load length (mm) and scale (N per unit strain), K = 0 if torn.
     bundle_force (n_ligaments,) receives the summed tension of each bundle (N).
@@ -237,7 +238,8 @@ def fibre_forces(R, x, v, w, com0, fibres, l0, K, damping_s, F, T, bundle_force)
         apply_force(F, T, x, a, tension * ux, tension * uy, tension * uz, ax, ay, az)
         apply_force(F, T, x, b, -tension * ux, -tension * uy, -tension * uz, bx, by, bz)
         bundle_force[fibres.ligament[i]] += tension
-        energy += blankevoort_energy(K[i], l0[i], strain)
+        if want_energy:
+            energy += blankevoort_energy(K[i], l0[i], strain)
     return energy
 
 
@@ -253,7 +255,7 @@ def place_nodes(R, x, com0, mem, nodes):
 
 
 @njit(cache=True, error_model="numpy")
-def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node_force):
+def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node_force, want_energy=True):
     """RSC membrane: connector tension and node–scaphoid contact.
 
     nodes (M, 3): world positions (attached nodes already placed on their bones).
@@ -280,7 +282,8 @@ def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node
         node_force[j, 0] -= tension * dx
         node_force[j, 1] -= tension * dy
         node_force[j, 2] -= tension * dz
-        energy += blankevoort_energy(K[c], l0[c], strain)
+        if want_energy:
+            energy += blankevoort_energy(K[c], l0[c], strain)
         if mem.first_row[c]:
             along += tension * length
     s = mem.scaphoid

@@ -92,9 +92,10 @@ def _fire(v, w, nv, F, T, node_force, mem, st, fire):
 
 
 @njit(cache=True, error_model="numpy")
-def _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, rebuild):
+def _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, rebuild, want_energy=True):
     """Forces F (N), torques T (N·mm), contact stats and bundle forces at the current
-    state; rebuilds the active contact set first if `rebuild`; returns internal energy (N·mm)."""
+    state; rebuilds the active contact set first if `rebuild`; returns internal energy
+    (N·mm; 0 unless `want_energy`)."""
     R, x, v, w, nodes, _ = state
     active, n_active, F, T, node_force, stats, bundle = work
     f_l0, f_K, m_l0, m_K = stiffness
@@ -105,9 +106,11 @@ def _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, rebuild
     F[:] = 0.0
     T[:] = 0.0
     bundle[:] = 0.0
-    energy = contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats)
-    energy += fibre_forces(R, x, v, w, com0, fib, f_l0, f_K, st.fibre_damping_s, F, T, bundle)
-    e_mem, rsc = membrane_forces(R, x, com0, mem, nodes, m_l0, m_K, st.membrane_contact_stiffness, F, T, node_force)
+    energy = contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, want_energy)
+    energy += fibre_forces(R, x, v, w, com0, fib, f_l0, f_K, st.fibre_damping_s, F, T, bundle, want_energy)
+    e_mem, rsc = membrane_forces(
+        R, x, com0, mem, nodes, m_l0, m_K, st.membrane_contact_stiffness, F, T, node_force, want_energy
+    )
     energy += e_mem
     bundle[RSC] += rsc
     if st.driver == LOADED:
@@ -118,8 +121,7 @@ def _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, rebuild
 @njit(cache=True, error_model="numpy")
 def _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step_index, fire):
     """One explicit step with the capitate at target (capR, capx), or, for the loaded
-    driver, at rotation capR under a compressive `load` (N, along +y); returns
-    internal energy (N·mm) before the step."""
+    driver, at rotation capR under a compressive `load` (N, along +y)."""
     R, x, v, w, nodes, nv = state
     _, _, F, T, node_force, _, _ = work
     R[CAPITATE] = capR
@@ -127,7 +129,7 @@ def _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, loa
         x[CAPITATE, 0], x[CAPITATE, 1], x[CAPITATE, 2] = capx
         v[CAPITATE] = 0.0
     w[CAPITATE] = 0.0
-    energy = _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, step_index % st.rebuild_every == 0)
+    _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, step_index % st.rebuild_every == 0, False)
     if st.fire_alpha0 > 0.0:
         _fire(v, w, nv, F, T, node_force, mem, st, fire)
     dt = st.dt
@@ -161,7 +163,6 @@ def _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, loa
     if step_index % 100 == 0:
         for b in (SCAPHOID, LUNATE):
             R[b] = orthonormalize(R[b])
-    return energy
 
 
 @njit(cache=True, error_model="numpy")
@@ -277,7 +278,6 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
     step = 0
     R0 = np.eye(3)
     x0 = com0[CAPITATE].copy()
-    energy = 0.0
     fire = np.array([st.fire_alpha0, 0.0])
     capR = np.eye(3)
     taken = 0
@@ -290,7 +290,7 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
             s = smoothstep((k + 1) / ramp) if ramp > 0 else 1.0
             capx = interpolate_pose(Ra, xa, axis, capR, shift, s)
             load = la + s * (lb - la)
-            energy = _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step, fire)
+            _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step, fire)
             step += 1
             k += 1
             if k >= ramp + st.min_hold_steps and _converged(F, T, bundle, st):
