@@ -14,7 +14,8 @@ are also polished by the quasi-static Newton reference
 answer to the equilibrium nearest it, and the net force left there.
 
 Run: `python experiments/solver_accuracy.py [P1 P2 P3] [--designs 100] [--newton 3] [--set dt_s=9e-5 ...]`
-(--set changes the settings under test; the reference stays the default's).
+(--set changes the settings under test; the reference stays the default's, with the same
+`smooth_normals`, which changes the answer, not only the path to it).
 References are cached in runs/solver_accuracy/ (delete to recompute).
 Reference runs take ~2 min per participant for 100 designs on 2 cores.
 """
@@ -71,7 +72,8 @@ def drivers(name: str, model):
 
 
 def reference(name: str, model, designs, base: SolverSettings) -> dict[str, np.ndarray]:
-    path = CACHE / f"{name}_{len(designs) - 1}.npz"
+    physics = "_smooth_normals" if base.smooth_normals else ""  # the one setting that changes the answer
+    path = CACHE / f"{name}_{len(designs) - 1}{physics}.npz"
     if path.exists():
         return dict(np.load(path))
     out = {}
@@ -87,7 +89,7 @@ def reference(name: str, model, designs, base: SolverSettings) -> dict[str, np.n
 def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int) -> None:
     model = load_model(name)
     designs = [design.population()] + monte_carlo_designs(n_designs)
-    ref = reference(name, model, designs, SolverSettings())
+    ref = reference(name, model, designs, replace(SolverSettings(), smooth_normals=settings.smooth_normals))
     for motion, driver in drivers(name, model).items():
         runs = simulate_batch(model, designs, driver, settings)
         both = [i for i, r in enumerate(runs) if r.ok and ref[motion + "_ok"][i]]

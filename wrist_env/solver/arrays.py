@@ -13,18 +13,22 @@ import numpy as np
 
 from wrist_env.design import RSC_INDEX, Design, ligament_arrays
 from wrist_env.model import BONES, PAIR_BONES, Model
+from wrist_env.solver.contact import nodal_gradients
 
 Bodies = namedtuple("Bodies", "com0 inv_mass inv_inertia mass inertia")
-Grids = namedtuple("Grids", "pair_bones sample_offsets points thickness area values offsets shape origin spacing")
+Grids = namedtuple(
+    "Grids", "pair_bones sample_offsets points thickness area values offsets shape origin spacing gradient"
+)
 Fibres = namedtuple("Fibres", "bones origin insertion ligament rest_length")
 Membrane = namedtuple(
     "Membrane",
-    "connectors kind first_row bone rest scaphoid grid_values grid_offset grid_shape grid_origin grid_spacing rest_length",
+    "connectors kind first_row bone rest scaphoid grid_values grid_offset grid_shape grid_origin grid_spacing rest_length "
+    "grid_gradient",
 )
 Settings = namedtuple(
     "Settings",
     "dt settle_steps move_steps ramp_steps min_hold_steps max_hold_steps tolerance force_floor damping rot_damping fibre_damping_s "
-    "active_band_mm rebuild_every node_mass membrane_contact_stiffness driver max_disp_mm max_rot_rad fire_alpha0",
+    "active_band_mm rebuild_every node_mass membrane_contact_stiffness driver max_disp_mm max_rot_rad fire_alpha0 smooth_normals",
 )
 
 RSC = RSC_INDEX
@@ -42,6 +46,10 @@ class SolverSettings:
     least min_hold_steps and at most max_hold_steps (settling: at most
     settle_steps). damping_per_s: mass-proportional damping of translations
     and rotations; fire_alpha0: FIRE mixing (0 turns FIRE off).
+    smooth_normals: contact forces along the grids' nodal gradients
+    interpolated trilinearly (continuous), instead of the derivative of the
+    trilinear distance (which jumps at cell faces, so no state balances
+    exactly: `experiments/solver_accuracy.py`).
     mass_scale, inertia_scale: mass scaling of the free bones (inertia_scale
     multiplies rotational inertia on top of mass_scale).
     """
@@ -66,6 +74,7 @@ class SolverSettings:
     max_disp_mm: float = 15.0
     max_rot_deg: float = 75.0
     fire_alpha0: float = 0.1
+    smooth_normals: bool = False
 
     def halved(self) -> "SolverSettings":
         """The same run with half the time step (twice the steps)."""
@@ -90,7 +99,13 @@ def bodies(model: Model, s: SolverSettings) -> Bodies:
     return Bodies(np.ascontiguousarray(model.com), inv_mass, inv_inertia, mass, inertia)
 
 
-def grids(model: Model) -> Grids:
+def grids(model: Model, smooth_normals: bool = False) -> Grids:
+    """The contact arrays; with `smooth_normals` the grids' nodal gradients too (else an empty (0, 3))."""
+    gradient = (
+        nodal_gradients(model.grid_values, model.grid_offsets, model.grid_shape, model.grid_spacing)
+        if smooth_normals
+        else np.zeros((0, 3), np.float32)
+    )
     return Grids(
         np.ascontiguousarray(PAIR_BONES, dtype=np.int64),
         np.ascontiguousarray(model.sample_offsets, dtype=np.int64),
@@ -102,6 +117,7 @@ def grids(model: Model) -> Grids:
         np.ascontiguousarray(model.grid_shape, dtype=np.int64),
         np.ascontiguousarray(model.grid_origin, dtype=np.float64),
         np.ascontiguousarray(model.grid_spacing, dtype=np.float64),
+        gradient,
     )
 
 
@@ -134,6 +150,7 @@ def membrane(model: Model, grd: Grids) -> Membrane:
         np.ascontiguousarray(model.grid_origin[s]),
         float(model.grid_spacing[s]),
         np.ascontiguousarray(model.membrane_length),
+        grd.gradient,
     )
 
 
@@ -184,4 +201,5 @@ def settings_tuple(s: SolverSettings, driver: int) -> Settings:
         float(s.max_disp_mm),
         float(np.radians(s.max_rot_deg)),
         float(s.fire_alpha0),
+        bool(s.smooth_normals),
     )

@@ -67,6 +67,55 @@ def sdf_lookup_scalar(values, offset, shape, origin, spacing, qx, qy, qz):
     return d, gx, gy, gz
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def sdf_lookup_smooth(values, gradient, offset, shape, origin, spacing, qx, qy, qz):
+    """As `sdf_lookup_scalar`, but the gradient interpolated trilinearly from the grid's
+    nodal gradients `gradient` (n, 3) (continuous across cells, unlike the derivative of
+    the trilinear distance, which jumps at cell faces)."""
+    nx, ny, nz = shape[0], shape[1], shape[2]
+    inv = 1.0 / spacing
+    fx = (qx - origin[0]) * inv
+    fy = (qy - origin[1]) * inv
+    fz = (qz - origin[2]) * inv
+    if fx < 0.0 or fy < 0.0 or fz < 0.0 or fx >= nx - 1 or fy >= ny - 1 or fz >= nz - 1:
+        return OUTSIDE_MM, 0.0, 0.0, 0.0
+    i = int(fx)
+    j = int(fy)
+    k = int(fz)
+    tx = fx - i
+    ty = fy - j
+    tz = fz - k
+    base = offset + (i * ny + j) * nz + k
+    sy = nz
+    sx = ny * nz
+    d = gx = gy = gz = 0.0
+    for di in range(2):
+        wx = tx if di else 1.0 - tx
+        for dj in range(2):
+            wy = ty if dj else 1.0 - ty
+            for dk in range(2):
+                wgt = wx * wy * (tz if dk else 1.0 - tz)
+                n = base + di * sx + dj * sy + dk
+                d += wgt * values[n]
+                gx += wgt * gradient[n, 0]
+                gy += wgt * gradient[n, 1]
+                gz += wgt * gradient[n, 2]
+    return d, gx, gy, gz
+
+
+def nodal_gradients(values, offsets, shape, spacing):
+    """Central-difference gradients (n, 3) float32 at every node of the flattened grids (one-sided at the borders)."""
+    out = np.zeros((len(values), 3), np.float32)
+    for b in range(len(shape)):
+        n = int(np.prod(shape[b]))
+        if n == 0 or np.min(shape[b]) < 2:
+            continue
+        grid = np.asarray(values[offsets[b] : offsets[b] + n], np.float64).reshape(tuple(shape[b]))
+        g = np.gradient(grid, float(spacing[b]))
+        out[offsets[b] : offsets[b] + n] = np.stack([c.ravel() for c in g], axis=1)
+    return out
+
+
 @njit(cache=True, error_model="numpy")
 def law_pressure(law, e):
     """Pressure (MPa) of the tri-linear law [e1, e2, k1, k2, k3] at strain e."""

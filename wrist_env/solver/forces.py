@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from wrist_env.solver.contact import law_energy, law_pressure, sdf_lookup_scalar
+from wrist_env.solver.contact import law_energy, law_pressure, sdf_lookup_scalar, sdf_lookup_smooth
 from wrist_env.solver.ligaments import blankevoort_energy, blankevoort_force
 
 # columns of the per-pair contact statistics the force kernels accumulate
@@ -105,6 +105,21 @@ def _lookup(grids, b, M, s):
     return d, gx, gy, gz, qx, qy, qz
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _lookup_smooth(grids, b, M, s):
+    """As `_lookup`, with the gradient interpolated from the grid's nodal gradients."""
+    m00, m01, m02, m10, m11, m12, m20, m21, m22, tx, ty, tz = M
+    p = grids.points
+    px, py, pz = p[s, 0], p[s, 1], p[s, 2]
+    qx = m00 * px + m01 * py + m02 * pz + tx
+    qy = m10 * px + m11 * py + m12 * pz + ty
+    qz = m20 * px + m21 * py + m22 * pz + tz
+    d, gx, gy, gz = sdf_lookup_smooth(
+        grids.values, grids.gradient, grids.offsets[b], grids.shape[b], grids.origin[b], grids.spacing[b], qx, qy, qz
+    )
+    return d, gx, gy, gz, qx, qy, qz
+
+
 @njit(cache=True, error_model="numpy")
 def rebuild_active(R, x, com0, grids, band_mm, active, n_active):
     """Refill `active` with the samples of each pair within `band_mm` of contact."""
@@ -132,7 +147,7 @@ def sample_pressures(R, x, com0, grids, law, pressure):
 
 
 @njit(cache=True, error_model="numpy")
-def contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, want_energy=True):
+def contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, want_energy=True, smooth=False):
     """Contact forces of all pairs' active samples; returns contact energy (N·mm; 0 unless `want_energy`).
 
     Each pair's forces and moments are summed in the grid bone's neutral frame
@@ -149,7 +164,10 @@ def contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, want_e
         force = area_sum = peak = 0.0
         for j in range(n_active[p]):
             s = active[start + j]
-            d, gx, gy, gz, qx, qy, qz = _lookup(grids, b, M, s)
+            if smooth:
+                d, gx, gy, gz, qx, qy, qz = _lookup_smooth(grids, b, M, s)
+            else:
+                d, gx, gy, gz, qx, qy, qz = _lookup(grids, b, M, s)
             if d >= 0.0:
                 continue
             gn = np.sqrt(gx * gx + gy * gy + gz * gz)
@@ -255,7 +273,7 @@ def place_nodes(R, x, com0, mem, nodes):
 
 
 @njit(cache=True, error_model="numpy")
-def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node_force, want_energy=True):
+def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node_force, want_energy=True, smooth=False):
     """RSC membrane: connector tension and node–scaphoid contact.
 
     nodes (M, 3): world positions (attached nodes already placed on their bones).
@@ -291,9 +309,22 @@ def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node
         if mem.bone[i] >= 0:
             continue
         qx, qy, qz = to_local(R, x, com0, s, nodes[i, 0], nodes[i, 1], nodes[i, 2])
-        d, gx, gy, gz = sdf_lookup_scalar(
-            mem.grid_values, mem.grid_offset, mem.grid_shape, mem.grid_origin, mem.grid_spacing, qx, qy, qz
-        )
+        if smooth:
+            d, gx, gy, gz = sdf_lookup_smooth(
+                mem.grid_values,
+                mem.grid_gradient,
+                mem.grid_offset,
+                mem.grid_shape,
+                mem.grid_origin,
+                mem.grid_spacing,
+                qx,
+                qy,
+                qz,
+            )
+        else:
+            d, gx, gy, gz = sdf_lookup_scalar(
+                mem.grid_values, mem.grid_offset, mem.grid_shape, mem.grid_origin, mem.grid_spacing, qx, qy, qz
+            )
         if d < 0.0:
             gn = np.sqrt(gx * gx + gy * gy + gz * gz)
             if gn > 1e-12:

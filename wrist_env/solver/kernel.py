@@ -106,10 +106,22 @@ def _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, rebuild
     F[:] = 0.0
     T[:] = 0.0
     bundle[:] = 0.0
-    energy = contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, want_energy)
+    energy = contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, want_energy, st.smooth_normals)
     energy += fibre_forces(R, x, v, w, com0, fib, f_l0, f_K, st.fibre_damping_s, F, T, bundle, want_energy)
     e_mem, rsc = membrane_forces(
-        R, x, com0, mem, nodes, m_l0, m_K, st.membrane_contact_stiffness, F, T, node_force, want_energy
+        R,
+        x,
+        com0,
+        mem,
+        nodes,
+        m_l0,
+        m_K,
+        st.membrane_contact_stiffness,
+        F,
+        T,
+        node_force,
+        want_energy,
+        st.smooth_normals,
     )
     energy += e_mem
     bundle[RSC] += rsc

@@ -167,7 +167,7 @@ class Prepared:
 def prepare(model: Model, settings: arrays.SolverSettings | None = None, mode: int = arrays.EXPERIMENTAL) -> Prepared:
     """The kernel arrays of `model` under `settings` (default `SolverSettings()`) for drivers of `mode`."""
     s = settings or arrays.SolverSettings()
-    grd = arrays.grids(model)
+    grd = arrays.grids(model, s.smooth_normals)
     return Prepared(
         model,
         int(mode),
