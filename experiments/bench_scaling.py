@@ -25,7 +25,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numba
 import numpy as np
-from bench_solver import monte_carlo_designs  # this folder's script (on sys.path when run)
+from bench_solver import median_seconds, monte_carlo_designs  # this folder's script (on sys.path when run)
 
 from wrist_env import design
 from wrist_env.builder.pipeline import BuildParams
@@ -36,38 +36,34 @@ BATCHES = (1, 2, 4, 8, 16, 32, 64)
 SPACINGS_MM = (0.7, 1.0, 1.4, 2.0)  # contact-sample spacing; 1.0 mm is the default build
 
 
-def best_of(fn, repeats: int = 3) -> float:
-    """Median wall time (s) of fn() after one warm-up call."""
-    fn()
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - start)
-    return float(np.median(times))
-
-
 def in_batches(model, designs, n, driver, prepared) -> None:
     """All `designs` through `simulate_batch`, n at a time (the same work at every batch size)."""
     for start in range(0, len(designs), n):
         simulate_batch(model, designs[start : start + n], driver, prepared=prepared)
 
 
-def throughput(name: str) -> dict[int, list[float]]:
-    """Simulations per second per batch size (64 Monte Carlo designs, n at a time), per thread count (1, 2)."""
+def throughput(name: str, repeats: int = 3) -> dict[int, list[float]]:
+    """Simulations per second per batch size (64 Monte Carlo designs, n at a time), per thread count
+    (1, 2); the thread counts alternate within each repeat, so a drifting machine load hits both."""
     model = load_model(name)
     driver = idealized(model)
     prepared = prepare(model, mode=driver.mode)
     designs = monte_carlo_designs(max(BATCHES))
-    out = {}
     available = numba.config.NUMBA_NUM_THREADS
-    for threads in (1, min(2, available)):
-        numba.set_num_threads(threads)
-        out[threads] = [
-            n / best_of(lambda n=n: simulate_batch(model, designs[:n], driver, prepared=prepared)) for n in BATCHES
-        ]
-        print(f"{threads} thread(s): " + ", ".join(f"{n}: {r:.1f}/s" for n, r in zip(BATCHES, out[threads])))
+    counts = (1, min(2, available))
+    in_batches(model, designs[:2], 1, driver, prepared)  # compile
+    seconds = {(n, t): [] for n in BATCHES for t in counts}
+    for n in BATCHES:
+        for _ in range(repeats):
+            for t in counts:
+                numba.set_num_threads(t)
+                start = time.perf_counter()
+                in_batches(model, designs, n, driver, prepared)
+                seconds[n, t].append(time.perf_counter() - start)
     numba.set_num_threads(available)
+    out = {t: [len(designs) / float(np.median(seconds[n, t])) for n in BATCHES] for t in counts}
+    for t in counts:
+        print(f"{t} thread(s): " + ", ".join(f"{n}: {r:.1f}/s" for n, r in zip(BATCHES, out[t])))
     return out
 
 
@@ -80,7 +76,7 @@ def resolution(name: str) -> list[tuple[float, int, int, float]]:
         driver = idealized(model)
         prepared = prepare(model, mode=driver.mode)
         result = simulate(model, design.population(), driver, prepared=prepared)
-        seconds = best_of(lambda: simulate(model, design.population(), driver, prepared=prepared))
+        seconds = median_seconds(lambda: simulate(model, design.population(), driver, prepared=prepared))
         rows.append((spacing, len(model.sample_points), int(result.steps.sum()), seconds))
         steps = rows[-1][2]
         print(

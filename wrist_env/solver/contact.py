@@ -23,27 +23,31 @@ def sdf_lookup(values, offset, shape, origin, spacing, q):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def sdf_lookup_scalar(values, offset, shape, origin, spacing, qx, qy, qz):
-    """Trilinear signed distance (mm) and gradient components at local point (qx, qy, qz).
-
-    values: C-order grids (float32, mm) flattened; offset: the grid's first value.
-    """
+def _cell(offset, shape, origin, spacing, qx, qy, qz):
+    """(inside, first corner's index, x and y strides, fractions tx, ty, tz, 1/spacing) of the grid
+    cell holding local point q; inside is False outside the grid."""
     nx, ny, nz = shape[0], shape[1], shape[2]
     inv = 1.0 / spacing
     fx = (qx - origin[0]) * inv
     fy = (qy - origin[1]) * inv
     fz = (qz - origin[2]) * inv
     if fx < 0.0 or fy < 0.0 or fz < 0.0 or fx >= nx - 1 or fy >= ny - 1 or fz >= nz - 1:
-        return OUTSIDE_MM, 0.0, 0.0, 0.0
+        return False, 0, 0, 0, 0.0, 0.0, 0.0, inv
     i = int(fx)
     j = int(fy)
     k = int(fz)
-    tx = fx - i
-    ty = fy - j
-    tz = fz - k
-    base = offset + (i * ny + j) * nz + k
-    sy = nz
-    sx = ny * nz
+    return True, offset + (i * ny + j) * nz + k, ny * nz, nz, fx - i, fy - j, fz - k, inv
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def sdf_lookup_scalar(values, offset, shape, origin, spacing, qx, qy, qz):
+    """Trilinear signed distance (mm) and gradient components at local point (qx, qy, qz).
+
+    values: C-order grids (float32, mm) flattened; offset: the grid's first value.
+    """
+    inside, base, sx, sy, tx, ty, tz, inv = _cell(offset, shape, origin, spacing, qx, qy, qz)
+    if not inside:
+        return OUTSIDE_MM, 0.0, 0.0, 0.0
     c000 = values[base]
     c001 = values[base + 1]
     c010 = values[base + sy]
@@ -72,22 +76,9 @@ def sdf_lookup_smooth(values, gradient, offset, shape, origin, spacing, qx, qy, 
     """As `sdf_lookup_scalar`, but the gradient interpolated trilinearly from the grid's
     nodal gradients `gradient` (n, 3) (continuous across cells, unlike the derivative of
     the trilinear distance, which jumps at cell faces)."""
-    nx, ny, nz = shape[0], shape[1], shape[2]
-    inv = 1.0 / spacing
-    fx = (qx - origin[0]) * inv
-    fy = (qy - origin[1]) * inv
-    fz = (qz - origin[2]) * inv
-    if fx < 0.0 or fy < 0.0 or fz < 0.0 or fx >= nx - 1 or fy >= ny - 1 or fz >= nz - 1:
+    inside, base, sx, sy, tx, ty, tz, inv = _cell(offset, shape, origin, spacing, qx, qy, qz)
+    if not inside:
         return OUTSIDE_MM, 0.0, 0.0, 0.0
-    i = int(fx)
-    j = int(fy)
-    k = int(fz)
-    tx = fx - i
-    ty = fy - j
-    tz = fz - k
-    base = offset + (i * ny + j) * nz + k
-    sy = nz
-    sx = ny * nz
     d = gx = gy = gz = 0.0
     for di in range(2):
         wx = tx if di else 1.0 - tx

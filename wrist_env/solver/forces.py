@@ -91,14 +91,22 @@ def pair_transform(R, x, com0, a, b):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _lookup(grids, b, M, s):
-    """Signed distance (mm), gradient and position (b's neutral frame) of sample s under the pair transform M."""
+def _moved(grids, M, s):
+    """Sample s's position under the pair transform M (12 scalars), in the grid bone's neutral frame."""
     m00, m01, m02, m10, m11, m12, m20, m21, m22, tx, ty, tz = M
     p = grids.points
     px, py, pz = p[s, 0], p[s, 1], p[s, 2]
-    qx = m00 * px + m01 * py + m02 * pz + tx
-    qy = m10 * px + m11 * py + m12 * pz + ty
-    qz = m20 * px + m21 * py + m22 * pz + tz
+    return (
+        m00 * px + m01 * py + m02 * pz + tx,
+        m10 * px + m11 * py + m12 * pz + ty,
+        m20 * px + m21 * py + m22 * pz + tz,
+    )
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _lookup(grids, b, M, s):
+    """Signed distance (mm), gradient and position (b's neutral frame) of sample s under the pair transform M."""
+    qx, qy, qz = _moved(grids, M, s)
     d, gx, gy, gz = sdf_lookup_scalar(
         grids.values, grids.offsets[b], grids.shape[b], grids.origin[b], grids.spacing[b], qx, qy, qz
     )
@@ -108,12 +116,7 @@ def _lookup(grids, b, M, s):
 @njit(cache=True, error_model="numpy", inline="always")
 def _lookup_smooth(grids, b, M, s):
     """As `_lookup`, with the gradient interpolated from the grid's nodal gradients."""
-    m00, m01, m02, m10, m11, m12, m20, m21, m22, tx, ty, tz = M
-    p = grids.points
-    px, py, pz = p[s, 0], p[s, 1], p[s, 2]
-    qx = m00 * px + m01 * py + m02 * pz + tx
-    qy = m10 * px + m11 * py + m12 * pz + ty
-    qz = m20 * px + m21 * py + m22 * pz + tz
+    qx, qy, qz = _moved(grids, M, s)
     d, gx, gy, gz = sdf_lookup_smooth(
         grids.values, grids.gradient, grids.offsets[b], grids.shape[b], grids.origin[b], grids.spacing[b], qx, qy, qz
     )
