@@ -115,7 +115,11 @@ def test_a_failed_run_fails_its_check_and_says_why():
     assert math.isnan(row.value) and not row.passed and "failed: NaN in the state" in row.description
 
 
-@pytest.mark.xfail(reason="model fidelity work in progress (issue 10)", strict=True, raises=AssertionError)
+@pytest.mark.xfail(
+    reason="the radiocarpal load share (and P2's SLIL force) need cartilage and TFCC data we do not have: issue 10, blocked",
+    strict=True,
+    raises=AssertionError,
+)
 @pytest.mark.parametrize("name", ["P1", "P2", "P3"])
 def test_builtins_pass_published_checks(name, built):
     report = validation.validate(name, model=built(name))
