@@ -3,7 +3,6 @@
 from dataclasses import replace
 
 import numpy as np
-import pytest
 from scipy.optimize import brentq
 from test_verification import EPSILON_L, OSCILLATORS, oscillator, undamped
 
@@ -16,11 +15,6 @@ from wrist_env.solver.simulate import experimental, idealized, simulate
 SCAPHOID = 2
 AXIS = np.array([1.0, 2.0, 2.0]) / 3.0
 CENTRE = np.array([3.0, -1.0, 2.0])
-
-
-@pytest.fixture(scope="module")
-def p1(built):
-    return built("P1")
 
 
 def tension(K, strain):

@@ -16,11 +16,6 @@ RS = PAIRS.index("radioscaphoid")
 
 
 @pytest.fixture(scope="module")
-def p1(built):
-    return built("P1")
-
-
-@pytest.fixture(scope="module")
 def sweep(p1):
     result = simulate(p1, design.population(), idealized(p1, n_frames=5))
     assert result.ok, result.message

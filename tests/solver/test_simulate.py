@@ -21,11 +21,6 @@ def flexion_deg(poses):
 
 
 @pytest.fixture(scope="module")
-def p1(built):
-    return built("P1")
-
-
-@pytest.fixture(scope="module")
 def sweep(p1):
     return simulate(p1, design.population(), idealized(p1))
 

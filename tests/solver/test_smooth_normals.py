@@ -3,7 +3,6 @@
 from dataclasses import replace
 
 import numpy as np
-import pytest
 
 from wrist_env import design
 from wrist_env.participants import registry
@@ -48,11 +47,6 @@ def test_smooth_gradient_is_the_sphere_normal_and_continuous_across_a_cell_face(
     trilinear_jump = angle(normal(sdf_lookup_scalar, face - eps), normal(sdf_lookup_scalar, face + eps))
     assert angle(normal(sdf_lookup_smooth, face), exact) < 1.0
     assert smooth_jump < 1e-3 and trilinear_jump > 0.1, (smooth_jump, trilinear_jump)
-
-
-@pytest.fixture(scope="module")
-def p1(built):
-    return built("P1")
 
 
 def test_newton_balances_the_trial_with_smooth_normals(p1):

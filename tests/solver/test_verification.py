@@ -341,11 +341,6 @@ MOVES = {  # (axis, quarter turns), translation mm
 }
 
 
-@pytest.fixture(scope="module")
-def p1(built):
-    return built("P1")
-
-
 def capitate_motion(model):
     """Four capitate transforms (neutral → frame): turns of up to 25° about its centre of mass
     about oblique axes, with sub-millimetre translations."""
