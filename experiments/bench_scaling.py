@@ -7,17 +7,18 @@ cost grows with the contact-sample resolution (issue 13).
 2. One sweep (population design, one thread) on P1 built at contact-sample spacings 0.7–2.0 mm:
    samples, steps, milliseconds per simulation and microseconds per step.
 
-Writes experiments/figures/scaling_P1.png (both panels). Timings are medians of repeated runs;
+Writes runs/figures/scaling_<name>.png (both panels; `experiments/regenerate.py` writes the README's copy). Timings are medians of repeated runs;
 run it on a quiet machine (nothing else on its cores). Builds the coarser and finer P1 variants
 on first use (~1 min each, cached).
 
-Run: `python experiments/bench_scaling.py [P1] [--out experiments/figures/scaling_P1.png]`
+Run: `python experiments/bench_scaling.py [P1] [--out PATH]`
 """
 
 from __future__ import annotations
 
 import argparse
 import time
+from pathlib import Path
 
 import matplotlib
 
@@ -116,13 +117,15 @@ def figure(name: str, rates: dict[int, list[float]], rows, out: str) -> None:
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("name", nargs="?", default="P1")
-    parser.add_argument("--out", default=None, help="figure path (default experiments/figures/scaling_<name>.png)")
+    parser.add_argument("--out", default=None, help="figure path (default runs/figures/scaling_<name>.png)")
     args = parser.parse_args(argv)
     rates = throughput(args.name)
     ratio = rates[max(rates)][-1] / rates[1][-1]
     print(f"2 threads / 1 thread at {BATCHES[-1]} designs: {ratio:.2f}×")
     rows = resolution(args.name)
-    figure(args.name, rates, rows, args.out or f"experiments/figures/scaling_{args.name}.png")
+    out = Path(args.out or f"runs/figures/scaling_{args.name}.png")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    figure(args.name, rates, rows, str(out))
 
 
 if __name__ == "__main__":

@@ -32,15 +32,13 @@ from bench_solver import monte_carlo_designs  # this folder's script (on sys.pat
 from tqdm import tqdm
 
 from wrist_env import design
-from wrist_env.model import BONES
 from wrist_env.participants import registry
 from wrist_env.participants.registry import load_model
 from wrist_env.solver.arrays import SolverSettings
-from wrist_env.solver.equilibrium import nearest
+from wrist_env.solver.equilibrium import distance, nearest
 from wrist_env.solver.simulate import experimental, idealized, simulate_batch
 
 CACHE = Path("runs/solver_accuracy")
-MOVING = [BONES.index(b) for b in ("scaphoid", "lunate", "capitate")]
 TOLERANCE = (0.1, 0.5)  # mm, degrees: issue 13's "answer unchanged"
 
 
@@ -52,16 +50,10 @@ def reference_settings(base: SolverSettings) -> SolverSettings:
     )
 
 
-def distance(a: np.ndarray, b: np.ndarray, com0: np.ndarray) -> tuple[float, float]:
-    """Largest centre-of-mass distance (mm) and rotation (deg) of a moving bone between two pose arrays."""
-    dx = dr = 0.0
-    for k in MOVING:
-        ca = np.einsum("fij,j->fi", a[:, k, :3, :3], com0[k]) + a[:, k, :3, 3]
-        cb = np.einsum("fij,j->fi", b[:, k, :3, :3], com0[k]) + b[:, k, :3, 3]
-        dx = max(dx, float(np.linalg.norm(ca - cb, axis=1).max()))
-        cos = (np.einsum("fij,fij->f", a[:, k, :3, :3], b[:, k, :3, :3]) - 1.0) / 2.0
-        dr = max(dr, float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))).max()))
-    return dx, dr
+def largest_distance(a: np.ndarray, b: np.ndarray, com0: np.ndarray) -> tuple[float, float]:
+    """Largest centre-of-mass distance (mm) and rotation (deg) of a moving bone over the frames."""
+    d = distance(a, b, com0).max(axis=0)
+    return float(d[0]), float(d[1])
 
 
 def drivers(name: str, model):
@@ -93,12 +85,12 @@ def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int) -
     for motion, driver in drivers(name, model).items():
         runs = simulate_batch(model, designs, driver, settings)
         both = [i for i, r in enumerate(runs) if r.ok and ref[motion + "_ok"][i]]
-        d = np.array([distance(runs[i].poses, ref[motion][i], model.com) for i in both])
+        d = np.array([largest_distance(runs[i].poses, ref[motion][i], model.com) for i in both])
         within = np.mean((d[:, 0] <= TOLERANCE[0]) & (d[:, 1] <= TOLERANCE[1]))
         steps = np.array([r.steps.sum() for r in runs])
         capped = sum(int(np.sum(r.steps[1:] >= settings.ramp_steps + settings.max_hold_steps)) for r in runs)
         frames = sum(len(r.steps) - 1 for r in runs)
-        pop = distance(runs[0].poses, ref[motion][0], model.com)
+        pop = largest_distance(runs[0].poses, ref[motion][0], model.com)
         print(
             f"{name} {motion}: {steps[0]} steps (population), {steps.mean():.0f} mean; "
             f"{capped}/{frames} frames ran out of hold steps; failed {sum(not r.ok for r in runs)} "

@@ -18,20 +18,21 @@ from numba import njit
 from scipy.optimize import least_squares
 
 from wrist_env.design import ALL_LIGAMENT_NAMES, Design
-from wrist_env.model import BONES, Model
+from wrist_env.model import Model
 from wrist_env.solver import arrays, kernel
 from wrist_env.solver.kernel import CAPITATE, LEVER_MM, LUNATE, SCAPHOID
 from wrist_env.solver.rigid import rotate_in_place
+from wrist_env.solver.simulate import prepare
 
 JACOBIAN_STEP = 1e-6  # finite-difference step of the Jacobian (rad, mm)
 MAX_EVALUATIONS = 60  # residual evaluations per frame (each with a Jacobian): where contact stalls it, stop
 
 
 @njit(cache=True, error_model="numpy")
-def _residual(q, R0, x0, nodes0, free_nodes, bod, grids, law, fib, stiffness, mem, st, load, out):
-    """Net forces (N) and moments / LEVER_MM (N) on the unknowns at the state moved by q: rotation
-    vectors (rad) and shifts (mm) of the scaphoid and lunate, the capitate's shift (loaded driver),
-    the free nodes' shifts (mm)."""
+def moved_state(q, R0, x0, nodes0, free_nodes, loaded):
+    """Rotations, centres of mass (mm) and membrane nodes (mm) of the state (R0, x0, nodes0) moved by
+    the unknowns q: rotation vectors (rad) and shifts (mm) of the scaphoid and lunate, the capitate's
+    shift if `loaded`, the free nodes' shifts (mm)."""
     R = R0.copy()
     x = x0.copy()
     nodes = nodes0.copy()
@@ -41,7 +42,6 @@ def _residual(q, R0, x0, nodes0, free_nodes, bod, grids, law, fib, stiffness, me
         for i in range(3):
             x[b, i] += q[k + 3 + i]
         k += 6
-    loaded = st.driver == arrays.LOADED
     if loaded:
         for i in range(3):
             x[CAPITATE, i] += q[k + i]
@@ -50,6 +50,14 @@ def _residual(q, R0, x0, nodes0, free_nodes, bod, grids, law, fib, stiffness, me
         for i in range(3):
             nodes[n, i] += q[k + i]
         k += 3
+    return R, x, nodes
+
+
+@njit(cache=True, error_model="numpy")
+def _residual(q, R0, x0, nodes0, free_nodes, bod, grids, law, fib, stiffness, mem, st, load, out):
+    """Net forces (N) and moments / LEVER_MM (N) on the unknowns (`moved_state`) at the state moved by q."""
+    loaded = st.driver == arrays.LOADED
+    R, x, nodes = moved_state(q, R0, x0, nodes0, free_nodes, loaded)
     n_bones = R.shape[0]
     state = kernel.State(R, x, np.zeros((n_bones, 3)), np.zeros((n_bones, 3)), nodes, np.zeros_like(nodes))
     work = kernel.Work(
@@ -114,10 +122,21 @@ class Equilibrium:
     distance: np.ndarray
 
 
+def distance(a: np.ndarray, b: np.ndarray, com0: np.ndarray) -> np.ndarray:
+    """Per frame, the largest centre-of-mass distance (mm) and rotation (deg) of a moving bone
+    (scaphoid, lunate, capitate) between two pose arrays (n_frames, 5, 4, 4); shape (n_frames, 2)."""
+    out = np.zeros((len(a), 2))
+    for k in (SCAPHOID, LUNATE, CAPITATE):
+        ca = np.einsum("fij,j->fi", a[:, k, :3, :3], com0[k]) + a[:, k, :3, 3]
+        cb = np.einsum("fij,j->fi", b[:, k, :3, :3], com0[k]) + b[:, k, :3, 3]
+        cos = (np.einsum("fij,fij->f", a[:, k, :3, :3], b[:, k, :3, :3]) - 1.0) / 2.0
+        out[:, 0] = np.maximum(out[:, 0], np.linalg.norm(ca - cb, axis=1))
+        out[:, 1] = np.maximum(out[:, 1], np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
+    return out
+
+
 def nearest(model: Model, design: Design, driver, result, settings: arrays.SolverSettings | None = None) -> Equilibrium:
     """The equilibrium nearest each frame of `result` (a successful `simulate(model, design, driver)`)."""
-    from wrist_env.solver.simulate import prepare
-
     if not result.ok:
         raise ValueError(f"the run failed ({result.message}); there is no state to start from")
     p = prepare(model, settings, driver.mode)
@@ -125,11 +144,10 @@ def nearest(model: Model, design: Design, driver, result, settings: arrays.Solve
     stiffness = kernel.Stiffness(f_l0, f_K, m_l0, m_K)
     free_nodes = np.flatnonzero(np.asarray(model.membrane_bone) < 0).astype(np.int64)
     n_unknown = 12 + (3 if driver.mode == arrays.LOADED else 0) + 3 * len(free_nodes)
+    loaded = driver.mode == arrays.LOADED
     com0 = model.com
-    moving = [BONES.index(b) for b in ("scaphoid", "lunate", "capitate")]
     poses = result.poses.copy()
     residual = np.zeros((driver.n_frames, 2))
-    distance = np.zeros((driver.n_frames, 2))
     out = np.zeros(n_unknown)
     for f in range(driver.n_frames):
         R0 = np.ascontiguousarray(result.poses[f, :, :3, :3])
@@ -149,19 +167,11 @@ def nearest(model: Model, design: Design, driver, result, settings: arrays.Solve
             fun, np.zeros(n_unknown), jac=jac, method="lm", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=MAX_EVALUATIONS
         ).x
         r = fun(q)
-        R = R0.copy()
-        x = x0.copy()
-        for i, b in enumerate((SCAPHOID, LUNATE)):
-            rotate_in_place(R[b], *q[6 * i : 6 * i + 3])
-            x[b] += q[6 * i + 3 : 6 * i + 6]
-        if driver.mode == arrays.LOADED:
-            x[CAPITATE] += q[12:15]
+        R, x, _ = moved_state(q, R0, x0, nodes0, free_nodes, loaded)
         poses[f, :, :3, :3] = R
         poses[f, :, :3, 3] = x - np.einsum("bij,bj->bi", R, com0)
         residual[f] = (
             max(np.linalg.norm(r[0:3]), np.linalg.norm(r[6:9])),
             LEVER_MM * max(np.linalg.norm(r[3:6]), np.linalg.norm(r[9:12])),
         )
-        distance[f, 0] = max(np.linalg.norm(x[b] - x0[b]) for b in moving)
-        distance[f, 1] = max(np.degrees(np.arccos(np.clip((np.trace(R[b] @ R0[b].T) - 1) / 2, -1, 1))) for b in moving)
-    return Equilibrium(poses, residual, distance)
+    return Equilibrium(poses, residual, distance(result.poses, poses, com0))
