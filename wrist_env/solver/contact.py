@@ -94,15 +94,6 @@ def sdf_lookup_smooth(values, gradient, offset, shape, origin, spacing, qx, qy, 
     return d, gx, gy, gz
 
 
-@njit(cache=True, error_model="numpy", inline="always")
-def sdf_lookup_normal(values, gradient, offset, shape, origin, spacing, qx, qy, qz, smooth):
-    """Signed distance (mm) and contact normal direction (unnormalized) at local point q:
-    `sdf_lookup_smooth` if `smooth`, else `sdf_lookup_scalar`."""
-    if smooth:
-        return sdf_lookup_smooth(values, gradient, offset, shape, origin, spacing, qx, qy, qz)
-    return sdf_lookup_scalar(values, offset, shape, origin, spacing, qx, qy, qz)
-
-
 def nodal_gradients(values, offsets, shape, spacing):
     """Central-difference gradients (n, 3) float32 at every node of the flattened grids (one-sided at the borders)."""
     out = np.zeros((len(values), 3), np.float32)

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from wrist_env.solver.contact import law_energy, law_pressure, sdf_lookup_normal
+from wrist_env.solver.contact import law_energy, law_pressure, sdf_lookup_scalar, sdf_lookup_smooth
 from wrist_env.solver.ligaments import blankevoort_energy, blankevoort_force
 
 # columns of the per-pair contact statistics the force kernels accumulate
@@ -91,26 +91,34 @@ def pair_transform(R, x, com0, a, b):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _lookup(grids, b, M, s, smooth=False):
-    """Signed distance (mm), normal (`contact.sdf_lookup_normal`) and position (b's neutral frame)
-    of sample s under the pair transform M."""
+def _moved(grids, M, s):
+    """Sample s's position under the pair transform M (12 scalars), in the grid bone's neutral frame."""
     m00, m01, m02, m10, m11, m12, m20, m21, m22, tx, ty, tz = M
     p = grids.points
     px, py, pz = p[s, 0], p[s, 1], p[s, 2]
-    qx = m00 * px + m01 * py + m02 * pz + tx
-    qy = m10 * px + m11 * py + m12 * pz + ty
-    qz = m20 * px + m21 * py + m22 * pz + tz
-    d, gx, gy, gz = sdf_lookup_normal(
-        grids.values,
-        grids.gradient,
-        grids.offsets[b],
-        grids.shape[b],
-        grids.origin[b],
-        grids.spacing[b],
-        qx,
-        qy,
-        qz,
-        smooth,
+    return (
+        m00 * px + m01 * py + m02 * pz + tx,
+        m10 * px + m11 * py + m12 * pz + ty,
+        m20 * px + m21 * py + m22 * pz + tz,
+    )
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _lookup(grids, b, M, s):
+    """Signed distance (mm), gradient and position (b's neutral frame) of sample s under the pair transform M."""
+    qx, qy, qz = _moved(grids, M, s)
+    d, gx, gy, gz = sdf_lookup_scalar(
+        grids.values, grids.offsets[b], grids.shape[b], grids.origin[b], grids.spacing[b], qx, qy, qz
+    )
+    return d, gx, gy, gz, qx, qy, qz
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _lookup_smooth(grids, b, M, s):
+    """As `_lookup`, with the gradient interpolated from the grid's nodal gradients."""
+    qx, qy, qz = _moved(grids, M, s)
+    d, gx, gy, gz = sdf_lookup_smooth(
+        grids.values, grids.gradient, grids.offsets[b], grids.shape[b], grids.origin[b], grids.spacing[b], qx, qy, qz
     )
     return d, gx, gy, gz, qx, qy, qz
 
@@ -159,7 +167,10 @@ def contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, want_e
         force = area_sum = peak = 0.0
         for j in range(n_active[p]):
             s = active[start + j]
-            d, gx, gy, gz, qx, qy, qz = _lookup(grids, b, M, s, smooth)
+            if smooth:
+                d, gx, gy, gz, qx, qy, qz = _lookup_smooth(grids, b, M, s)
+            else:
+                d, gx, gy, gz, qx, qy, qz = _lookup(grids, b, M, s)
             if d >= 0.0:
                 continue
             gn = np.sqrt(gx * gx + gy * gy + gz * gz)
@@ -301,18 +312,22 @@ def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node
         if mem.bone[i] >= 0:
             continue
         qx, qy, qz = to_local(R, x, com0, s, nodes[i, 0], nodes[i, 1], nodes[i, 2])
-        d, gx, gy, gz = sdf_lookup_normal(
-            mem.grid_values,
-            mem.grid_gradient,
-            mem.grid_offset,
-            mem.grid_shape,
-            mem.grid_origin,
-            mem.grid_spacing,
-            qx,
-            qy,
-            qz,
-            smooth,
-        )
+        if smooth:
+            d, gx, gy, gz = sdf_lookup_smooth(
+                mem.grid_values,
+                mem.grid_gradient,
+                mem.grid_offset,
+                mem.grid_shape,
+                mem.grid_origin,
+                mem.grid_spacing,
+                qx,
+                qy,
+                qz,
+            )
+        else:
+            d, gx, gy, gz = sdf_lookup_scalar(
+                mem.grid_values, mem.grid_offset, mem.grid_shape, mem.grid_origin, mem.grid_spacing, qx, qy, qz
+            )
         if d < 0.0:
             gn = np.sqrt(gx * gx + gy * gy + gz * gz)
             if gn > 1e-12:
