@@ -60,8 +60,8 @@ class SolverSettings:
     ramp_steps: int = 60
     min_hold_steps: int = 10
     max_hold_steps: int = 400
-    tolerance: float = 0.005
-    force_floor_n: float = 0.05
+    tolerance: float = 0.001
+    force_floor_n: float = 0.01
     damping_per_s: float = 100.0
     rot_damping_per_s: float = 100.0
     fibre_damping_s: float = 2e-4
@@ -74,7 +74,7 @@ class SolverSettings:
     max_disp_mm: float = 15.0
     max_rot_deg: float = 75.0
     fire_alpha0: float = 0.1
-    smooth_normals: bool = False
+    smooth_normals: bool = True
 
     def halved(self) -> "SolverSettings":
         """The same run with half the time step (twice the steps)."""
