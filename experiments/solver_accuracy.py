@@ -16,7 +16,7 @@ answer to the equilibrium nearest it, and the net force left there.
 Run: `python experiments/solver_accuracy.py [P1 P2 P3] [--designs 100] [--newton 3] [--set dt_s=9e-5 ...]`
 (--set changes the settings under test; the reference stays the default's, with the same
 `smooth_normals`, which changes the answer, not only the path to it).
-References are cached in runs/solver_accuracy/ (delete to recompute).
+References are cached in runs/solver_accuracy/ under a hash of their settings.
 Reference runs take ~2 min per participant for 100 designs on 2 cores.
 """
 
@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import argparse
 import ast
+import hashlib
 from dataclasses import replace
 from pathlib import Path
 
@@ -64,13 +65,14 @@ def drivers(name: str, model):
 
 
 def reference(name: str, model, designs, base: SolverSettings) -> dict[str, np.ndarray]:
-    physics = "_smooth_normals" if base.smooth_normals else ""  # the one setting that changes the answer
-    path = CACHE / f"{name}_{len(designs) - 1}{physics}.npz"
+    settings = reference_settings(base)
+    key = hashlib.sha1(repr(settings).encode()).hexdigest()[:8]  # a new default gets a new reference
+    path = CACHE / f"{name}_{len(designs) - 1}_{key}.npz"
     if path.exists():
         return dict(np.load(path))
     out = {}
     for motion, driver in drivers(name, model).items():
-        runs = simulate_batch(model, designs, driver, reference_settings(base))
+        runs = simulate_batch(model, designs, driver, settings)
         out[motion] = np.stack([r.poses for r in runs])
         out[motion + "_ok"] = np.array([r.ok for r in runs])
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -7,7 +7,7 @@ import numpy as np
 from wrist_env import design
 from wrist_env.participants import registry
 from wrist_env.solver.arrays import SolverSettings
-from wrist_env.solver.contact import nodal_gradients, sdf_lookup_scalar, sdf_lookup_smooth
+from wrist_env.solver.contact import nodal_normals, sdf_lookup_scalar, sdf_lookup_smooth
 from wrist_env.solver.equilibrium import nearest
 from wrist_env.solver.simulate import experimental, simulate
 
@@ -26,14 +26,14 @@ def sphere_grid(radius=4.0):
 def test_smooth_gradient_is_the_sphere_normal_and_continuous_across_a_cell_face():
     """On a sphere's distance grid, the interpolated nodal gradient is the sphere's normal within 1°
     and changes by < 0.001° across a cell face, where the trilinear derivative jumps by 0.23°."""
-    values = sphere_grid()
-    gradient = nodal_gradients(values, np.array([0, len(values)]), SHAPE[None], np.array([SPACING]))
+    values = sphere_grid(radius=5.0)  # the probe (4.0, 1.1, 0.7) overcloses it by 0.8 mm
+    normals = nodal_normals(values, np.array([0, len(values)]), SHAPE[None], np.array([SPACING]))
     face = ORIGIN[0] + SPACING * 20  # the x-face between cells 19 and 20 (x = 4.0 mm)
     eps = 1e-7
 
     def normal(lookup, x, y=1.1, z=0.7):
         if lookup is sdf_lookup_smooth:
-            d, gx, gy, gz = sdf_lookup_smooth(values, gradient, 0, SHAPE, ORIGIN, SPACING, x, y, z)
+            d, gx, gy, gz = sdf_lookup_smooth(values, normals, 0, SHAPE, ORIGIN, SPACING, x, y, z)
         else:
             d, gx, gy, gz = sdf_lookup_scalar(values, 0, SHAPE, ORIGIN, SPACING, x, y, z)
         g = np.array([gx, gy, gz])

@@ -6,6 +6,7 @@ plain records). Nothing here runs in a hot loop.
 
 from __future__ import annotations
 
+import weakref
 from collections import namedtuple
 from dataclasses import dataclass
 
@@ -13,17 +14,17 @@ import numpy as np
 
 from wrist_env.design import RSC_INDEX, Design, ligament_arrays
 from wrist_env.model import BONES, PAIR_BONES, Model
-from wrist_env.solver.contact import nodal_gradients
+from wrist_env.solver.contact import nodal_normals
 
 Bodies = namedtuple("Bodies", "com0 inv_mass inv_inertia mass inertia")
 Grids = namedtuple(
-    "Grids", "pair_bones sample_offsets points thickness area values offsets shape origin spacing gradient"
+    "Grids", "pair_bones sample_offsets points thickness area values offsets shape origin spacing normals"
 )
 Fibres = namedtuple("Fibres", "bones origin insertion ligament rest_length")
 Membrane = namedtuple(
     "Membrane",
     "connectors kind first_row bone rest scaphoid grid_values grid_offset grid_shape grid_origin grid_spacing rest_length "
-    "grid_gradient",
+    "grid_normals",
 )
 Settings = namedtuple(
     "Settings",
@@ -99,13 +100,25 @@ def bodies(model: Model, s: SolverSettings) -> Bodies:
     return Bodies(np.ascontiguousarray(model.com), inv_mass, inv_inertia, mass, inertia)
 
 
+_NORMALS: dict[int, tuple[weakref.ref, np.ndarray]] = {}
+
+
+def _normals(model: Model) -> np.ndarray:
+    """`contact.nodal_normals` of the model's grids, computed once per model object."""
+    key = id(model)
+    cached = _NORMALS.get(key)
+    if cached is not None and cached[0]() is model:
+        return cached[1]
+    normals = nodal_normals(model.grid_values, model.grid_offsets, model.grid_shape, model.grid_spacing)
+    normals.setflags(write=False)
+    _NORMALS[key] = (weakref.ref(model, lambda _, key=key: _NORMALS.pop(key, None)), normals)
+    return normals
+
+
 def grids(model: Model, smooth_normals: bool = False) -> Grids:
-    """The contact arrays; with `smooth_normals` the grids' nodal gradients too (else an empty (0, 3))."""
-    gradient = (
-        nodal_gradients(model.grid_values, model.grid_offsets, model.grid_shape, model.grid_spacing)
-        if smooth_normals
-        else np.zeros((0, 3), np.float32)
-    )
+    """The contact arrays; with `smooth_normals` the grids' nodal normals
+    (`contact.nodal_normals`, (n, 4)) too, else an empty (0, 4)."""
+    normals = _normals(model) if smooth_normals else np.zeros((0, 4), np.int8)
     return Grids(
         np.ascontiguousarray(PAIR_BONES, dtype=np.int64),
         np.ascontiguousarray(model.sample_offsets, dtype=np.int64),
@@ -117,7 +130,7 @@ def grids(model: Model, smooth_normals: bool = False) -> Grids:
         np.ascontiguousarray(model.grid_shape, dtype=np.int64),
         np.ascontiguousarray(model.grid_origin, dtype=np.float64),
         np.ascontiguousarray(model.grid_spacing, dtype=np.float64),
-        gradient,
+        normals,
     )
 
 
@@ -150,7 +163,7 @@ def membrane(model: Model, grd: Grids) -> Membrane:
         np.ascontiguousarray(model.grid_origin[s]),
         float(model.grid_spacing[s]),
         np.ascontiguousarray(model.membrane_length),
-        grd.gradient,
+        grd.normals,
     )
 
 

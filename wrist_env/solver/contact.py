@@ -72,38 +72,51 @@ def sdf_lookup_scalar(values, offset, shape, origin, spacing, qx, qy, qz):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def sdf_lookup_smooth(values, gradient, offset, shape, origin, spacing, qx, qy, qz):
-    """As `sdf_lookup_scalar`, but the gradient interpolated trilinearly from the grid's
-    nodal gradients `gradient` (n, 3) (continuous across cells, unlike the derivative of
-    the trilinear distance, which jumps at cell faces)."""
+def sdf_lookup_smooth(values, normals, offset, shape, origin, spacing, qx, qy, qz):
+    """Trilinear signed distance (mm) at local point q and, where it is negative (overclosure),
+    the direction interpolated trilinearly from `nodal_normals` (continuous across cells, unlike
+    the derivative of the trilinear distance, which jumps at cell faces; zeros where d >= 0)."""
     inside, base, sx, sy, tx, ty, tz, inv = _cell(offset, shape, origin, spacing, qx, qy, qz)
     if not inside:
         return OUTSIDE_MM, 0.0, 0.0, 0.0
-    d = gx = gy = gz = 0.0
+    c00 = values[base] + (values[base + 1] - values[base]) * tz
+    c01 = values[base + sy] + (values[base + sy + 1] - values[base + sy]) * tz
+    c10 = values[base + sx] + (values[base + sx + 1] - values[base + sx]) * tz
+    c11 = values[base + sx + sy] + (values[base + sx + sy + 1] - values[base + sx + sy]) * tz
+    c0 = c00 + (c01 - c00) * ty
+    c1 = c10 + (c11 - c10) * ty
+    d = c0 + (c1 - c0) * tx
+    if d >= 0.0:
+        return d, 0.0, 0.0, 0.0
+    gx = gy = gz = 0.0
     for di in range(2):
         wx = tx if di else 1.0 - tx
         for dj in range(2):
-            wy = ty if dj else 1.0 - ty
-            for dk in range(2):
-                wgt = wx * wy * (tz if dk else 1.0 - tz)
-                n = base + di * sx + dj * sy + dk
-                d += wgt * values[n]
-                gx += wgt * gradient[n, 0]
-                gy += wgt * gradient[n, 1]
-                gz += wgt * gradient[n, 2]
+            wy = wx * (ty if dj else 1.0 - ty)
+            n = base + di * sx + dj * sy
+            gx += wy * ((1.0 - tz) * normals[n, 0] + tz * normals[n + 1, 0])
+            gy += wy * ((1.0 - tz) * normals[n, 1] + tz * normals[n + 1, 1])
+            gz += wy * ((1.0 - tz) * normals[n, 2] + tz * normals[n + 1, 2])
     return d, gx, gy, gz
 
 
-def nodal_gradients(values, offsets, shape, spacing):
-    """Central-difference gradients (n, 3) float32 at every node of the flattened grids (one-sided at the borders)."""
-    out = np.zeros((len(values), 3), np.float32)
+NORMAL_SCALE = 127.0  # unit normals stored as int8 components
+
+
+def nodal_normals(values, offsets, shape, spacing):
+    """Unit direction of the central-difference gradient (one-sided at the borders) at every node of
+    the flattened grids, as int8 components × 127 in rows of 4 (n, 4) (the fourth 0): a 0.5° quantization,
+    4 bytes a node so the look-ups stay in cache; only the direction of a contact force is taken from it."""
+    out = np.zeros((len(values), 4), np.int8)
     for b in range(len(shape)):
         n = int(np.prod(shape[b]))
         if n == 0 or np.min(shape[b]) < 2:
             continue
         grid = np.asarray(values[offsets[b] : offsets[b] + n], np.float64).reshape(tuple(shape[b]))
-        g = np.gradient(grid, float(spacing[b]))
-        out[offsets[b] : offsets[b] + n] = np.stack([c.ravel() for c in g], axis=1)
+        g = np.stack([c.ravel() for c in np.gradient(grid, float(spacing[b]))], axis=1)
+        norm = np.linalg.norm(g, axis=1, keepdims=True)
+        unit = np.divide(g, norm, out=np.zeros_like(g), where=norm > 0)
+        out[offsets[b] : offsets[b] + n, :3] = np.rint(unit * NORMAL_SCALE).astype(np.int8)
     return out
 
 

@@ -115,10 +115,10 @@ def _lookup(grids, b, M, s):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _lookup_smooth(grids, b, M, s):
-    """As `_lookup`, with the gradient interpolated from the grid's nodal gradients."""
+    """As `_lookup`, with the direction interpolated from the grid's nodal normals where d < 0."""
     qx, qy, qz = _moved(grids, M, s)
     d, gx, gy, gz = sdf_lookup_smooth(
-        grids.values, grids.gradient, grids.offsets[b], grids.shape[b], grids.origin[b], grids.spacing[b], qx, qy, qz
+        grids.values, grids.normals, grids.offsets[b], grids.shape[b], grids.origin[b], grids.spacing[b], qx, qy, qz
     )
     return d, gx, gy, gz, qx, qy, qz
 
@@ -315,7 +315,7 @@ def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node
         if smooth:
             d, gx, gy, gz = sdf_lookup_smooth(
                 mem.grid_values,
-                mem.grid_gradient,
+                mem.grid_normals,
                 mem.grid_offset,
                 mem.grid_shape,
                 mem.grid_origin,
