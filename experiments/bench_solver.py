@@ -28,8 +28,7 @@ from wrist_env import design
 from wrist_env.participants import registry
 from wrist_env.participants.registry import load_model
 from wrist_env.solver import arrays
-from wrist_env.solver.contact import sdf_lookup_scalar
-from wrist_env.solver.forces import pair_transform, rebuild_active
+from wrist_env.solver.forces import pair_transform, rebuild_active, sample_lookup, sample_lookup_smooth
 from wrist_env.solver.simulate import experimental, idealized, simulate, simulate_batch
 
 PREPRINT_SECONDS = 45.0
@@ -58,27 +57,22 @@ def monte_carlo_designs(n: int, seed: int = 0):
 
 
 @njit(cache=True, error_model="numpy")
-def bare_lookups(repeats, R, x, com0, grids, active, n_active):
-    """Only the signed-distance look-ups of `repeats` steps' active samples (the sum keeps them live)."""
+def bare_lookups(repeats, R, x, com0, grids, active, n_active, smooth):
+    """Only the signed-distance look-ups of `repeats` steps' active samples, as the solver does them
+    (with `smooth`, the nodal-normal look-up); the sum keeps them live."""
     total = 0.0
     for _ in range(repeats):
         for p in range(grids.pair_bones.shape[0]):
             a, b = grids.pair_bones[p, 0], grids.pair_bones[p, 1]
-            m00, m01, m02, m10, m11, m12, m20, m21, m22, tx, ty, tz = pair_transform(R, x, com0, a, b)
+            M = pair_transform(R, x, com0, a, b)
             start = grids.sample_offsets[p]
             for j in range(n_active[p]):
                 s = active[start + j]
-                px, py, pz = grids.points[s, 0], grids.points[s, 1], grids.points[s, 2]
-                total += sdf_lookup_scalar(
-                    grids.values,
-                    grids.offsets[b],
-                    grids.shape[b],
-                    grids.origin[b],
-                    grids.spacing[b],
-                    m00 * px + m01 * py + m02 * pz + tx,
-                    m10 * px + m11 * py + m12 * pz + ty,
-                    m20 * px + m21 * py + m22 * pz + tz,
-                )[0]
+                if smooth:
+                    d, gx, _, _, _, _, _ = sample_lookup_smooth(grids, b, M, s)
+                else:
+                    d, gx, _, _, _, _, _ = sample_lookup(grids, b, M, s)
+                total += d + gx
     return total
 
 
@@ -89,12 +83,15 @@ def efficiency(model, steps_per_sim: float, seconds_per_sim: float) -> tuple[flo
     pose = settled.poses[-1]
     R = np.ascontiguousarray(pose[:, :3, :3])
     x = np.ascontiguousarray(np.einsum("bij,bj->bi", R, model.com) + pose[:, :3, 3])
-    grids = arrays.grids(model)
+    grids = arrays.grids(model, s.smooth_normals)
     active = np.zeros(len(grids.points), np.int64)
     n_active = np.zeros(len(grids.pair_bones), np.int64)
     rebuild_active(R, x, model.com, grids, s.active_band_mm, active, n_active)
     repeats = 2000
-    per_step = median_seconds(lambda: bare_lookups(repeats, R, x, model.com, grids, active, n_active), 5) / repeats
+    per_step = (
+        median_seconds(lambda: bare_lookups(repeats, R, x, model.com, grids, active, n_active, s.smooth_normals), 5)
+        / repeats
+    )
     per_step *= 1.0 + len(grids.points) / (s.rebuild_every * n_active.sum())  # amortized rebuilds
     return per_step * 1e6, seconds_per_sim / steps_per_sim * 1e6, int(n_active.sum())
 

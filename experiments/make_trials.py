@@ -11,7 +11,8 @@ transforms per bone per frame (RCS, mm):
    40 N resisted; grip clenches from 10 N to 60 N / 120 N);
 2. the scaphoid and lunate come from a higher-fidelity run of the model —
    finer contact sampling (0.7 mm instead of 1.0 mm), half the time step,
-   a five times tighter equilibrium tolerance — with the participant's
+   a ten times tighter equilibrium tolerance and force floor, holds up to
+   6,400 steps — with the participant's
    hidden true ligament properties (`builtin.truth`);
 3. every carpal bone gets 4DCT-like tracking noise: a rigid perturbation
    about its centroid, 0.2 mm and 0.5° RMS.

@@ -90,7 +90,10 @@ def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int) -
         d = np.array([largest_distance(runs[i].poses, ref[motion][i], model.com) for i in both])
         within = np.mean((d[:, 0] <= TOLERANCE[0]) & (d[:, 1] <= TOLERANCE[1]))
         steps = np.array([r.steps.sum() for r in runs])
-        capped = sum(int(np.sum(r.steps[1:] >= settings.ramp_steps + settings.max_hold_steps)) for r in runs)
+        capped_frames = [int(np.sum(r.steps[1:] >= settings.ramp_steps + settings.max_hold_steps)) for r in runs]
+        capped = sum(capped_frames)
+        settled = np.array([capped_frames[i] == 0 for i in both])
+        close = (d[:, 0] <= TOLERANCE[0]) & (d[:, 1] <= TOLERANCE[1])
         frames = sum(len(r.steps) - 1 for r in runs)
         pop = largest_distance(runs[0].poses, ref[motion][0], model.com)
         print(
@@ -100,7 +103,10 @@ def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int) -
             f"  from the reference: population {pop[0]:.3f} mm {pop[1]:.2f}°; designs median "
             f"{np.median(d[:, 0]):.3f} mm {np.median(d[:, 1]):.2f}°, 95th pct {np.percentile(d[:, 0], 95):.3f} mm "
             f"{np.percentile(d[:, 1], 95):.2f}°, max {d[:, 0].max():.3f} mm {d[:, 1].max():.2f}°; "
-            f"within 0.1 mm and 0.5°: {100 * within:.0f} %"
+            f"within 0.1 mm and 0.5°: {100 * within:.0f} %\n"
+            f"  designs with every frame settled: {100 * np.mean(close[settled]):.0f} % of {settled.sum()} within; "
+            f"with a frame out of hold steps: {100 * np.mean(close[~settled]) if (~settled).any() else 0:.0f} % "
+            f"of {(~settled).sum()}"
         )
         for i in tqdm(range(min(n_newton, len(runs))), desc=f"{name} {motion} Newton", leave=False):
             if not runs[i].ok:

@@ -85,12 +85,16 @@ def test_freeze_wrapper_keeps_ligaments_intact():
 def test_a_failed_run_gives_the_same_nan_free_info_single_and_vectorized():
     """Failed runs (dislocated random designs) report zeros, never NaN or None, in the single env and
     in the vector env, whether the batch's first run failed or a later one."""
-    rng = np.random.default_rng(11)
-    actions = rng.uniform(-1, 1, (64, 27))[[0, 21, 34, 1]]  # ok, failed, failed, ok (Idealized P1)
+    pool = np.random.default_rng(11).uniform(-1, 1, (64, 27))
     single = gym.make("wrist_env/Idealized-P1-v0")
     single.reset(seed=0)
-    infos = [single.step(a)[4] for a in actions]
-    assert [i["failed"] for i in infos] == [False, True, True, False]
+    pool_infos = [single.step(a)[4] for a in pool]
+    failed = [i for i, info in enumerate(pool_infos) if info["failed"]]
+    ok = [i for i, info in enumerate(pool_infos) if not info["failed"]]
+    assert len(failed) >= 2 and len(ok) >= 2, failed
+    pick = [ok[0], failed[0], failed[1], ok[1]]
+    actions = pool[pick]
+    infos = [pool_infos[i] for i in pick]
     for order in ([0, 1, 2, 3], [1, 0, 2, 3]):
         vec = gym.make_vec("wrist_env/Idealized-P1-v0", num_envs=4, vectorization_mode="vector_entry_point")
         vec.reset(seed=0)

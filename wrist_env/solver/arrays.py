@@ -60,7 +60,7 @@ class SolverSettings:
     move_steps: int = 200
     ramp_steps: int = 60
     min_hold_steps: int = 10
-    max_hold_steps: int = 400
+    max_hold_steps: int = 1600
     tolerance: float = 0.001
     force_floor_n: float = 0.01
     damping_per_s: float = 100.0

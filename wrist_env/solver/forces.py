@@ -104,7 +104,7 @@ def _moved(grids, M, s):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _lookup(grids, b, M, s):
+def sample_lookup(grids, b, M, s):
     """Signed distance (mm), gradient and position (b's neutral frame) of sample s under the pair transform M."""
     qx, qy, qz = _moved(grids, M, s)
     d, gx, gy, gz = sdf_lookup_scalar(
@@ -114,8 +114,8 @@ def _lookup(grids, b, M, s):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _lookup_smooth(grids, b, M, s):
-    """As `_lookup`, with the direction interpolated from the grid's nodal normals where d < 0."""
+def sample_lookup_smooth(grids, b, M, s):
+    """As `sample_lookup`, with the direction interpolated from the grid's nodal normals where d < 0."""
     qx, qy, qz = _moved(grids, M, s)
     d, gx, gy, gz = sdf_lookup_smooth(
         grids.values, grids.normals, grids.offsets[b], grids.shape[b], grids.origin[b], grids.spacing[b], qx, qy, qz
@@ -132,7 +132,7 @@ def rebuild_active(R, x, com0, grids, band_mm, active, n_active):
         n = 0
         start = grids.sample_offsets[p]
         for s in range(start, grids.sample_offsets[p + 1]):
-            if _lookup(grids, b, M, s)[0] < band_mm:
+            if sample_lookup(grids, b, M, s)[0] < band_mm:
                 active[start + n] = s
                 n += 1
         n_active[p] = n
@@ -145,7 +145,7 @@ def sample_pressures(R, x, com0, grids, law, pressure):
         a, b = grids.pair_bones[p, 0], grids.pair_bones[p, 1]
         M = pair_transform(R, x, com0, a, b)
         for s in range(grids.sample_offsets[p], grids.sample_offsets[p + 1]):
-            d = _lookup(grids, b, M, s)[0]
+            d = sample_lookup(grids, b, M, s)[0]
             pressure[s] = law_pressure(law, -d / grids.thickness[s]) if d < 0.0 else 0.0
 
 
@@ -168,9 +168,9 @@ def contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, want_e
         for j in range(n_active[p]):
             s = active[start + j]
             if smooth:
-                d, gx, gy, gz, qx, qy, qz = _lookup_smooth(grids, b, M, s)
+                d, gx, gy, gz, qx, qy, qz = sample_lookup_smooth(grids, b, M, s)
             else:
-                d, gx, gy, gz, qx, qy, qz = _lookup(grids, b, M, s)
+                d, gx, gy, gz, qx, qy, qz = sample_lookup(grids, b, M, s)
             if d >= 0.0:
                 continue
             gn = np.sqrt(gx * gx + gy * gy + gz * gz)
