@@ -1,4 +1,5 @@
-"""`wrist-bench` studies: calibrate, benchmark, leaderboard, iohanalyzer, montecarlo, montecarlo-report."""
+"""`wrist-bench` studies: calibrate, benchmark, leaderboard, iohanalyzer, montecarlo, montecarlo-report,
+sensitivity."""
 
 from __future__ import annotations
 
@@ -177,6 +178,27 @@ def _montecarlo_report(args) -> int:
     return 0
 
 
+def _sensitivity(args) -> int:
+    from wrist_env import sensitivity
+    from wrist_env.participants import registry
+
+    registry.require(*args.participants)
+    for participant in args.participants:
+        start = time.perf_counter()
+        table = sensitivity.study(participant, args.method, args.n, tuple(args.motions), args.seed, args.out)
+        key = "mu_star" if args.method == "morris" else "ST"
+        for motion, rows in table[table["output"] == "cost"].groupby("motion", sort=False):
+            top = rows.nlargest(5, key)
+            ranked = ", ".join(f"{m} {v:.3g}" for m, v in zip(top["material"], top[key]))
+            print(f"{participant} {motion}: cost {key} {ranked} ({rows['runs'].iloc[0]} runs)")
+        print(
+            f"{participant}: {args.out}/sensitivity_{participant}_{args.method}.csv and .png "
+            f"in {time.perf_counter() - start:.0f} s",
+            flush=True,
+        )
+    return 0
+
+
 def _run_log_arguments(s: argparse.ArgumentParser, *, out: str) -> None:
     """--runs (a benchmark run log) and --out (an output folder, default `out`) of a command that reads a log."""
     s.add_argument("--runs", default="runs/benchmark", help="run-log folder (default runs/benchmark)")
@@ -303,3 +325,25 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     s.add_argument("--out", default="runs/montecarlo-report", help="output folder (default runs/montecarlo-report)")
     s.add_argument("--max-runs", type=int, help="fit on a seeded random subset of this many runs (default: all)")
     s.set_defaults(run=_montecarlo_report)
+
+    s = command(
+        "sensitivity",
+        help="global sensitivity of the cost and the 12 DOF errors to the 22 materials (SALib)",
+        description="Morris screening (n trajectories, n x 23 runs per motion) or Sobol first and total "
+        "indices (Saltelli, base n a power of 2, n x 24 runs per motion) of the kinematic cost and the "
+        "scaphoid and lunate DOF errors to the 22 ligament materials over the action box (Table 2 mean "
+        "+-3 SD), injuries intact, simulated through the vector environment; a CSV and a PNG per participant.",
+    )
+    s.add_argument("participants", nargs="+", help="participant names (`wrist-bench participants` lists them)")
+    s.add_argument("--method", choices=("morris", "sobol"), default="morris", help="default morris")
+    s.add_argument("--n", type=int, default=20, help="Morris trajectories or Sobol base size (default 20)")
+    s.add_argument(
+        "--motions",
+        nargs="+",
+        choices=("calibrate", "validate", "idealized"),
+        default=["calibrate", "validate", "idealized"],
+        help="default: all three",
+    )
+    s.add_argument("--seed", type=int, default=0, help="sampling seed (default 0)")
+    s.add_argument("--out", default="runs/sensitivity", help="output folder (default runs/sensitivity)")
+    s.set_defaults(run=_sensitivity)
