@@ -229,6 +229,16 @@ def z_scores(design: Design) -> np.ndarray:
     return (design.vector[:N_MATERIAL] - MEAN[:N_MATERIAL]) / SD[:N_MATERIAL]
 
 
+def with_z(base: Design, z: ArrayLike) -> Design:
+    """`base` with its 22 materials at z (22,) Table 2 SD units from the mean (the inverse of `z_scores`)."""
+    z = np.asarray(z, dtype=np.float64)
+    if z.shape != (N_MATERIAL,):
+        raise DesignError(f"z must have shape ({N_MATERIAL},), but got {z.shape}.")
+    values = base.vector.copy()
+    values[:N_MATERIAL] = MEAN[:N_MATERIAL] + SD[:N_MATERIAL] * z
+    return Design.from_vector(values)
+
+
 def sample_materials(n: int, seed: int | None, *, truncate_sd: float = SPAN_SD) -> np.ndarray:
     """Normalized material actions of shape (n, 22) drawn from Table 2's normals truncated at ±`truncate_sd`."""
     from scipy.stats import truncnorm

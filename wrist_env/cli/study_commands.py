@@ -1,5 +1,5 @@
 """`wrist-bench` studies: calibrate, benchmark, leaderboard, iohanalyzer, montecarlo, montecarlo-report,
-sensitivity."""
+sensitivity, identifiability."""
 
 from __future__ import annotations
 
@@ -199,6 +199,27 @@ def _sensitivity(args) -> int:
     return 0
 
 
+def _identifiability(args) -> int:
+    from wrist_env import identifiability
+    from wrist_env.participants import builtin
+
+    unknown = [p for p in args.participants if p not in builtin.BUILTIN]
+    if unknown:
+        raise SystemExit(
+            f"wrist-bench identifiability: {unknown} have no hidden truth; built-ins: {list(builtin.BUILTIN)}"
+        )
+    materials, spectra = identifiability.study(args.participants, args.out)
+    for (participant, trials), rows in materials.groupby(["participant", "trials"], sort=False):
+        s = spectra[(spectra["participant"] == participant) & (spectra["trials"] == trials)]
+        pinned = rows[rows["posterior_sd"] < 0.5]["material"].tolist()
+        print(
+            f"{participant} {trials}: {int((s['sd'] < 1).sum())} of 22 directions pinned tighter than the prior; "
+            f"materials to < 0.5 SD: {', '.join(pinned) or 'none'}"
+        )
+    print(f"written to {args.out}")
+    return 0
+
+
 def _run_log_arguments(s: argparse.ArgumentParser, *, out: str) -> None:
     """--runs (a benchmark run log) and --out (an output folder, default `out`) of a command that reads a log."""
     s.add_argument("--runs", default="runs/benchmark", help="run-log folder (default runs/benchmark)")
@@ -347,3 +368,15 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     s.add_argument("--seed", type=int, default=0, help="sampling seed (default 0)")
     s.add_argument("--out", default="runs/sensitivity", help="output folder (default runs/sensitivity)")
     s.set_defaults(run=_sensitivity)
+
+    s = command(
+        "identifiability",
+        help="what the calibration and held-out trials identify at the hidden truth (Fisher matrix)",
+        description="The Gauss-Newton (Fisher) matrix of the per-frame scaphoid and lunate DOF residuals over "
+        "the 4DCT noise (0.2 mm, 0.5 deg), in Table 2 SD units, at each built-in participant's hidden truth "
+        "(central differences, 45 runs per trial): its spectrum and each material's posterior SD with the "
+        "population prior, for the calibration trial, the held-out trial and both; CSV and a PNG per participant.",
+    )
+    s.add_argument("participants", nargs="+", help="built-in participants (they have a hidden truth)")
+    s.add_argument("--out", default="runs/identifiability", help="output folder (default runs/identifiability)")
+    s.set_defaults(run=_identifiability)

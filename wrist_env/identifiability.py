@@ -1,0 +1,144 @@
+"""What a trial can identify: the Gauss–Newton (Fisher) matrix of the per-frame kinematic residuals
+at the hidden truth, in z units (Table 2 SD).
+
+The residuals of a design are the six-DOF errors (`frames.error_dof`, mm and deg) of the scaphoid
+and lunate at every frame, each divided by the 4DCT tracking noise of its DOF (0.2 mm, 0.5°, the
+noise of the synthetic trials). Their Jacobian J with respect to the 22 materials is taken by
+central differences at the truth (step 0.25 SD), simulated with a 10× tighter equilibrium
+tolerance than the default (`SETTINGS`; at the default the solver's residual moves make the
+differences step-dependent: 20 % between 0.25 and 0.125 SD on P1, 15 % with it). F = JᵀJ is the
+Fisher information of z under that Gaussian noise: an eigenvector with eigenvalue λ is a
+combination of materials the trial pins down to 1/√λ SD (≥ 1 SD: no better than the population
+prior). Trials add: F of the calibration and the held-out trial together is the sum of theirs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from wrist_env import design
+from wrist_env.cost import COST_BONES
+from wrist_env.envs.task import Task
+from wrist_env.frames import error_dof
+from wrist_env.model import BONES
+from wrist_env.participants import builtin
+from wrist_env.solver.arrays import SolverSettings
+
+NOISE = np.array([0.2, 0.2, 0.2, 0.5, 0.5, 0.5])  # mm, deg: 4DCT tracking noise per DOF
+STEP_Z = 0.25  # central-difference step, SD units
+SETTINGS = SolverSettings(tolerance=1e-4, force_floor_n=1e-3, max_hold_steps=6400)
+TRIALS = ("calibrate", "validate")
+
+
+@dataclass(frozen=True)
+class Spectrum:
+    """Eigen-decomposition of a Fisher matrix (22, 22) in z units, largest eigenvalue first.
+
+    eigenvalues (22,): information (1/SD²); eigenvectors (22, 22): column k is direction k;
+    sd (22,): 1/√eigenvalue, the SD to which the trial pins direction k (inf where λ = 0).
+    """
+
+    eigenvalues: np.ndarray
+    eigenvectors: np.ndarray
+
+    @property
+    def sd(self) -> np.ndarray:
+        with np.errstate(divide="ignore"):
+            return 1.0 / np.sqrt(np.maximum(self.eigenvalues, 0.0))
+
+    def identified(self, threshold_sd: float = 1.0) -> int:
+        """Directions pinned tighter than `threshold_sd` (by default: tighter than the prior)."""
+        return int(np.sum(self.sd < threshold_sd))
+
+
+def spectrum(fisher: np.ndarray) -> Spectrum:
+    """`Spectrum` of a symmetric Fisher matrix."""
+    values, vectors = np.linalg.eigh(0.5 * (fisher + fisher.T))
+    order = np.argsort(values)[::-1]
+    return Spectrum(values[order], vectors[:, order])
+
+
+def _residuals(task: Task, poses: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """Per-frame DOF errors of the cost bones over the noise, flattened: (2 · n_frames · 6,)."""
+    out = []
+    for b, bone in enumerate(COST_BONES):
+        i = BONES.index(bone)
+        out.append(error_dof(poses[:, i], reference[:, i], task.model.centroid[i]) / NOISE)
+    return np.concatenate(out).ravel()
+
+
+def jacobian(task: Task, center: design.Design, step: float = STEP_Z) -> np.ndarray:
+    """∂(residuals)/∂z at `center`, shape (2 · n_frames · 6, 22), by central differences of `step` SD."""
+    from wrist_env.solver.simulate import simulate_batch
+
+    z0 = design.z_scores(center)
+    designs = [center]
+    for i in range(design.N_MATERIAL):
+        for sign in (1.0, -1.0):
+            z = z0.copy()
+            z[i] += sign * step
+            designs.append(design.with_z(center, z))
+    runs = simulate_batch(task.model, designs, task.driver, prepared=task.prepared)
+    failed = [k for k, r in enumerate(runs) if not r.ok]
+    if failed:
+        raise RuntimeError(f"{task.participant} {task.motion}: {len(failed)} perturbed runs failed (step {step} SD)")
+    reference = runs[0].poses
+    r = np.stack([_residuals(task, run.poses, reference) for run in runs[1:]])
+    return ((r[0::2] - r[1::2]) / (2.0 * step)).T
+
+
+def fisher(participant: str, motion: str, center: design.Design | None = None, step: float = STEP_Z) -> np.ndarray:
+    """JᵀJ (22, 22) of a trial at `center` (default: the participant's hidden truth)."""
+    center = builtin.truth(participant) if center is None else center
+    J = jacobian(Task(participant, motion, settings=SETTINGS), center, step)
+    return J.T @ J
+
+
+def posterior_sd(fisher: np.ndarray) -> np.ndarray:
+    """Per-material SD (22,) in z units of the Laplace posterior with the population prior N(0, 1)
+    (Table 2): sqrt(diag((F + I)⁻¹)); 1 where the trial tells nothing, → 0 where it pins a material."""
+    return np.sqrt(np.diag(np.linalg.inv(fisher + np.eye(len(fisher)))))
+
+
+def study(participants, out=None):
+    """Per participant, the Fisher matrices of the calibration and held-out trials at the truth:
+    (materials table: participant, trials, material, posterior_sd; spectrum table: participant,
+    trials, direction, eigenvalue, sd, leading materials); written as CSV with a figure per
+    participant when `out` is given."""
+    import pandas as pd
+
+    materials, spectra = [], []
+    for participant in participants:
+        F = {motion: fisher(participant, motion) for motion in TRIALS}
+        for trials, f in (("calibrate", F["calibrate"]), ("validate", F["validate"]), ("both", sum(F.values()))):
+            for name, sd in zip(design.NAMES[: design.N_MATERIAL], posterior_sd(f)):
+                materials.append({"participant": participant, "trials": trials, "material": name, "posterior_sd": sd})
+            s = spectrum(f)
+            for k in range(len(f)):
+                v = s.eigenvectors[:, k]
+                lead = np.argsort(-np.abs(v))[:3]
+                spectra.append(
+                    {
+                        "participant": participant,
+                        "trials": trials,
+                        "direction": k,
+                        "eigenvalue": s.eigenvalues[k],
+                        "sd": s.sd[k],
+                        "leading_materials": " ".join(f"{v[j]:+.2f}·{design.NAMES[j]}" for j in lead),
+                    }
+                )
+    tables = pd.DataFrame(materials), pd.DataFrame(spectra)
+    if out is not None:
+        from pathlib import Path
+
+        from wrist_env.figures.identifiability import plot
+
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        tables[0].to_csv(out / "identifiability_materials.csv", index=False)
+        tables[1].to_csv(out / "identifiability_spectrum.csv", index=False)
+        for participant in participants:
+            plot(tables[0], tables[1], participant, out / f"identifiability_{participant}.png")
+    return tables
