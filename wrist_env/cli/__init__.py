@@ -7,7 +7,7 @@ import os
 import sys
 from collections.abc import Sequence
 
-from wrist_env.cli import participant_commands, study_commands
+from wrist_env.cli import identification_commands, participant_commands, study_commands
 
 
 def parser() -> argparse.ArgumentParser:
@@ -26,6 +26,7 @@ def parser() -> argparse.ArgumentParser:
 
     participant_commands.add_commands(command)
     study_commands.add_commands(command)
+    identification_commands.add_commands(command)
     return p
 
 
