@@ -9,8 +9,8 @@ Monte Carlo study (P1 + P2, 2 × 12,500) with its report, and what a trial ident
 sensitivity and the Fisher matrix at the hidden truth, P1–P3). The studies' run logs go to a fresh
 folder `runs/regenerate-<commit>/` (a killed run resumes there when rerun at the same commit).
 
-Run: `python experiments/regenerate.py` (~40 min on a 2-core machine); `--figures-only` skips the
-two studies (a minute).
+Run: `python experiments/regenerate.py` (~80 min on a 2-core machine); `--figures-only` skips the
+studies (~6 min).
 """
 
 from __future__ import annotations
@@ -49,7 +49,7 @@ def steps(runs: Path, figures_only: bool) -> list[list[str]]:
         ["iohanalyzer", "--runs", str(runs / "benchmark"), "--out", "leaderboards/iohanalyzer"],
         ["montecarlo", "P1", "P2", "--n", "12500", "--seed", "0", "--out", str(runs / "montecarlo")],
         ["montecarlo-report", "--runs", str(runs / "montecarlo"), "--out", "leaderboards/montecarlo"],
-        ["sensitivity", "P1", "P2", "P3", "--out", "leaderboards/sensitivity"],
+        ["sensitivity", "P1", "P2", "P3", "--n", "10", "--out", "leaderboards/sensitivity"],
         ["identifiability", "P1", "P2", "P3", "--out", "leaderboards/identifiability"],
     ]
 
