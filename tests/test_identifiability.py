@@ -43,7 +43,7 @@ def test_the_jacobian_predicts_the_simulated_change(p1_calibrate):
     base, moved = simulate_batch(
         task.model, [truth, design.with_z(truth, design.z_scores(truth) + dz)], task.driver, prepared=task.prepared
     )
-    change = identifiability._residuals(task, moved.poses, base.poses)
+    change = identifiability.residuals(task, moved.poses, base.poses)
     assert np.linalg.norm(change - J @ dz) < 0.3 * np.linalg.norm(change), np.linalg.norm(change)
 
 

@@ -60,7 +60,7 @@ def spectrum(fisher: np.ndarray) -> Spectrum:
     return Spectrum(values[order], vectors[:, order])
 
 
-def _residuals(task: Task, poses: np.ndarray, reference: np.ndarray) -> np.ndarray:
+def residuals(task: Task, poses: np.ndarray, reference: np.ndarray) -> np.ndarray:
     """Per-frame DOF errors of the cost bones over the noise, flattened: (2 · n_frames · 6,)."""
     out = []
     for b, bone in enumerate(COST_BONES):
@@ -85,7 +85,7 @@ def jacobian(task: Task, center: design.Design, step: float = STEP_Z) -> np.ndar
     if failed:
         raise RuntimeError(f"{task.participant} {task.motion}: {len(failed)} perturbed runs failed (step {step} SD)")
     reference = runs[0].poses
-    r = np.stack([_residuals(task, run.poses, reference) for run in runs[1:]])
+    r = np.stack([residuals(task, run.poses, reference) for run in runs[1:]])
     return ((r[0::2] - r[1::2]) / (2.0 * step)).T
 
 
