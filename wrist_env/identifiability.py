@@ -1,10 +1,9 @@
 """What a trial can identify: the Gauss–Newton (Fisher) matrix of the per-frame kinematic residuals
 at the hidden truth, in z units (Table 2 SD).
 
-The residuals of a design are the six-DOF errors (`frames.error_dof`, mm and deg) of the scaphoid
-and lunate at every frame, each divided by the 4DCT tracking noise of its DOF (0.2 mm, 0.5°, the
-noise of the synthetic trials). Their Jacobian J with respect to the 22 materials is taken by
-central differences at the truth (step 0.25 SD), simulated with a 10× tighter equilibrium
+The residuals of a design are `posterior.residuals`: the six-DOF errors of the scaphoid and lunate
+at every frame over the 4DCT tracking noise of each DOF (`posterior.NOISE`, 0.2 mm, 0.5°). Their
+Jacobian J with respect to the 22 materials is taken by central differences at the truth (step 0.25 SD), simulated with a 10× tighter equilibrium
 tolerance than the default (`SETTINGS`; at the default the solver's residual moves make the
 differences step-dependent: 20 % between 0.25 and 0.125 SD on P1, 15 % with it). F = JᵀJ is the
 Fisher information of z under that Gaussian noise: an eigenvector with eigenvalue λ is a
@@ -19,14 +18,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from wrist_env import design
-from wrist_env.cost import COST_BONES
-from wrist_env.envs.task import Task
-from wrist_env.frames import error_dof
-from wrist_env.model import BONES
+from wrist_env.envs.task import Task, cost_poses
 from wrist_env.participants import builtin
+from wrist_env.posterior import residuals
 from wrist_env.solver.arrays import SolverSettings
 
-NOISE = np.array([0.2, 0.2, 0.2, 0.5, 0.5, 0.5])  # mm, deg: 4DCT tracking noise per DOF
 STEP_Z = 0.25  # central-difference step, SD units
 SETTINGS = SolverSettings(tolerance=1e-4, force_floor_n=1e-3, max_hold_steps=6400)
 TRIALS = ("calibrate", "validate")
@@ -60,15 +56,6 @@ def spectrum(fisher: np.ndarray) -> Spectrum:
     return Spectrum(values[order], vectors[:, order])
 
 
-def residuals(task: Task, poses: np.ndarray, reference: np.ndarray) -> np.ndarray:
-    """Per-frame DOF errors of the cost bones over the noise, flattened: (2 · n_frames · 6,)."""
-    out = []
-    for b, bone in enumerate(COST_BONES):
-        i = BONES.index(bone)
-        out.append(error_dof(poses[:, i], reference[:, i], task.model.centroid[i]) / NOISE)
-    return np.concatenate(out).ravel()
-
-
 def jacobian(task: Task, center: design.Design, step: float = STEP_Z) -> np.ndarray:
     """∂(residuals)/∂z at `center`, shape (2 · n_frames · 6, 22), by central differences of `step` SD."""
     from wrist_env.solver.simulate import simulate_batch
@@ -84,8 +71,8 @@ def jacobian(task: Task, center: design.Design, step: float = STEP_Z) -> np.ndar
     failed = [k for k, r in enumerate(runs) if not r.ok]
     if failed:
         raise RuntimeError(f"{task.participant} {task.motion}: {len(failed)} perturbed runs failed (step {step} SD)")
-    reference = runs[0].poses
-    r = np.stack([residuals(task, run.poses, reference) for run in runs[1:]])
+    reference = cost_poses(runs[0].poses)
+    r = np.stack([residuals(task, run.poses, reference).ravel() for run in runs[1:]])
     return ((r[0::2] - r[1::2]) / (2.0 * step)).T
 
 

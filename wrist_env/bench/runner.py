@@ -98,7 +98,7 @@ def run_cell(
     cell's lock meanwhile, so a leftover process of a killed run and its
     restart never run the same cell at once.
     """
-    from wrist_env.bench.calibrate import calibrate
+    from wrist_env.bench.calibrate import calibrate, split_prior
     from wrist_env.participants import registry
 
     set_threads(threads)
@@ -116,7 +116,7 @@ def run_cell(
             key.seed,
             log=log,
             storage=cell_storage(storage, key),
-            options=(options or {}).get(key.optimizer),
+            options=(options or {}).get(key.optimizer, (options or {}).get(split_prior(key.optimizer)[0])),
             callback=callback,
         )
         return {"status": "ran", "summary": run.to_dict()}
@@ -145,7 +145,8 @@ def benchmark(
     storage: Optuna storage URL for calibrators that take one, "{cell}" replaced by the cell's key name
         (default: `sqlite:///<out_dir>/optuna/{cell}.db`); the study is named by the cell's key.
         "memory": studies in memory only (Optuna cells ~2× faster; resume still works, by replay).
-    options: {optimizer name: {option: value}} passed to `optimizers.make`.
+    options: {optimizer name: {option: value}} passed to `optimizers.make` (a `+prior` name takes its
+        base calibrator's options unless given its own).
     folders: participant folders to register (in every worker too).
     """
     start = time.perf_counter()
@@ -198,19 +199,21 @@ def _check_names(cells, folders) -> None:
     for folder in folders:
         registry.ensure_folder(folder)
     registry.require(*sorted({k.participant for k in cells}))
+    from wrist_env.bench.calibrate import split_prior
+
     for name in sorted({k.optimizer for k in cells}):
-        optimizers.get(name)  # UnknownOptimizerError lists the registered ones
+        optimizers.get(split_prior(name)[0])  # UnknownOptimizerError lists the registered ones
 
 
 def _prepare_storage(cells, storage) -> None:
     """Create the Optuna storage's tables once, before parallel workers open it."""
     import optimizers
-    from wrist_env.bench.calibrate import accepts_storage, open_storage
+    from wrist_env.bench.calibrate import accepts_storage, open_storage, split_prior
 
     if (
         isinstance(storage, str)
         and STORAGE_PER_CELL not in storage
-        and any(accepts_storage(optimizers.get(name)) for name in {k.optimizer for k in cells})
+        and any(accepts_storage(optimizers.get(split_prior(k.optimizer)[0])) for k in cells)
     ):
         open_storage(storage)
 

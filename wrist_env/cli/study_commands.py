@@ -13,7 +13,7 @@ from wrist_env.cli.participant_commands import PARTICIPANT_HELP
 
 
 def _calibrate(args) -> int:
-    from wrist_env.bench.calibrate import calibrate
+    from wrist_env.bench.calibrate import PRIOR_SUFFIX, calibrate
     from wrist_env.bench.leaderboard import reference
     from wrist_env.design import LIGAMENT_NAMES
     from wrist_env.participants import registry
@@ -22,7 +22,8 @@ def _calibrate(args) -> int:
     if args.budget < 1:
         raise SystemExit("wrist-bench calibrate: --budget must be at least 1")
     start = time.perf_counter()
-    run = calibrate(args.participant, args.optimizer, args.budget, args.seed, log=args.log, storage=args.storage)
+    name = args.optimizer + (PRIOR_SUFFIX if args.prior and not args.optimizer.endswith(PRIOR_SUFFIX) else "")
+    run = calibrate(args.participant, name, args.budget, args.seed, log=args.log, storage=args.storage)
     wall = time.perf_counter() - start
     ref = reference(args.participant)
     out = run.to_dict(history=True)
@@ -37,7 +38,7 @@ def _calibrate(args) -> int:
         return 0
     truth = out["truth"]
     print(
-        f"{args.participant}: {args.optimizer}, seed {args.seed}: {run.result.nfev} evaluations"
+        f"{args.participant}: {name}, seed {args.seed}: {run.result.nfev} evaluations"
         f"{f' ({run.replayed} replayed from the log)' if run.replayed else ''} in {wall:.1f} s; {run.result.message}"
     )
     for motion, name in (("calibrate", "calibration trial"), ("validate", "held-out resisted trial")):
@@ -64,12 +65,15 @@ def _calibrate(args) -> int:
 
 def _benchmark(args) -> int:
     import optimizers
+    from wrist_env.bench.calibrate import PRIOR_SUFFIX
     from wrist_env.bench.leaderboard import write_leaderboard
     from wrist_env.bench.runner import benchmark, make_cells
     from wrist_env.participants import builtin
 
     participants = args.participants or list(builtin.BUILTIN)
     names = args.optimizers or list(optimizers.available())
+    if args.prior:
+        names = list(dict.fromkeys(names + [n + PRIOR_SUFFIX for n in names if not n.endswith(PRIOR_SUFFIX)]))
     if args.seeds < 1 or args.budget < 1:
         raise SystemExit("wrist-bench benchmark: --seeds and --budget must be at least 1")
     cells = make_cells(participants, names, args.seeds, args.budget)
@@ -206,6 +210,12 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     s.add_argument("--seed", type=int, default=0, help="calibrator seed (default 0)")
     s.add_argument("--log", help="run-log folder: log every batch, resume this run if it was cut short")
     s.add_argument("--storage", help="Optuna storage URL for Optuna calibrators (default: in memory)")
+    s.add_argument(
+        "--prior",
+        action="store_true",
+        help="minimize the MAP objective (kinematic misfit over the 4DCT noise + the Table 2 prior) instead of "
+        "the cost; the same as the calibrator name with '+prior' appended",
+    )
     s.add_argument("--out", help="also write the JSON result to this file (usable as --design elsewhere)")
     s.add_argument("--json", action="store_true", help="print the result, design and held-out cost as JSON")
     s.set_defaults(run=_calibrate)
@@ -219,7 +229,12 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "skipped, unfinished ones replay their logged evaluations. Writes the leaderboard at the end.",
     )
     s.add_argument("--participants", nargs="+", help="default: the built-in P1 P2 P3")
-    s.add_argument("--optimizers", nargs="+", help="default: every registered calibrator")
+    s.add_argument(
+        "--optimizers", nargs="+", help="default: every registered calibrator; '<name>+prior' for its MAP twin"
+    )
+    s.add_argument(
+        "--prior", action="store_true", help="also run every calibrator on the MAP objective ('<name>+prior')"
+    )
     s.add_argument("--seeds", type=int, default=5, help="seeds 0 .. N-1 per participant and calibrator (default 5)")
     s.add_argument("--budget", type=int, default=300, help="simulations per run (default 300)")
     s.add_argument("--out", default="runs/benchmark", help="run-log folder (default runs/benchmark)")

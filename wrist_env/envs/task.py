@@ -65,7 +65,7 @@ class Task:
             if self.participant not in builtin.BUILTIN:
                 return driver, None
             truth = simulate(self.model, builtin.truth(self.participant), driver, self.settings)
-            return driver, _cost_poses(truth.poses)
+            return driver, cost_poses(truth.poses)
         trial = registry.trial(self.participant, "calibrate" if self.motion == "calibrate" else "validate")
         driver = experimental(self.model, trial.pose("capitate"))
         return driver, np.stack([trial.pose(b) for b in COST_BONES])
@@ -88,14 +88,14 @@ class Task:
             cost, report = 0.0, None
         else:
             report = kinematic_cost(
-                _cost_poses(result.poses), self.reference, reference_points=self.reference_points, weights=self.weights
+                cost_poses(result.poses), self.reference, reference_points=self.reference_points, weights=self.weights
             )
             cost = float(report.total)
         failed = not result.ok or (report is not None and report.failed)
         return Evaluation(-cost, cost, failed, outputs(result, report), result)
 
 
-def _cost_poses(poses: np.ndarray) -> np.ndarray:
+def cost_poses(poses: np.ndarray) -> np.ndarray:
     """(n_frames, 5, 4, 4) → (2, n_frames, 4, 4) for the cost's bones."""
     return np.stack([poses[:, BONES.index(b)] for b in COST_BONES])
 
