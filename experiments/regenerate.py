@@ -5,11 +5,12 @@ Runs, from the repository root, each step as the README documents it and prints 
 the built-in models shipped with the package (`experiments/ship_models.py`), the figures (`wrist-bench figure ...`, `wrist-bench validate P1`, the scaling benchmark `experiments/bench_scaling.py`), the full default benchmark
 and its leaderboard (3 participants × 11 calibrators × 5 seeds × 300 evaluations; Nevergrad's four
 need the `[nevergrad]` extra) with its IOHanalyzer files (`[ioh]`), and the full
-Monte Carlo study (P1 + P2, 2 × 12,500) with its report, and what a trial identifies (Morris
-sensitivity and the Fisher matrix at the hidden truth, P1–P3). The studies' run logs go to a fresh
+Monte Carlo study (P1 + P2, 2 × 12,500) with its report, what a trial identifies (Morris and Sobol
+sensitivity and the Fisher matrix at the hidden truth, P1–P3), the best calibrators with and without
+the prior (`leaderboards/prior/`) and the Bayesian calibrator's coverage (`leaderboards/posterior/`). The studies' run logs go to a fresh
 folder `runs/regenerate-<commit>/` (a killed run resumes there when rerun at the same commit).
 
-Run: `python experiments/regenerate.py` (~80 min on a 2-core machine); `--figures-only` skips the
+Run: `python experiments/regenerate.py` (~2 h 30 min on a 2-core machine); `--figures-only` skips the
 studies (~6 min).
 """
 
@@ -50,7 +51,22 @@ def steps(runs: Path, figures_only: bool) -> list[list[str]]:
         ["montecarlo", "P1", "P2", "--n", "12500", "--seed", "0", "--out", str(runs / "montecarlo")],
         ["montecarlo-report", "--runs", str(runs / "montecarlo"), "--out", "leaderboards/montecarlo"],
         ["sensitivity", "P1", "P2", "P3", "--n", "10", "--out", "leaderboards/sensitivity"],
+        [
+            "sensitivity",
+            *("P1", "P2", "P3", "--method", "sobol", "--n", "128", "--motions", "calibrate"),
+            *("--out", "leaderboards/sensitivity"),
+        ],
         ["identifiability", "P1", "P2", "P3", "--out", "leaderboards/identifiability"],
+        [
+            "benchmark",
+            *("--optimizers", "nelder-mead", "cmaes", "ng-ngopt", "surrogate", "--prior", "--seeds", "3"),
+            *("--storage", "memory", "--out", str(runs / "prior"), "--leaderboard", "leaderboards/prior"),
+        ],
+        [
+            "posterior",
+            *("P1", "P2", "P3", "--seeds", "3", "--walkers", "48", "--steps", "300"),
+            *("--out", str(runs / "posterior"), "--report", "leaderboards/posterior"),
+        ],
     ]
 
 

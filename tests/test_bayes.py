@@ -59,3 +59,14 @@ def test_the_command_samples_p1_and_writes_coverage_and_figures(built, tmp_path,
     capsys.readouterr()
     assert main(args) == 0
     assert "loaded" in capsys.readouterr().out
+
+
+def test_the_laplace_covariance_takes_the_noise_the_fit_implies():
+    """Residual rows alternate 3 translations, 3 rotations; with translation residuals of RMS 2 their
+    Jacobian rows count a quarter: (J_tᵀJ_t / 4 + J_rᵀJ_r + I)⁻¹."""
+    rng = np.random.default_rng(0)
+    J = rng.normal(size=(60, 5))
+    translation = np.arange(60) % 6 < 3
+    r = np.where(translation, 2.0, 1.0) * rng.choice([-1.0, 1.0], 60)
+    expected = np.linalg.inv(J[translation].T @ J[translation] / 4 + J[~translation].T @ J[~translation] + np.eye(5))
+    np.testing.assert_allclose(bayes.laplace_covariance(r, J), expected, rtol=1e-12)

@@ -71,3 +71,20 @@ def test_a_prior_calibrator_logs_its_objective_and_resumes(built, tmp_path):
         summary.unlink()  # as if killed after its last batch: every evaluation replays from the log
     again = calibrate("P1", "random+prior", 6, 0, log=tmp_path / "runs")
     assert again.replayed == 6 and again.result.fun == pytest.approx(run.result.fun)
+
+
+@pytest.mark.slow
+def test_benchmark_prior_runs_every_calibrator_with_and_without_it(built, tmp_path):
+    built("P1")
+    from wrist_env.cli import main
+
+    out = tmp_path / "runs"
+    args = ["benchmark", "--participants", "P1", "--optimizers", "random", "--prior", "--seeds", "1"]
+    assert main(args + ["--budget", "3", "--storage", "memory", "--out", str(out), "--no-progress"]) == 0
+    summaries = {s["optimizer"]: s for s in RunLog(out).summaries()}
+    assert sorted(summaries) == ["random", "random+prior"]
+    assert summaries["random"]["objective"] == "cost" and summaries["random+prior"]["objective"] == "map"
+    import pandas as pd
+
+    recovery = pd.read_csv(out / "leaderboards" / "recovery.csv")
+    assert sorted(recovery.calibrator) == ["random", "random+prior"]

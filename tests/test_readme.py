@@ -13,7 +13,7 @@ from wrist_env.cli import parser
 
 ROOT = Path(wrist_env.__file__).resolve().parent.parent
 README = ROOT / "README.md"
-OUTPUTS = ("out", "out_folder", "leaderboard")  # the options through which a command writes files
+OUTPUTS = ("out", "out_folder", "leaderboard", "report")  # the options through which a command writes files
 
 
 def readme_commands() -> list[list[str]]:

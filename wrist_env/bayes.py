@@ -16,8 +16,8 @@ runs on the residuals at the 4DCT noise and the prior) from its Laplace covarian
 (`laplace_covariance`); the first half of the steps is burn-in and discarded.
 
 Diagnostics (`Posterior`): the integrated autocorrelation time τ of each material (emcee), the
-effective sample size (kept samples / τ), split R̂ over the walkers (Gelman et al., BDA3 §11.4)
-and the acceptance rate. Predictive bands: `PREDICTIVE_DRAWS` posterior draws simulated on the
+effective sample size (kept samples / τ), split R̂ over the walkers (Gelman et al., BDA3 §11.4;
+the stricter of the two on short chains) and the acceptance rate. Predictive bands: `PREDICTIVE_DRAWS` posterior draws simulated on the
 calibration and the held-out trial, 5/50/95 % of each DOF at each frame.
 """
 
@@ -53,7 +53,8 @@ class Posterior:
     """Posterior samples of the 22 materials (z units) and their diagnostics.
 
     samples (n, 22): the kept chain, walkers and steps flattened; log_prob (n,).
-    map_z (22,): the start (MAP at the 4DCT noise); autocorr (22,): τ in steps; ess (22,);
+    map_z (22,): the start (MAP at the 4DCT noise); autocorr (22,): τ in steps; ess (22,): kept
+    samples / τ (τ from a chain shorter than 50 τ is low, so this is then an upper bound);
     rhat (22,): split R̂ over walkers; acceptance: mean acceptance rate; noise (2,): posterior median
     of the translation (mm) and rotation (deg) noise scale; evaluations: simulations run.
     predictive (2 motions, 3 quantiles 5/50/95 %, 2 bones, n_frames, 6) DOF (mm, deg) of the
@@ -98,7 +99,9 @@ class Posterior:
         """`<path>.npz` (arrays) and `<path>.json` (scalars and the summary)."""
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
-        np.savez_compressed(path.with_suffix(".npz"), **{k: getattr(self, k) for k in self.ARRAYS})
+        arrays = {k: getattr(self, k) for k in self.ARRAYS}
+        arrays["samples"] = arrays["samples"].astype(np.float32)  # 1e-7 SD: plenty, half the file
+        np.savez_compressed(path.with_suffix(".npz"), **arrays)
         scalars = {k: v for k, v in asdict(self).items() if k not in self.ARRAYS}
         scalars["materials"] = list(design.NAMES[: design.N_MATERIAL])
         path.with_suffix(".json").write_text(json.dumps(scalars, indent=1) + "\n")
@@ -187,8 +190,11 @@ def sample(log_prob, start: np.ndarray, steps: int, seed: int, progress: bool = 
     Returns {"chain": (kept, walkers, dim), "log_prob": (kept, walkers), "acceptance",
     "autocorr" (dim,), "ess" (dim,), "rhat" (dim,)}.
     """
+    import logging
+
     import emcee
 
+    logging.getLogger("emcee").setLevel(logging.ERROR)  # a short chain's τ is reported, not warned about
     walkers, dim = start.shape
     moves = [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
     sampler = emcee.EnsembleSampler(walkers, dim, log_prob, moves=moves, vectorize=True)
@@ -278,12 +284,14 @@ def study(
     steps: int = STEPS,
     progress: bool = True,
     on_run: Callable[[Posterior, bool], object] | None = None,
+    report: str | Path | None = None,
 ):
     """A Bayesian calibration per participant and seed (`out/posterior_<P>_seed<s>.npz/.json`; a run
     already saved is loaded, not rerun), then the coverage table (one row per run: share of the 22 true
     z inside the 50 % and 90 % intervals, recovery of the posterior mean, the MAP and the population
     design, diagnostics) as `out/coverage.csv` and the figures; returns the table.
-    on_run(posterior, loaded) is called after each run."""
+    on_run(posterior, loaded) is called after each run; report: the folder of the table and figures
+    (default `out`)."""
     import pandas as pd
 
     from wrist_env.figures.posterior import plot_intervals, plot_predictive
@@ -325,12 +333,13 @@ def study(
                 row["recovery_population"] = _rms(truth)
             rows.append(row)
     table = pd.DataFrame(rows)
-    out.mkdir(parents=True, exist_ok=True)
-    table.to_csv(out / "coverage.csv", index=False)
+    report = out if report is None else Path(report)
+    report.mkdir(parents=True, exist_ok=True)
+    table.to_csv(report / "coverage.csv", index=False)
     for participant, posts in posteriors.items():
         truth = design.z_scores(builtin.truth(participant)) if participant in builtin.BUILTIN else None
-        plot_intervals(posts, truth, out / f"posterior_intervals_{participant}.png")
-        plot_predictive(posts[0], out / f"posterior_predictive_{participant}.png")
+        plot_intervals(posts, truth, report / f"posterior_intervals_{participant}.png")
+        plot_predictive(posts[0], report / f"posterior_predictive_{participant}.png")
     return table
 
 

@@ -7,9 +7,10 @@ solver call on the calibration trial (`Task("calibrate").evaluate_batch`);
 the kinematic cost is the value. Any calibrator's name with `+prior`
 appended (`cmaes+prior`) minimizes the MAP objective instead: the kinematic
 misfit in units of the 4DCT noise plus the population prior
-(`posterior.map_objective`); the log keeps both its cost and its objective. The best design is then scored on the
-held-out resisted trial ("validate") and, for built-in participants, against
-the hidden truth (parameter recovery in Table 2 SD units).
+(`posterior.map_objective`); the log keeps both its cost and its objective.
+The best design is then scored on the held-out resisted trial ("validate")
+and, for built-in participants, against the hidden truth (parameter recovery
+in Table 2 SD units).
 
 With a run log, every batch is logged as it finishes, and a cell that was
 cut short resumes: its logged evaluations are replayed into a fresh

@@ -79,6 +79,7 @@ def _posterior(args) -> int:
         steps=args.steps,
         progress=not args.no_progress,
         on_run=report,
+        report=args.report,
     )
     if "coverage_90" in table:
         for participant, rows in table.groupby("participant", sort=False):
@@ -91,7 +92,7 @@ def _posterior(args) -> int:
             f"all: 50 % intervals cover {table.coverage_50.mean():.0%}, 90 % cover {table.coverage_90.mean():.0%} "
             f"({len(table)} runs)"
         )
-    print(f"written to {args.out}")
+    print(f"written to {args.out}" + (f" (table and figures: {args.report})" if args.report else ""))
     return 0
 
 
@@ -147,5 +148,6 @@ def add_commands(command: Callable[..., object]) -> None:
     s.add_argument("--walkers", type=int, default=48, help="ensemble walkers (default 48; >= 44)")
     s.add_argument("--steps", type=int, default=400, help="ensemble steps (default 400)")
     s.add_argument("--out", default="runs/posterior", help="output folder (default runs/posterior)")
+    s.add_argument("--report", help="folder of coverage.csv and the figures (default: --out)")
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
     s.set_defaults(run=_posterior)

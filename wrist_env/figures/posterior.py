@@ -48,7 +48,8 @@ def plot_intervals(posteriors, truth: np.ndarray | None, out: str | Path) -> Pat
 
 def plot_predictive(post, out: str | Path) -> Path:
     """Rows: calibration trial scaphoid, lunate, held-out trial scaphoid, lunate; columns: the six DOF.
-    The posterior predictive 5–95 % band and median against the trial's frames."""
+    The 5–95 % band and median of the model's kinematics over posterior draws (the materials'
+    uncertainty; tracking noise not added) against the trial's frames."""
     fig, axes = plt.subplots(4, 6, figsize=(17, 10), sharex=True)
     frames = np.arange(post.observed.shape[2])
     for m, motion in enumerate(("calibration", "held-out")):
@@ -68,7 +69,8 @@ def plot_predictive(post, out: str | Path) -> Path:
                     ax.set_xlabel("frame")
                 ax.tick_params(labelsize=7)
     fig.suptitle(
-        f"{post.participant}: posterior predictive kinematics (5–95 % band, median; dots: the trial), seed {post.seed}"
+        f"{post.participant}: the model's kinematics over the posterior (5–95 % band, median; the materials' "
+        f"uncertainty, tracking noise not added; dots: the trial), seed {post.seed}"
     )
     fig.tight_layout()
     out = Path(out)
