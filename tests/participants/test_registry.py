@@ -116,7 +116,12 @@ def test_a_fresh_install_reads_the_shipped_builtin_model(tmp_path, monkeypatch):
 
 
 def test_the_shipped_model_is_what_a_build_gives(tmp_path, monkeypatch):
-    """Rebuilding P1 from scratch gives the shipped model: same inputs' hash, same arrays."""
+    """Rebuilding P1 from scratch gives the shipped model: same inputs' hash, the same arrays but for
+    floating-point detail. Library releases move a few values (a fresh install with NumPy 2.4, SciPy
+    1.17, Numba 0.68, trimesh 5.2 moved 6 % of the contact grid by ≤ 0.026 mm, 134 of 2,343 contact
+    samples by ≤ 0.0015 mm and two samples' cartilage thickness by ≤ 0.03 mm; the per-vertex
+    thickness differed in one run and not in another), so: every value within 0.05 (mm, mm², unit
+    vectors), at least 90 % of each array identical."""
     from dataclasses import fields
 
     from wrist_env.model import Model
@@ -129,4 +134,8 @@ def test_the_shipped_model_is_what_a_build_gives(tmp_path, monkeypatch):
     for f in fields(Model):
         a, b = getattr(built, f.name), getattr(shipped, f.name)
         if isinstance(a, np.ndarray):
-            assert a.shape == b.shape and np.allclose(a, b, rtol=1e-9, atol=1e-9, equal_nan=True), f.name
+            assert a.shape == b.shape, f.name
+            same = np.isclose(a, b, rtol=1e-9, atol=1e-9, equal_nan=True)
+            assert np.allclose(a, b, rtol=0, atol=0.05, equal_nan=True) and same.mean() >= 0.9, (
+                f"{f.name}: {int((~same).sum())} of {same.size} differ, by up to {np.nanmax(np.abs(a - b)):.3g}"
+            )

@@ -35,6 +35,15 @@ VIEWS = (("volar view", 0, 0), ("radial view", 0, 90), ("oblique", 25, 40))
 LIGAMENT_COLOURS = dict(zip(ALL_LIGAMENT_NAMES, plt.get_cmap("tab10").colors + ("#000000", "#7a5195", "#ef5675")))
 
 
+def save(fig, out: str | Path, dpi: int = 110, **kwargs) -> Path:
+    """Write `fig` as a PNG at `out` (folders created), close it, return the path."""
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=dpi, **kwargs)
+    plt.close(fig)
+    return out
+
+
 def to_plot(p: ArrayLike) -> np.ndarray:
     """RCS (x volar, y proximal, z radial) to plot axes (radial right, volar towards the viewer, proximal up)."""
     p = np.asarray(p)

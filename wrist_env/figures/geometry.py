@@ -83,10 +83,7 @@ def model_figure(name: str, out: Path | None = None) -> Path:
         f"{name}: bones, cartilage coloured by thickness, ligament fibres (drawn on top) "
         "and the RSC membrane; RCS, neutral pose"
     )
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
+    return draw.save(fig, out)
 
 
 ANNOTATION_PANELS = (
@@ -136,7 +133,4 @@ def annotations_figure(out: Path | None = None) -> Path:
     ]
     fig.legend(handles=handles, loc="lower center", ncol=8, frameon=False)
     fig.suptitle("Template annotations: cartilage coverage per articulation (patches) and ligament sites (dots), RCS")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
+    return draw.save(fig, out)

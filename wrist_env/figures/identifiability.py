@@ -12,6 +12,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from wrist_env.figures.draw import save  # noqa: E402
+
 COLOURS = {"calibrate": "tab:blue", "validate": "tab:orange", "both": "tab:green"}
 
 
@@ -34,7 +36,4 @@ def plot(materials: pd.DataFrame, spectra: pd.DataFrame, participant: str, out: 
     right.set(ylabel="posterior SD with the Table 2 prior (z units)", ylim=(0, 1.05))
     fig.suptitle(f"{participant}: what the trials identify at the hidden truth (Fisher, 4DCT noise 0.2 mm / 0.5°)")
     fig.tight_layout()
-    out = Path(out)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
+    return save(fig, out)

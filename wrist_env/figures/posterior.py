@@ -13,6 +13,7 @@ import numpy as np  # noqa: E402
 
 from wrist_env import design  # noqa: E402
 from wrist_env.cost import COST_BONES  # noqa: E402
+from wrist_env.figures.draw import save  # noqa: E402
 from wrist_env.frames import DOF_NAMES, DOF_UNITS  # noqa: E402
 
 PRIOR_90 = 1.645  # the N(0, 1) prior's 90 % interval, z units
@@ -40,10 +41,7 @@ def plot_intervals(posteriors, truth: np.ndarray | None, out: str | Path) -> Pat
     ax.legend(loc="lower right", fontsize=8)
     ax.set_title(f"{posteriors[0].participant}: posterior credible intervals (calibration trial)")
     fig.tight_layout()
-    out = Path(out)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
+    return save(fig, out)
 
 
 def plot_predictive(post, out: str | Path) -> Path:
@@ -73,7 +71,4 @@ def plot_predictive(post, out: str | Path) -> Path:
         f"uncertainty, tracking noise not added; dots: the trial), seed {post.seed}"
     )
     fig.tight_layout()
-    out = Path(out)
-    fig.savefig(out, dpi=100)
-    plt.close(fig)
-    return out
+    return save(fig, out, dpi=100)

@@ -11,6 +11,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from wrist_env.figures.draw import save  # noqa: E402
+
 SHADE = {"morris": ("mu_star", "Morris μ* / largest μ* of the output"), "sobol": ("ST", "Sobol total index ST")}
 
 
@@ -35,7 +37,4 @@ def plot(table: pd.DataFrame, method: str, out: str | Path) -> Path:
     fig.colorbar(image, ax=axes[0].tolist(), shrink=0.6, label=label)
     participant = table["participant"].iloc[0]
     fig.suptitle(f"{participant}: sensitivity of the cost and the scaphoid (S) and lunate (L) DOF errors")
-    out = Path(out)
-    fig.savefig(out, dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    return out
+    return save(fig, out, bbox_inches="tight")

@@ -203,10 +203,7 @@ def pressure_figure(name: str, out: Path | None = None, *, static: bool = False)
         f"(radioscaphoid mean {_mpa(rs[0])}, peak {_mpa(rs[1])})\n{how}",
         fontsize=12,
     )
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
+    return draw.save(fig, out)
 
 
 KINEMATIC_ANGLES = (
@@ -290,7 +287,4 @@ def kinematics_figure(name: str, out: Path | None = None, *, n_frames: int = 17)
         f"(Cardan Z-X-Y angles, RCS, neutral = 0)" + ("\n" + "; ".join(notes) if notes else ""),
         fontsize=12,
     )
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
+    return draw.save(fig, out)
