@@ -11,7 +11,7 @@ better than the default stretch move in 22 dimensions. Gradient samplers (NUTS) 
 the explicit solver does not give; nested sampling (dynesty) and flow-preconditioned SMC (pocomc,
 which needs torch) spend more simulations or dependencies on one posterior.
 
-Start: the walkers are drawn around the MAP (`map_estimate`: the best of several Levenberg–Marquardt
+Start: the walkers are drawn around the MAP (`map_estimate`: the best of several trust-region Gauss–Newton
 runs on the residuals at the 4DCT noise and the prior) from its Laplace covariance
 (`laplace_covariance`); the first half of the steps is burn-in and discarded.
 
@@ -121,9 +121,9 @@ def map_estimate(
     calibration: Task, starts: int = MAP_STARTS, seed: int = 0, max_evaluations: int = 40
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
     """(MAP z (22,), its residuals (n,), their Jacobian (n, 22), simulations run): the best of
-    Levenberg–Marquardt runs (SciPy's trust-region reflective, |z| ≤ 3) on [residuals; z] from the
-    population design and `starts` − 1 draws of N(0, 0.7²) (the contact makes the misfit multimodal:
-    on P1, 1 of 6 random starts reached the basin of the hidden truth)."""
+    trust-region Gauss–Newton runs (SciPy's `least_squares`, TRF, |z| ≤ 3) on [residuals; z] from the
+    population design and `starts` − 1 draws of N(0, 0.7²) (the misfit is multimodal: on P1, 1 of 6
+    random starts reached the basin of the hidden truth)."""
     from scipy.optimize import least_squares
 
     base, runs = design.population(), [0]
