@@ -32,10 +32,8 @@ from pathlib import Path
 import numpy as np
 
 from wrist_env import design, posterior
-from wrist_env.cost import COST_BONES
 from wrist_env.envs.task import Task, cost_poses, task
 from wrist_env.frames import pose_to_dof
-from wrist_env.model import BONES
 
 WALKERS = 48
 STEPS = 400
@@ -268,8 +266,7 @@ def calibrate(
 
 def _dof(t: Task, poses: np.ndarray) -> np.ndarray:
     """DOF (2, n_frames, 6) of cost-bone poses (2, n_frames, 4, 4) at their centroids (mm, deg)."""
-    points = t.model.centroid[[BONES.index(b) for b in COST_BONES]][:, None, :]
-    return pose_to_dof(poses, points)
+    return pose_to_dof(poses, t.reference_points[:, None, :])
 
 
 LEVELS = (0.5, 0.9)

@@ -49,6 +49,8 @@ def _identifiability(args) -> int:
 
 
 def _posterior(args) -> int:
+    import numpy as np
+
     from wrist_env import bayes
     from wrist_env.participants import registry
 
@@ -68,8 +70,6 @@ def _posterior(args) -> int:
             f"{post.noise[0]:.2f} mm / {post.noise[1]:.2f} deg",
             flush=True,
         )
-
-    import numpy as np
 
     table = bayes.study(
         args.participants,
