@@ -57,9 +57,7 @@ def monte_carlo_designs(n: int, seed: int = 0):
 
 
 @njit(cache=True, error_model="numpy")
-def bare_lookups(repeats, R, x, com0, grids, active, n_active, smooth):
-    """Only the signed-distance look-ups of `repeats` steps' active samples, as the solver does them
-    (with `smooth`, the nodal-normal look-up); the sum keeps them live."""
+def _lookups(repeats, R, x, com0, grids, active, n_active, smooth):
     total = 0.0
     for _ in range(repeats):
         for p in range(grids.pair_bones.shape[0]):
@@ -74,6 +72,16 @@ def bare_lookups(repeats, R, x, com0, grids, active, n_active, smooth):
                     d, gx, _, _, _, _, _ = sample_lookup(grids, b, M, s)
                 total += d + gx
     return total
+
+
+@njit(cache=True, error_model="numpy")
+def bare_lookups(repeats, R, x, com0, grids, active, n_active, smooth):
+    """Only the signed-distance look-ups of `repeats` steps' active samples, as the solver does them
+    (with `smooth`, the nodal-normal look-up; the flag passed as a constant, as the solver does);
+    the sum keeps them live."""
+    if smooth:
+        return _lookups(repeats, R, x, com0, grids, active, n_active, True)
+    return _lookups(repeats, R, x, com0, grids, active, n_active, False)
 
 
 def efficiency(model, steps_per_sim: float, seconds_per_sim: float) -> tuple[float, float, int]:

@@ -92,6 +92,19 @@ def _fire(v, w, nv, F, T, node_force, mem, st, fire):
 
 
 @njit(cache=True, error_model="numpy")
+def _contact(R, x, com0, grids, law, active, n_active, F, T, stats, want_energy, smooth):
+    """`contact_forces` with its two flags passed as constants, so Numba compiles one loop per
+    combination (flags read at run time in its inner loop made a step 2× slower: `bench_solver.py`)."""
+    if smooth:
+        if want_energy:
+            return contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, True, True)
+        return contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, False, True)
+    if want_energy:
+        return contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, True, False)
+    return contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, False, False)
+
+
+@njit(cache=True, error_model="numpy")
 def _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, rebuild, want_energy=True):
     """Forces F (N), torques T (N·mm), contact stats and bundle forces at the current
     state; rebuilds the active contact set first if `rebuild`; returns internal energy
@@ -106,23 +119,13 @@ def _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, rebuild
     F[:] = 0.0
     T[:] = 0.0
     bundle[:] = 0.0
-    energy = contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, want_energy, st.smooth_normals)
+    energy = _contact(R, x, com0, grids, law, active, n_active, F, T, stats, want_energy, st.smooth_normals)
     energy += fibre_forces(R, x, v, w, com0, fib, f_l0, f_K, st.fibre_damping_s, F, T, bundle, want_energy)
-    e_mem, rsc = membrane_forces(
-        R,
-        x,
-        com0,
-        mem,
-        nodes,
-        m_l0,
-        m_K,
-        st.membrane_contact_stiffness,
-        F,
-        T,
-        node_force,
-        want_energy,
-        st.smooth_normals,
-    )
+    k_mem = st.membrane_contact_stiffness
+    if st.smooth_normals:
+        e_mem, rsc = membrane_forces(R, x, com0, mem, nodes, m_l0, m_K, k_mem, F, T, node_force, want_energy, True)
+    else:
+        e_mem, rsc = membrane_forces(R, x, com0, mem, nodes, m_l0, m_K, k_mem, F, T, node_force, want_energy, False)
     energy += e_mem
     bundle[RSC] += rsc
     if st.driver == LOADED:
