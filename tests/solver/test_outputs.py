@@ -60,11 +60,15 @@ def test_pressure_map_sums_to_the_solver_contact_force_at_the_same_state(p1, swe
     for f in range(len(sweep.poses)):
         R, x = _state(p1, sweep.poses[f])
         stats = np.zeros((len(PAIRS), 3))
-        active = np.arange(n, dtype=np.int64)
-        n_active = np.diff(p1.sample_offsets).astype(np.int64)
+        active = np.zeros(n, dtype=np.int64)
+        n_active = np.zeros(len(PAIRS), np.int64)
+        unset = np.full((len(PAIRS), 12), np.nan)
+        com = np.ascontiguousarray(p1.com)
+        every = 1e9  # a band holding every sample
         forces.contact_forces(
-            R, x, np.ascontiguousarray(p1.com), grids, law, active, n_active, np.zeros((5, 3)), np.zeros((5, 3)), stats
+            R, x, com, grids, law, every, active, n_active, unset, np.zeros((5, 3)), np.zeros((5, 3)), stats
         )
+        assert n_active.sum() == n
         p = pressure_map(p1, sweep.poses[f])
         for k, pair in enumerate(PAIRS):
             s = pair_slice(p1, pair)

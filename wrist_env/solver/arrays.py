@@ -18,7 +18,8 @@ from wrist_env.solver.contact import nodal_normals
 
 Bodies = namedtuple("Bodies", "com0 inv_mass inv_inertia mass inertia")
 Grids = namedtuple(
-    "Grids", "pair_bones sample_offsets points thickness area values offsets shape origin spacing normals"
+    "Grids",
+    "pair_bones sample_offsets points thickness area values offsets shape origin spacing normals pair_centre pair_reach",
 )
 Fibres = namedtuple("Fibres", "bones origin insertion ligament rest_length")
 Membrane = namedtuple(
@@ -29,7 +30,7 @@ Membrane = namedtuple(
 Settings = namedtuple(
     "Settings",
     "dt settle_steps move_steps ramp_steps min_hold_steps max_hold_steps tolerance force_floor damping rot_damping fibre_damping_s "
-    "active_band_mm rebuild_every node_mass membrane_contact_stiffness driver max_disp_mm max_rot_rad fire_alpha0 smooth_normals",
+    "active_band_mm node_mass membrane_contact_stiffness driver max_disp_mm max_rot_rad fire_alpha0 smooth_normals",
 )
 
 RSC = RSC_INDEX
@@ -52,7 +53,10 @@ class SolverSettings:
     trilinear distance (which jumps at cell faces, so no state balances
     exactly: `experiments/solver_accuracy.py`).
     mass_scale, inertia_scale: mass scaling of the free bones (inertia_scale
-    multiplies rotational inertia on top of mass_scale).
+    multiplies rotational inertia on top of mass_scale). active_band_mm: a
+    contact sample is looked up every step while it is within this distance
+    of contact (a pair's set is refilled once its samples may have moved half
+    of it: `forces.contact_forces`).
     """
 
     dt_s: float = 6e-5
@@ -68,8 +72,7 @@ class SolverSettings:
     fibre_damping_s: float = 2e-4
     mass_scale: float = 10.0
     inertia_scale: float = 2.0
-    active_band_mm: float = 0.6
-    rebuild_every: int = 8
+    active_band_mm: float = 0.15
     node_mass_t: float = 2e-7
     membrane_contact_stiffness: float = 50.0
     max_disp_mm: float = 15.0
@@ -119,6 +122,14 @@ def grids(model: Model, smooth_normals: bool = False) -> Grids:
     """The contact arrays; with `smooth_normals` the grids' nodal normals
     (`contact.nodal_normals`, (n, 4)) too, else an empty (0, 4)."""
     normals = _normals(model) if smooth_normals else np.zeros((0, 4), np.int8)
+    offsets = np.asarray(model.sample_offsets)
+    centre = np.zeros((len(PAIR_BONES), 3))
+    reach = np.zeros(len(PAIR_BONES))
+    for p in range(len(PAIR_BONES)):
+        points = np.asarray(model.sample_points[offsets[p] : offsets[p + 1]], np.float64)
+        if len(points):
+            centre[p] = points.mean(axis=0)
+            reach[p] = np.linalg.norm(points - centre[p], axis=1).max()
     return Grids(
         np.ascontiguousarray(PAIR_BONES, dtype=np.int64),
         np.ascontiguousarray(model.sample_offsets, dtype=np.int64),
@@ -131,6 +142,8 @@ def grids(model: Model, smooth_normals: bool = False) -> Grids:
         np.ascontiguousarray(model.grid_origin, dtype=np.float64),
         np.ascontiguousarray(model.grid_spacing, dtype=np.float64),
         normals,
+        centre,
+        reach,
     )
 
 
@@ -207,7 +220,6 @@ def settings_tuple(s: SolverSettings, driver: int) -> Settings:
         float(s.rot_damping_per_s),
         float(s.fibre_damping_s),
         float(s.active_band_mm),
-        int(s.rebuild_every),
         float(s.node_mass_t),
         float(s.membrane_contact_stiffness),
         int(driver),

@@ -40,6 +40,27 @@ def _cell(offset, shape, origin, spacing, qx, qy, qz):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
+def sdf_distance(values, offset, shape, origin, spacing, qx, qy, qz):
+    """Trilinear signed distance (mm) at local point (qx, qy, qz); `OUTSIDE_MM` outside the grid."""
+    inside, base, sx, sy, tx, ty, tz, _ = _cell(offset, shape, origin, spacing, qx, qy, qz)
+    if not inside:
+        return OUTSIDE_MM
+    return _trilinear(values, base, sx, sy, tx, ty, tz)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _trilinear(values, base, sx, sy, tx, ty, tz):
+    """Trilinear interpolation of the cell whose first corner is values[base] (strides sx, sy, 1)."""
+    c00 = values[base] + (values[base + 1] - values[base]) * tz
+    c01 = values[base + sy] + (values[base + sy + 1] - values[base + sy]) * tz
+    c10 = values[base + sx] + (values[base + sx + 1] - values[base + sx]) * tz
+    c11 = values[base + sx + sy] + (values[base + sx + sy + 1] - values[base + sx + sy]) * tz
+    c0 = c00 + (c01 - c00) * ty
+    c1 = c10 + (c11 - c10) * ty
+    return c0 + (c1 - c0) * tx
+
+
+@njit(cache=True, error_model="numpy", inline="always")
 def sdf_lookup_scalar(values, offset, shape, origin, spacing, qx, qy, qz):
     """Trilinear signed distance (mm) and gradient components at local point (qx, qy, qz).
 
@@ -79,13 +100,7 @@ def sdf_lookup_smooth(values, normals, offset, shape, origin, spacing, qx, qy, q
     inside, base, sx, sy, tx, ty, tz, inv = _cell(offset, shape, origin, spacing, qx, qy, qz)
     if not inside:
         return OUTSIDE_MM, 0.0, 0.0, 0.0
-    c00 = values[base] + (values[base + 1] - values[base]) * tz
-    c01 = values[base + sy] + (values[base + sy + 1] - values[base + sy]) * tz
-    c10 = values[base + sx] + (values[base + sx + 1] - values[base + sx]) * tz
-    c11 = values[base + sx + sy] + (values[base + sx + sy + 1] - values[base + sx + sy]) * tz
-    c0 = c00 + (c01 - c00) * ty
-    c1 = c10 + (c11 - c10) * ty
-    d = c0 + (c1 - c0) * tx
+    d = _trilinear(values, base, sx, sy, tx, ty, tz)
     if d >= 0.0:
         return d, 0.0, 0.0, 0.0
     gx = gy = gz = 0.0

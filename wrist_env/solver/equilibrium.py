@@ -63,6 +63,7 @@ def _residual(q, R0, x0, nodes0, free_nodes, bod, grids, law, fib, stiffness, me
     work = kernel.Work(
         np.zeros(grids.points.shape[0], np.int64),
         np.zeros(grids.pair_bones.shape[0], np.int64),
+        np.full((grids.pair_bones.shape[0], 12), np.nan),
         np.zeros((n_bones, 3)),
         np.zeros((n_bones, 3)),
         np.zeros_like(nodes),

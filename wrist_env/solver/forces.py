@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from wrist_env.solver.contact import law_energy, law_pressure, sdf_lookup_scalar, sdf_lookup_smooth
+from wrist_env.solver.contact import law_energy, law_pressure, sdf_distance, sdf_lookup_scalar, sdf_lookup_smooth
 from wrist_env.solver.ligaments import blankevoort_energy, blankevoort_force
 
 # columns of the per-pair contact statistics the force kernels accumulate
@@ -123,19 +123,51 @@ def sample_lookup_smooth(grids, b, M, s):
     return d, gx, gy, gz, qx, qy, qz
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def sample_distance(grids, b, M, s):
+    """Signed distance (mm) of sample s under the pair transform M (no gradient)."""
+    qx, qy, qz = _moved(grids, M, s)
+    return sdf_distance(grids.values, grids.offsets[b], grids.shape[b], grids.origin[b], grids.spacing[b], qx, qy, qz)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _travel(grids, p, M, ref):
+    """Upper bound (mm) on how far any sample of pair p has moved in the grid bone's frame since its
+    pair transform was ref[p] (12 values, `pair_transform`'s order): |ΔM|·reach + |ΔM c + Δt|
+    about the pair's sample centre c; NaN if ref[p] is unset."""
+    c = grids.pair_centre[p]
+    norm2 = 0.0
+    for k in range(9):
+        dm = M[k] - ref[p, k]
+        norm2 += dm * dm
+    shift2 = 0.0
+    for r in range(3):
+        dm0, dm1, dm2 = M[3 * r] - ref[p, 3 * r], M[3 * r + 1] - ref[p, 3 * r + 1], M[3 * r + 2] - ref[p, 3 * r + 2]
+        dr = dm0 * c[0] + dm1 * c[1] + dm2 * c[2] + M[9 + r] - ref[p, 9 + r]
+        shift2 += dr * dr
+    return np.sqrt(norm2) * grids.pair_reach[p] + np.sqrt(shift2)
+
+
 @njit(cache=True, error_model="numpy")
-def rebuild_active(R, x, com0, grids, band_mm, active, n_active):
-    """Refill `active` with the samples of each pair within `band_mm` of contact."""
+def _refill(grids, p, b, M, band_mm, active, n_active, ref):
+    """Refill pair p's active samples (those within `band_mm` of contact) and remember M as ref[p]."""
+    n = 0
+    start = grids.sample_offsets[p]
+    for s in range(start, grids.sample_offsets[p + 1]):
+        if sample_distance(grids, b, M, s) < band_mm:
+            active[start + n] = s
+            n += 1
+    n_active[p] = n
+    for k in range(12):
+        ref[p, k] = M[k]
+
+
+@njit(cache=True, error_model="numpy")
+def rebuild_active(R, x, com0, grids, band_mm, active, n_active, ref):
+    """Refill every pair's active samples (`_refill`) at the state (R, x)."""
     for p in range(grids.pair_bones.shape[0]):
         a, b = grids.pair_bones[p, 0], grids.pair_bones[p, 1]
-        M = pair_transform(R, x, com0, a, b)
-        n = 0
-        start = grids.sample_offsets[p]
-        for s in range(start, grids.sample_offsets[p + 1]):
-            if sample_lookup(grids, b, M, s)[0] < band_mm:
-                active[start + n] = s
-                n += 1
-        n_active[p] = n
+        _refill(grids, p, b, pair_transform(R, x, com0, a, b), band_mm, active, n_active, ref)
 
 
 @njit(cache=True, error_model="numpy")
@@ -145,23 +177,30 @@ def sample_pressures(R, x, com0, grids, law, pressure):
         a, b = grids.pair_bones[p, 0], grids.pair_bones[p, 1]
         M = pair_transform(R, x, com0, a, b)
         for s in range(grids.sample_offsets[p], grids.sample_offsets[p + 1]):
-            d = sample_lookup(grids, b, M, s)[0]
+            d = sample_distance(grids, b, M, s)
             pressure[s] = law_pressure(law, -d / grids.thickness[s]) if d < 0.0 else 0.0
 
 
 @njit(cache=True, error_model="numpy")
-def contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, want_energy=True, smooth=False):
+def contact_forces(R, x, com0, grids, law, band_mm, active, n_active, ref, F, T, stats, want_energy=True, smooth=False):
     """Contact forces of all pairs' active samples; returns contact energy (N·mm; 0 unless `want_energy`).
 
-    Each pair's forces and moments are summed in the grid bone's neutral frame
-    and applied to both bodies once. stats (n_pairs, 3) receives per pair:
-    force (N), contacting area (mm²), peak pressure (MPa).
+    A pair's active samples (within `band_mm` of contact) are refilled when its
+    samples may have moved band_mm / 2 since the last refill (`_travel`; ref:
+    (n_pairs, 12) pair transforms at the refills, NaN to force one): the
+    trilinear distance changes at most √3× as fast as a sample moves, so no
+    sample left out can have reached contact. Each pair's forces and moments
+    are summed in the grid bone's neutral frame and applied to both bodies
+    once. stats (n_pairs, 3) receives per pair: force (N), contacting area
+    (mm²), peak pressure (MPa).
     """
     energy = 0.0
     stats[:] = 0.0
     for p in range(grids.pair_bones.shape[0]):
         a, b = grids.pair_bones[p, 0], grids.pair_bones[p, 1]
         M = pair_transform(R, x, com0, a, b)
+        if not _travel(grids, p, M, ref) < 0.5 * band_mm:
+            _refill(grids, p, b, M, band_mm, active, n_active, ref)
         start = grids.sample_offsets[p]
         fx = fy = fz = mx = my = mz = 0.0
         force = area_sum = peak = 0.0

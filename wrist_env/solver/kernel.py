@@ -29,7 +29,6 @@ from wrist_env.solver.forces import (
     fibre_forces,
     membrane_forces,
     place_nodes,
-    rebuild_active,
 )
 from wrist_env.solver.rigid import interpolate_pose, matrix_to_rotvec, orthonormalize, rotate_in_place, smoothstep
 
@@ -92,16 +91,16 @@ def _fire(v, w, nv, F, T, node_force, mem, st, fire):
 
 
 @njit(cache=True, error_model="numpy")
-def _contact(R, x, com0, grids, law, active, n_active, F, T, stats, want_energy, smooth):
+def _contact(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, want_energy, smooth):
     """`contact_forces` with its two flags passed as constants, so Numba compiles one loop per
     combination (flags read at run time in its inner loop made a step 2× slower: `bench_solver.py`)."""
     if smooth:
         if want_energy:
-            return contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, True, True)
-        return contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, False, True)
+            return contact_forces(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, True, True)
+        return contact_forces(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, False, True)
     if want_energy:
-        return contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, True, False)
-    return contact_forces(R, x, com0, grids, law, active, n_active, F, T, stats, False, False)
+        return contact_forces(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, True, False)
+    return contact_forces(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, False, False)
 
 
 @njit(cache=True, error_model="numpy")
@@ -110,16 +109,17 @@ def _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, rebuild
     state; rebuilds the active contact set first if `rebuild`; returns internal energy
     (N·mm; 0 unless `want_energy`)."""
     R, x, v, w, nodes, _ = state
-    active, n_active, F, T, node_force, stats, bundle = work
+    active, n_active, ref, F, T, node_force, stats, bundle = work
     f_l0, f_K, m_l0, m_K = stiffness
     com0 = bod.com0
     if rebuild:
-        rebuild_active(R, x, com0, grids, st.active_band_mm, active, n_active)
+        ref[:] = np.nan
     place_nodes(R, x, com0, mem, nodes)
     F[:] = 0.0
     T[:] = 0.0
     bundle[:] = 0.0
-    energy = _contact(R, x, com0, grids, law, active, n_active, F, T, stats, want_energy, st.smooth_normals)
+    band = st.active_band_mm
+    energy = _contact(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, want_energy, st.smooth_normals)
     energy += fibre_forces(R, x, v, w, com0, fib, f_l0, f_K, st.fibre_damping_s, F, T, bundle, want_energy)
     k_mem = st.membrane_contact_stiffness
     if st.smooth_normals:
@@ -138,13 +138,13 @@ def _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, loa
     """One explicit step with the capitate at target (capR, capx), or, for the loaded
     driver, at rotation capR under a compressive `load` (N, along +y)."""
     R, x, v, w, nodes, nv = state
-    _, _, F, T, node_force, _, _ = work
+    _, _, _, F, T, node_force, _, _ = work
     R[CAPITATE] = capR
     if st.driver == EXPERIMENTAL:
         x[CAPITATE, 0], x[CAPITATE, 1], x[CAPITATE, 2] = capx
         v[CAPITATE] = 0.0
     w[CAPITATE] = 0.0
-    _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, step_index % st.rebuild_every == 0, False)
+    _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, False, False)
     if st.fire_alpha0 > 0.0:
         _fire(v, w, nv, F, T, node_force, mem, st, fire)
     dt = st.dt
@@ -228,8 +228,9 @@ def _kinetic(R, v, w, nv, bod, st):
 State = namedtuple("State", ["R", "x", "v", "w", "nodes", "nv"])
 """A run's mutable state: rotations (5, 3, 3), centres of mass (5, 3) mm, velocities (5, 3) mm/s and
 angular velocities (5, 3) rad/s of the bodies; RSC membrane node positions (M, 3) mm and velocities."""
-Work = namedtuple("Work", ["active", "n_active", "F", "T", "node_force", "stats", "bundle"])
-"""A run's scratch: active contact samples and their count per pair, forces (5, 3) N and torques
+Work = namedtuple("Work", ["active", "n_active", "ref", "F", "T", "node_force", "stats", "bundle"])
+"""A run's scratch: active contact samples, their count per pair and the pair transforms when they
+were filled (n_pairs, 12; NaN to refill), forces (5, 3) N and torques
 (5, 3) N·mm on the bodies, membrane node forces (M, 3) N, per-pair contact stats, bundle forces (N)."""
 Stiffness = namedtuple("Stiffness", ["f_l0", "f_K", "m_l0", "m_K"])
 """A design's zero-load lengths (mm) and stiffnesses of the fibres and the membrane connectors."""
@@ -283,12 +284,13 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
     node_force = np.zeros_like(nodes)
     active = np.zeros(grids.points.shape[0], np.int64)
     n_active = np.zeros(grids.pair_bones.shape[0], np.int64)
+    ref = np.full((grids.pair_bones.shape[0], 12), np.nan)
     F = np.zeros((N_BONES, 3))
     T = np.zeros((N_BONES, 3))
     stats = np.zeros((grids.pair_bones.shape[0], 3))
     bundle = np.zeros(N_LIGAMENTS)
     state = State(R, x, v, w, nodes, nv)
-    work = Work(active, n_active, F, T, node_force, stats, bundle)
+    work = Work(active, n_active, ref, F, T, node_force, stats, bundle)
     status[0] = OK
     step = 0
     R0 = np.eye(3)
