@@ -31,6 +31,7 @@ def main(participant: str = "P1", n: int = 500) -> None:
     d = design.population()
     action = design.to_action(d)
     task = env.task
+    sim.simulate(task.model, d, task.driver)  # load the compiled kernel first
     real = per_call_s(lambda: sim.simulate(task.model, d, task.driver), 10)
     stored = {}
     run = kernel.run
