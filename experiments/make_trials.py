@@ -30,7 +30,6 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from wrist_env.builder.pipeline import BuildParams
 from wrist_env.frames import cardan_rotation
@@ -45,7 +44,7 @@ DATA = Path(__file__).resolve().parents[1] / "wrist_env" / "participants" / "dat
 N_FRAMES = 15
 HIGH_FIDELITY_BUILD = BuildParams(contact_spacing_mm=0.7)
 HIGH_FIDELITY_SOLVER = replace(SolverSettings().halved(), tolerance=1e-4, force_floor_n=1e-3, max_hold_steps=6400)
-NOISE_MM, NOISE_DEG = 0.2, 0.5
+NOISE_MM, NOISE_DEG = builtin.TRACKING_NOISE_MM, builtin.TRACKING_NOISE_DEG
 LOAD_N = {"unresisted": 10.0, "resisted": 40.0}
 GRIP_PEAK_N = {"unresisted": 60.0, "resisted": 120.0}
 ROLE = {"unresisted": "calibrate", "resisted": "validate"}
@@ -77,18 +76,6 @@ def capitate_motion(task: str, trial: str):
     return angles, load
 
 
-def tracking_noise(transforms: np.ndarray, centroid: np.ndarray, rng) -> np.ndarray:
-    """Perturb poses (n, 4, 4) by a random rigid motion about the moved centroid (NOISE_MM, NOISE_DEG RMS)."""
-    n = len(transforms)
-    turn = Rotation.from_rotvec(rng.normal(0.0, np.radians(NOISE_DEG) / np.sqrt(3), (n, 3))).as_matrix()
-    shift = rng.normal(0.0, NOISE_MM / np.sqrt(3), (n, 3))
-    out = transforms.copy()
-    moved = np.einsum("fij,j->fi", transforms[:, :3, :3], centroid) + transforms[:, :3, 3]
-    out[:, :3, :3] = turn @ transforms[:, :3, :3]
-    out[:, :3, 3] = np.einsum("fij,fj->fi", turn, transforms[:, :3, 3] - moved) + moved + shift
-    return out
-
-
 def make(name: str) -> dict:
     info = builtin.info(name)
     model = load_model(name, HIGH_FIDELITY_BUILD)
@@ -106,7 +93,7 @@ def make(name: str) -> dict:
         poses = np.transpose(result.poses, (1, 0, 2, 3)).copy()  # (bone, frame, 4, 4)
         for b in ("scaphoid", "lunate", "capitate"):
             i = BONES.index(b)
-            poses[i] = tracking_noise(poses[i], model.centroid[i], rng)
+            poses[i] = builtin.tracking_noise(poses[i], model.centroid[i], rng)
         t = Trial(trial, ROLE[trial], BONES, poses)
         write_trial_csv(t, folder / f"{trial}.csv")
         out[trial] = {

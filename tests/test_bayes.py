@@ -70,3 +70,72 @@ def test_the_laplace_covariance_takes_the_noise_the_fit_implies():
     r = np.where(translation, 2.0, 1.0) * rng.choice([-1.0, 1.0], 60)
     expected = np.linalg.inv(J[translation].T @ J[translation] / 4 + J[~translation].T @ J[~translation] + np.eye(5))
     np.testing.assert_allclose(bayes.laplace_covariance(r, J), expected, rtol=1e-12)
+
+
+def test_model_trials_carry_the_tracking_noise_and_no_model_error(built):
+    """The model's own run of the hidden truth plus tracking noise: at the truth the residuals are the
+    noise alone (0.2 mm and 0.5° RMS rigid, so ~0.12 mm and ~0.29° per DOF at the centroid: about 0.6
+    noise units each), below the built-in trial's (noise plus the fidelity gap); the noise follows the
+    seed, the held-out trial gets its own draw, and a participant without a truth is refused."""
+    from wrist_env import posterior
+    from wrist_env.envs.task import task
+    from wrist_env.participants import builtin
+
+    built("P1")
+    trial = task("P1", "calibrate")
+    model = bayes.model_trials(trial, seed=0)
+    truth = builtin.truth("P1")
+    r_model = posterior.residuals(model, trial.evaluate(truth).result.poses)
+    r_trial = posterior.residuals(trial, trial.evaluate(truth).result.poses)
+    rms = np.sqrt(np.mean(r_model[..., :3] ** 2)), np.sqrt(np.mean(r_model[..., 3:] ** 2))
+    assert 0.4 < rms[0] < 0.85 and 0.4 < rms[1] < 0.85, rms
+    assert np.sum(r_model**2) < 0.6 * np.sum(r_trial**2)
+    np.testing.assert_array_equal(bayes.model_trials(trial, seed=0).reference, model.reference)
+    assert not np.allclose(bayes.model_trials(trial, seed=1).reference, model.reference)
+    assert trial.reference is not model.reference and model.driver is trial.driver
+    with pytest.raises(ValueError, match="trials must be one of"):
+        bayes.calibrate("P1", trials="simulated")
+
+
+def test_tracking_noise_has_the_stated_rms():
+    """0.2 mm and 0.5° RMS: the centroid's displacement and the rotation angle over 20,000 frames."""
+    from scipy.spatial.transform import Rotation
+
+    from wrist_env.participants import builtin
+
+    rng = np.random.default_rng(0)
+    poses = np.tile(np.eye(4), (20_000, 1, 1))
+    poses[:, :3, :3] = Rotation.random(20_000, random_state=1).as_matrix()
+    centroid = np.array([10.0, -5.0, 30.0])
+    noisy = builtin.tracking_noise(poses, centroid, rng)
+    moved = np.einsum("fij,j->fi", poses[:, :3, :3], centroid) + poses[:, :3, 3]
+    moved_noisy = np.einsum("fij,j->fi", noisy[:, :3, :3], centroid) + noisy[:, :3, 3]
+    shift = np.sqrt(np.mean(np.sum((moved_noisy - moved) ** 2, axis=1)))
+    turn = Rotation.from_matrix(noisy[:, :3, :3] @ np.transpose(poses[:, :3, :3], (0, 2, 1))).magnitude()
+    assert shift == pytest.approx(builtin.TRACKING_NOISE_MM, rel=0.03)
+    assert np.degrees(np.sqrt(np.mean(turn**2))) == pytest.approx(builtin.TRACKING_NOISE_DEG, rel=0.03)
+
+
+def test_a_model_trials_study_keeps_its_own_files_and_says_so(built, tmp_path, monkeypatch):
+    """The study with trials="model" saves `_model` files and table, marks its rows, and passes the
+    choice to the calibrator (here a stand-in that returns a fixed posterior, to test the bookkeeping)."""
+    built("P1")
+    asked = []
+    n_frames = 15
+
+    def fake(participant, seed, walkers, steps, progress, trials):
+        asked.append(trials)
+        rng = np.random.default_rng(seed)
+        zeros = np.zeros(design.N_MATERIAL)
+        return bayes.Posterior(
+            participant, seed, rng.normal(size=(96, design.N_MATERIAL)), np.zeros(96), zeros, zeros + 1,
+            zeros + 96, zeros + 1, 0.3, np.array([0.1, 0.3]), 10, 1.0,
+            np.zeros((2, 3, 2, n_frames, 6)), np.zeros((2, 2, n_frames, 6)), trials,
+        )  # fmt: skip
+
+    monkeypatch.setattr(bayes, "calibrate", fake)
+    table = bayes.study(["P1"], 2, tmp_path, progress=False, trials="model")
+    assert asked == ["model", "model"] and (table.trials == "model").all()
+    assert (tmp_path / "coverage_model.csv").exists() and not (tmp_path / "coverage.csv").exists()
+    assert bayes.Posterior.load(tmp_path / "posterior_P1_seed1_model.npz").trials == "model"
+    assert (tmp_path / "posterior_intervals_P1_model.png").exists()

@@ -57,6 +57,7 @@ class Posterior:
     of the translation (mm) and rotation (deg) noise scale; evaluations: simulations run.
     predictive (2 motions, 3 quantiles 5/50/95 %, 2 bones, n_frames, 6) DOF (mm, deg) of the
     calibration and held-out trial; observed (2, 2, n_frames, 6) the trials' own DOF.
+    trials: "built-in" (the participant's trials) or "model" (`model_trials`: no model error).
     """
 
     participant: str
@@ -73,6 +74,7 @@ class Posterior:
     wall_seconds: float
     predictive: np.ndarray
     observed: np.ndarray
+    trials: str = "built-in"
 
     ARRAYS = ("samples", "log_prob", "map_z", "autocorr", "ess", "rhat", "noise", "predictive", "observed")
 
@@ -221,12 +223,54 @@ def split_rhat(chain: np.ndarray) -> np.ndarray:
     return np.sqrt(((n - 1) / n * within + between / n) / within)
 
 
+TRIALS = ("built-in", "model")
+
+
+def model_trials(t: Task, seed: int) -> Task:
+    """A copy of a built-in participant's task whose reference kinematics are the calibration model's own
+    run of the hidden truth on the task's capitate motion, with the synthetic trials' tracking noise
+    (`builtin.tracking_noise`, drawn from `seed`): data without model error, to tell the calibrator's
+    honesty from the model's fidelity."""
+    import copy
+
+    from wrist_env.cost import COST_BONES
+    from wrist_env.model import BONES
+    from wrist_env.participants import builtin
+
+    if t.participant not in builtin.BUILTIN:
+        raise ValueError(f"model trials need a hidden truth; {t.participant!r} is not a built-in participant")
+    run = t.evaluate(builtin.truth(t.participant))
+    if run.failed:
+        raise RuntimeError(f"{t.participant} {t.motion}: the hidden truth's run failed ({run.result.message})")
+    rng = np.random.default_rng([seed, ("calibrate", "validate").index(t.motion)])
+    poses = cost_poses(run.result.poses)
+    out = copy.copy(t)
+    out.reference = np.stack(
+        [builtin.tracking_noise(p, t.model.centroid[BONES.index(b)], rng) for b, p in zip(COST_BONES, poses)]
+    )
+    return out
+
+
+def _tasks(participant: str, trials: str, seed: int) -> tuple[Task, Task]:
+    """The calibration and held-out tasks: the participant's trials or `model_trials`."""
+    if trials not in TRIALS:
+        raise ValueError(f"trials must be one of {TRIALS}, but got {trials!r}")
+    pair = task(participant, "calibrate"), task(participant, "validate")
+    return pair if trials == "built-in" else tuple(model_trials(t, seed) for t in pair)
+
+
 def calibrate(
-    participant: str, seed: int = 0, walkers: int = WALKERS, steps: int = STEPS, progress: bool = False
+    participant: str,
+    seed: int = 0,
+    walkers: int = WALKERS,
+    steps: int = STEPS,
+    progress: bool = False,
+    trials: str = "built-in",
 ) -> Posterior:
-    """Sample the posterior of `participant`'s 22 materials given its calibration trial (see the module doc)."""
+    """Sample the posterior of `participant`'s 22 materials given its calibration trial (see the module doc);
+    trials="model" calibrates against `model_trials` instead."""
     start_time = time.perf_counter()
-    calibration = task(participant, "calibrate")
+    calibration, held_out = _tasks(participant, trials, seed)
     map_z, r, J, runs = map_estimate(calibration, seed=seed)
     rng = np.random.default_rng(seed)
     start = rng.multivariate_normal(map_z, laplace_covariance(r, J), size=walkers)
@@ -236,8 +280,7 @@ def calibrate(
     samples = out["chain"].reshape(-1, design.N_MATERIAL)
     draws = samples[rng.choice(len(samples), PREDICTIVE_DRAWS, replace=False)]
     predictive, observed, noise = [], [], None
-    for motion in ("calibrate", "validate"):
-        t = task(participant, motion)
+    for motion, t in (("calibrate", calibration), ("validate", held_out)):
         evaluations = t.evaluate_batch([design.with_z(design.population(), z) for z in draws])
         counter[0] += len(draws)
         ok = [e for e in evaluations if not e.failed]
@@ -261,6 +304,7 @@ def calibrate(
         time.perf_counter() - start_time,
         np.stack(predictive),
         np.stack(observed),
+        trials,
     )
 
 
@@ -282,35 +326,39 @@ def study(
     progress: bool = True,
     on_run: Callable[[Posterior, bool], object] | None = None,
     report: str | Path | None = None,
+    trials: str = "built-in",
 ):
     """A Bayesian calibration per participant and seed (`out/posterior_<P>_seed<s>.npz/.json`; a run
     already saved is loaded, not rerun), then the coverage table (one row per run: share of the 22 true
     z inside the 50 % and 90 % intervals, recovery of the posterior mean, the MAP and the population
     design, diagnostics) as `out/coverage.csv` and the figures; returns the table.
     on_run(posterior, loaded) is called after each run; report: the folder of the table and figures
-    (default `out`)."""
+    (default `out`); trials: "built-in" or "model" (`model_trials`; files and figures get a `_model`
+    suffix)."""
     import pandas as pd
 
     from wrist_env.figures.posterior import plot_intervals, plot_predictive
     from wrist_env.participants import builtin
 
     out = Path(out)
+    suffix = "" if trials == "built-in" else f"_{trials}"
     rows, posteriors = [], {}
     for participant in participants:
         truth = design.z_scores(builtin.truth(participant)) if participant in builtin.BUILTIN else None
         for seed in range(seeds) if isinstance(seeds, int) else seeds:
-            path = out / f"posterior_{participant}_seed{seed}.npz"
+            path = out / f"posterior_{participant}_seed{seed}{suffix}.npz"
             loaded = path.exists()
             if loaded:
                 post = Posterior.load(path)
             else:
-                post = calibrate(participant, seed, walkers, steps, progress)
+                post = calibrate(participant, seed, walkers, steps, progress, trials)
                 post.save(path)
             if on_run is not None:
                 on_run(post, loaded)
             posteriors.setdefault(participant, []).append(post)
             row = {
                 "participant": participant,
+                "trials": post.trials,
                 "seed": seed,
                 "walkers": walkers,
                 "steps": steps,
@@ -332,11 +380,11 @@ def study(
     table = pd.DataFrame(rows)
     report = out if report is None else Path(report)
     report.mkdir(parents=True, exist_ok=True)
-    table.to_csv(report / "coverage.csv", index=False)
+    table.to_csv(report / f"coverage{suffix}.csv", index=False)
     for participant, posts in posteriors.items():
         truth = design.z_scores(builtin.truth(participant)) if participant in builtin.BUILTIN else None
-        plot_intervals(posts, truth, report / f"posterior_intervals_{participant}.png")
-        plot_predictive(posts[0], report / f"posterior_predictive_{participant}.png")
+        plot_intervals(posts, truth, report / f"posterior_intervals_{participant}{suffix}.png")
+        plot_predictive(posts[0], report / f"posterior_predictive_{participant}{suffix}.png")
     return table
 
 

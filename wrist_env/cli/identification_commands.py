@@ -80,6 +80,7 @@ def _posterior(args) -> int:
         progress=not args.no_progress,
         on_run=report,
         report=args.report,
+        trials="model" if args.model_trials else "built-in",
     )
     if "coverage_90" in table:
         for participant, rows in table.groupby("participant", sort=False):
@@ -149,5 +150,11 @@ def add_commands(command: Callable[..., object]) -> None:
     s.add_argument("--steps", type=int, default=400, help="ensemble steps (default 400)")
     s.add_argument("--out", default="runs/posterior", help="output folder (default runs/posterior)")
     s.add_argument("--report", help="folder of coverage.csv and the figures (default: --out)")
+    s.add_argument(
+        "--model-trials",
+        action="store_true",
+        help="calibrate against the model's own run of the hidden truth plus the trials' tracking noise "
+        "(no model error: tells the calibrator's honesty from the model's fidelity; files get a _model suffix)",
+    )
     s.add_argument("--no-progress", action="store_true", help="no progress bar")
     s.set_defaults(run=_posterior)

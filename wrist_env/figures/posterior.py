@@ -39,7 +39,8 @@ def plot_intervals(posteriors, truth: np.ndarray | None, out: str | Path) -> Pat
     ax.invert_yaxis()
     ax.set(xlabel="z (Table 2 SD from the mean)", xlim=(-3.1, 3.1))
     ax.legend(loc="lower right", fontsize=8)
-    ax.set_title(f"{posteriors[0].participant}: posterior credible intervals (calibration trial)")
+    which = "calibration trial" if posteriors[0].trials == "built-in" else "the model's own run of the truth + noise"
+    ax.set_title(f"{posteriors[0].participant}: posterior credible intervals ({which})")
     fig.tight_layout()
     return save(fig, out)
 
@@ -68,7 +69,8 @@ def plot_predictive(post, out: str | Path) -> Path:
                 ax.tick_params(labelsize=7)
     fig.suptitle(
         f"{post.participant}: the model's kinematics over the posterior (5–95 % band, median; the materials' "
-        f"uncertainty, tracking noise not added; dots: the trial), seed {post.seed}"
+        f"uncertainty, tracking noise not added; dots: the {'trial' if post.trials == 'built-in' else 'model trial'}), "
+        f"seed {post.seed}"
     )
     fig.tight_layout()
     return save(fig, out, dpi=100)

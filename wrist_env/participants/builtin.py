@@ -27,6 +27,8 @@ if TYPE_CHECKING:
     from wrist_env.participants.folder import ParticipantSource
 
 BUILTIN = ("P1", "P2", "P3")
+TRACKING_NOISE_MM, TRACKING_NOISE_DEG = 0.2, 0.5
+"""RMS of the synthetic trials' 4DCT tracking noise: a rigid perturbation of each bone per frame."""
 
 
 @dataclass(frozen=True)
@@ -135,3 +137,19 @@ def source(name: str, fossa_sweep_deg: tuple | None = None) -> ParticipantSource
     return ParticipantSource(
         name, meta, {b: (s.vertices, s.faces) for b, s in surfaces.items()}, trials(name), Path(str(root))
     )
+
+
+def tracking_noise(transforms, centroid, rng):
+    """Poses (n, 4, 4) perturbed by a random rigid motion about the moved centroid (mm) per frame:
+    `TRACKING_NOISE_MM` and `TRACKING_NOISE_DEG` RMS (isotropic), drawn from `rng`."""
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
+    n = len(transforms)
+    turn = Rotation.from_rotvec(rng.normal(0.0, np.radians(TRACKING_NOISE_DEG) / np.sqrt(3), (n, 3))).as_matrix()
+    shift = rng.normal(0.0, TRACKING_NOISE_MM / np.sqrt(3), (n, 3))
+    out = np.array(transforms, dtype=np.float64, copy=True)
+    moved = np.einsum("fij,j->fi", out[:, :3, :3], centroid) + out[:, :3, 3]
+    out[:, :3, :3] = turn @ out[:, :3, :3]
+    out[:, :3, 3] = np.einsum("fij,fj->fi", turn, out[:, :3, 3] - moved) + moved + shift
+    return out
