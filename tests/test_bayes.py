@@ -136,6 +136,10 @@ def test_a_model_trials_study_keeps_its_own_files_and_says_so(built, tmp_path, m
     monkeypatch.setattr(bayes, "calibrate", fake)
     table = bayes.study(["P1"], 2, tmp_path, progress=False, trials="model")
     assert asked == ["model", "model"] and (table.trials == "model").all()
+    # the stand-in's samples all have log posterior 0, above any real design's: the truth ranks 0
+    assert (
+        np.isfinite(table.truth_log_prob).all() and (table.truth_log_prob < 0).all() and (table.truth_rank == 0).all()
+    )
     assert (tmp_path / "coverage_model.csv").exists() and not (tmp_path / "coverage.csv").exists()
     assert bayes.Posterior.load(tmp_path / "posterior_P1_seed1_model.npz").trials == "model"
     assert (tmp_path / "posterior_intervals_P1_model.png").exists()

@@ -330,8 +330,8 @@ def study(
 ):
     """A Bayesian calibration per participant and seed (`out/posterior_<P>_seed<s>.npz/.json`; a run
     already saved is loaded, not rerun), then the coverage table (one row per run: share of the 22 true
-    z inside the 50 % and 90 % intervals, recovery of the posterior mean, the MAP and the population
-    design, diagnostics) as `out/coverage.csv` and the figures; returns the table.
+    z inside the 50 % and 90 % intervals, `truth_rank`, recovery of the posterior mean, the MAP and the
+    population design, diagnostics) as `out/coverage.csv` and the figures; returns the table.
     on_run(posterior, loaded) is called after each run; report: the folder of the table and figures
     (default `out`); trials: "built-in" or "model" (`model_trials`; files and figures get a `_model`
     suffix)."""
@@ -373,6 +373,7 @@ def study(
             if truth is not None:
                 for level in LEVELS:
                     row[f"coverage_{int(level * 100)}"] = float(post.covers(truth, level).mean())
+                row.update(truth_rank(post, truth))
                 row["recovery_mean"] = _rms(post.mean - truth)
                 row["recovery_map"] = _rms(post.map_z - truth)
                 row["recovery_population"] = _rms(truth)
@@ -386,6 +387,16 @@ def study(
         plot_intervals(posts, truth, report / f"posterior_intervals_{participant}{suffix}.png")
         plot_predictive(posts[0], report / f"posterior_predictive_{participant}{suffix}.png")
     return table
+
+
+def truth_rank(post: Posterior, z_true: np.ndarray) -> dict:
+    """{"truth_log_prob": the log posterior of the hidden truth on the run's calibration task,
+    "truth_rank": the share of the kept samples whose log posterior is lower}. A rank near 1 says
+    the chains missed the truth's region although it is as probable as any they visited (a mode
+    the sampler did not find), not that the truth is implausible."""
+    calibration, _ = _tasks(post.participant, post.trials, post.seed)
+    value = float(log_probability(calibration)(z_true[None])[0])
+    return {"truth_log_prob": value, "truth_rank": float(np.mean(post.log_prob < value))}
 
 
 def _rms(v: np.ndarray) -> float:
