@@ -36,7 +36,8 @@ from wrist_env.envs.task import Task, cost_poses, task
 from wrist_env.frames import pose_to_dof
 
 WALKERS = 48
-STEPS = 400
+STEPS = 1200
+"""Ensemble steps: at 300 the chains were overconfident even on the model's own trials (README); ~12 min a run."""
 MAP_STARTS = 8
 FD_STEP_Z = 0.1
 """Forward-difference step of the MAP search's Jacobian (SD units)."""

@@ -147,7 +147,7 @@ def add_commands(command: Callable[..., object]) -> None:
     s.add_argument("participants", nargs="+", help="participant names (`wrist-bench participants` lists them)")
     s.add_argument("--seeds", type=int, default=1, help="runs per participant, seeds 0 .. N-1 (default 1)")
     s.add_argument("--walkers", type=int, default=48, help="ensemble walkers (default 48; >= 44)")
-    s.add_argument("--steps", type=int, default=400, help="ensemble steps (default 400)")
+    s.add_argument("--steps", type=int, default=1200, help="ensemble steps (default 1200 = bayes.STEPS, ~12 min a run)")
     s.add_argument("--out", default="runs/posterior", help="output folder (default runs/posterior)")
     s.add_argument("--report", help="folder of coverage.csv and the figures (default: --out)")
     s.add_argument(
