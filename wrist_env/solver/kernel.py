@@ -106,7 +106,8 @@ def _contact(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, w
 @njit(cache=True, error_model="numpy")
 def _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, rebuild, want_energy=True):
     """Forces F (N), torques T (N·mm), contact stats and bundle forces at the current
-    state; rebuilds the active contact set first if `rebuild`; returns internal energy
+    state; with `rebuild`, every pair's active contact samples are refilled first (otherwise a
+    pair refills when its samples may have moved half the band); returns internal energy
     (N·mm; 0 unless `want_energy`)."""
     R, x, v, w, nodes, _ = state
     active, n_active, ref, F, T, node_force, stats, bundle = work
