@@ -10,25 +10,73 @@ from wrist_env import bayes, design
 from wrist_env.cli import main
 
 
-def test_the_sampler_recovers_a_linear_gaussian_posterior():
+def _linear_gaussian():
     """y = A z + ε, ε ~ N(0, 0.5²), prior N(0, I) in 4 dimensions: the posterior is N(m, C) with
-    C = (AᵀA / 0.25 + I)⁻¹, m = C Aᵀ y / 0.25. The sampled mean is within 0.1 posterior SD of m and
-    each SD within 10 % of √diag C; R̂ < 1.05."""
+    C = (AᵀA / 0.25 + I)⁻¹, m = C Aᵀ y / 0.25, and with the likelihood's normaliser left out the
+    evidence is log ∫ L(z) N(z; 0, I) dz = ½ log det C − ½ (Σ y² / 0.25 − mᵀ C⁻¹ m).
+    Returns (log likelihood, m, C, log evidence)."""
     rng = np.random.default_rng(1)
     A = rng.normal(size=(12, 4)) * np.array([3.0, 1.0, 0.3, 0.05])  # from well to hardly identified
     y = A @ rng.normal(size=4) + rng.normal(0, 0.5, 12)
     C = np.linalg.inv(A.T @ A / 0.25 + np.eye(4))
+
+    def log_like(Z):
+        return -0.5 * np.sum((y - Z @ A.T) ** 2, axis=1) / 0.25
+
     m = C @ A.T @ y / 0.25
+    log_evidence = 0.5 * np.linalg.slogdet(C)[1] - 0.5 * (y @ y / 0.25 - m @ np.linalg.solve(C, m))
+    return log_like, m, C, log_evidence
 
-    def log_prob(Z):
-        return -0.5 * np.sum((y - Z @ A.T) ** 2, axis=1) / 0.25 - 0.5 * np.sum(Z**2, axis=1)
 
-    out = bayes.sample(log_prob, rng.normal(size=(32, 4)), 4000, seed=0)
+def test_the_sampler_recovers_a_linear_gaussian_posterior():
+    """emcee on the closed-form posterior: the sampled mean is within 0.1 posterior SD of m and each
+    SD within 10 % of √diag C; R̂ < 1.05."""
+    log_like, m, C, _ = _linear_gaussian()
+    out = bayes.sample(
+        lambda Z: log_like(Z) - 0.5 * np.sum(Z**2, axis=1), np.random.default_rng(0).normal(size=(32, 4)), 4000, seed=0
+    )
     samples = out["chain"].reshape(-1, 4)
     sd = np.sqrt(np.diag(C))
     assert np.all(np.abs(samples.mean(axis=0) - m) < 0.1 * sd), (samples.mean(axis=0) - m) / sd
     np.testing.assert_allclose(samples.std(axis=0), sd, rtol=0.1)
     assert np.all(out["rhat"] < 1.05) and np.all(out["ess"] > 500)
+
+
+def test_smc_recovers_a_linear_gaussian_posterior_and_its_evidence():
+    """SMC from the prior (truncated at |z| ≤ 3, which holds 99.7 % of each N(0, 1)) on the same
+    posterior: mean within 0.15 posterior SD, SDs within 15 %, log evidence within 0.3 of the closed form."""
+    log_like, m, C, log_evidence = _linear_gaussian()
+    out = bayes.sample_smc(log_like, 4, particles=2000, mcmc_steps=10, seed=0)
+    sd = np.sqrt(np.diag(C))
+    samples = out["samples"]
+    assert samples.shape == (2000, 4) and out["phi"][0] == 0 and out["phi"][-1] == 1
+    assert np.all(np.abs(samples.mean(axis=0) - m) < 0.15 * sd), (samples.mean(axis=0) - m) / sd
+    np.testing.assert_allclose(samples.std(axis=0), sd, rtol=0.15)
+    np.testing.assert_allclose(out["log_likelihood"], log_like(samples))
+    assert abs(out["log_evidence"] - log_evidence) < 0.3, (out["log_evidence"], log_evidence)
+    assert np.all((out["acceptance"] > 0) & (out["acceptance"] <= 1))
+
+
+def test_emcee_spreads_over_a_slack_ligaments_plateau():
+    """A hinge, as a reference strain makes a ligament slack: the likelihood of z₀ is flat up to 0.5
+    and falls off a cliff beyond, z₁ is well identified; walkers start in a tight ball at the hinge
+    (as from a MAP where the ligament just engages). z₀'s sampled 5/50/95 % quantiles match the exact
+    marginal (the prior truncated by the cliff, by quadrature) within 0.1 SD."""
+    from scipy.stats import norm
+
+    def log_prob(Z):
+        cliff = -50.0 * np.clip(Z[:, 0] - 0.5, 0.0, None) ** 2
+        inside = np.all(np.abs(Z) <= 3, axis=1)
+        value = cliff - 0.5 * ((Z[:, 1] - 1.0) / 0.1) ** 2 - 0.5 * np.sum(Z**2, axis=1)
+        return np.where(inside, value, -np.inf)
+
+    start = np.array([0.5, 1.0]) + 0.01 * np.random.default_rng(0).normal(size=(32, 2))
+    samples = bayes.sample(log_prob, start, 3000, seed=0)["chain"].reshape(-1, 2)
+    x = np.linspace(-3, 3, 60_001)
+    density = norm.pdf(x) * np.exp(-50.0 * np.clip(x - 0.5, 0.0, None) ** 2)
+    cdf = np.cumsum(density) / density.sum()
+    exact = np.interp([0.05, 0.5, 0.95], cdf, x)
+    np.testing.assert_allclose(np.quantile(samples[:, 0], [0.05, 0.5, 0.95]), exact, atol=0.1)
 
 
 def test_split_rhat_flags_chains_that_disagree():
@@ -45,7 +93,8 @@ def test_the_command_samples_p1_and_writes_coverage_and_figures(built, tmp_path,
     """`wrist-bench posterior P1` with a short chain: a saved posterior per seed, coverage in [0, 1],
     the intervals and predictive figures; rerun, it loads instead of sampling."""
     built("P1")
-    args = ["posterior", "P1", "--seeds", "1", "--walkers", "48", "--steps", "8", "--out", str(tmp_path)]
+    args = ["posterior", "P1", "--seeds", "1", "--walkers", "48", "--steps", "8", "--map-starts", "2"]
+    args += ["--out", str(tmp_path)]
     assert main(args) == 0
     import pandas as pd
 
@@ -59,6 +108,58 @@ def test_the_command_samples_p1_and_writes_coverage_and_figures(built, tmp_path,
     capsys.readouterr()
     assert main(args) == 0
     assert "loaded" in capsys.readouterr().out
+
+
+def test_smc_from_a_defensive_start_off_the_mode_recovers_the_same_posterior():
+    """The geometric bridge from a `DefensiveStart` centred 1 posterior SD off the mean, with half the
+    covariance: the same closed-form posterior and evidence as from the prior."""
+    log_like, m, C, log_evidence = _linear_gaussian()
+    sd = np.sqrt(np.diag(C))
+    out = bayes.sample_smc(log_like, 4, 2000, 10, seed=0, start=bayes.DefensiveStart(m + sd, 0.5 * C))
+    samples = out["samples"]
+    assert np.all(np.abs(samples.mean(axis=0) - m) < 0.15 * sd), (samples.mean(axis=0) - m) / sd
+    np.testing.assert_allclose(samples.std(axis=0), sd, rtol=0.15)
+    assert abs(out["log_evidence"] - log_evidence) < 0.3, (out["log_evidence"], log_evidence)
+
+
+def test_the_defensive_start_is_a_normalized_density_on_the_prior_box():
+    """Its density integrates to 1 over |z| ≤ 3 (a 2-D grid; the t is centred near the edge, so its
+    truncation matters), its draws stay in the box, and 20 % of them follow the prior."""
+    start = bayes.DefensiveStart(np.array([2.5, -1.0]), np.array([[0.3, 0.1], [0.1, 0.2]]))
+    g = np.linspace(-3, 3, 601)
+    grid = np.stack(np.meshgrid(g, g), axis=-1).reshape(-1, 2)
+    assert np.exp(start.logpdf(grid)).sum() * (g[1] - g[0]) ** 2 == pytest.approx(1.0, abs=0.01)
+    assert start.logpdf(np.array([[3.1, 0.0]]))[0] == -np.inf
+    draws = start.rvs(100_000, random_state=1)
+    assert draws.shape == (100_000, 2) and np.all(np.abs(draws) <= 3)
+    # the t puts almost nothing below z₀ = −2 (its centre 2.5, SD ≈ 0.8); the prior puts 2.15 % there
+    assert np.mean(draws[:, 0] < -2) == pytest.approx(bayes.PRIOR_SHARE * 0.02146, abs=0.0008)
+
+
+@pytest.mark.slow
+def test_the_command_runs_smc_and_keeps_its_own_files(built, tmp_path, capsys):
+    """`wrist-bench posterior P1 --sampler smc` with few particles: an `_smc` posterior of `particles`
+    samples that all satisfy the prior box, each with its own log posterior, stages and evidence in
+    its JSON, an `_smc` table."""
+    built("P1")
+    args = ["posterior", "P1", "--sampler", "smc", "--particles", "44", "--mcmc-steps", "1", "--map-starts", "2"]
+    args += ["--out", str(tmp_path)]
+    assert main(args) == 0
+    post = bayes.Posterior.load(tmp_path / "posterior_P1_seed0_smc.npz")
+    assert post.sampler == "smc" and post.samples.shape == (44, design.N_MATERIAL)
+    assert np.all(np.abs(post.samples) <= 3) and post.stages >= 1 and np.isfinite(post.log_evidence)
+    assert post.evaluations >= 44 * (post.stages + 1) and np.all(np.isnan(post.rhat))
+    # the stored log posterior is the particle's own (prior included); within 1 nat, as the samples are
+    # stored in float32 and the solver's stopping rule makes the likelihood rough at that scale (README)
+    best = post.samples[np.argmax(post.log_prob)]
+    assert post.log_prob.max() == pytest.approx(
+        float(bayes.log_probability(bayes._tasks("P1", "built-in", 0)[0])(best[None])[0]), abs=1.0
+    )
+    import pandas as pd
+
+    table = pd.read_csv(tmp_path / "coverage_smc.csv")
+    assert table.sampler.tolist() == ["smc"] and table.particles.tolist() == [44] and table.stages[0] == post.stages
+    assert "distinct particles" in capsys.readouterr().out
 
 
 def test_the_laplace_covariance_takes_the_noise_the_fit_implies():
@@ -123,7 +224,7 @@ def test_a_model_trials_study_keeps_its_own_files_and_says_so(built, tmp_path, m
     asked = []
     n_frames = 15
 
-    def fake(participant, seed, walkers, steps, progress, trials):
+    def fake(participant, seed, progress, trials, **settings):
         asked.append(trials)
         rng = np.random.default_rng(seed)
         zeros = np.zeros(design.N_MATERIAL)

@@ -55,8 +55,18 @@ def _posterior(args) -> int:
     from wrist_env.participants import registry
 
     registry.require(*args.participants)
-    if args.walkers < 44 or args.steps < 4 or args.seeds < 1:
-        raise SystemExit("wrist-bench posterior: needs --walkers >= 44 (2 x 22), --steps >= 4 and --seeds >= 1")
+    if (
+        args.walkers < 44
+        or args.steps < 4
+        or args.seeds < 1
+        or args.particles < 44
+        or args.mcmc_steps < 1
+        or args.map_starts < 1
+    ):
+        raise SystemExit(
+            "wrist-bench posterior: needs --walkers >= 44 (2 x 22), --steps >= 4, --particles >= 44, "
+            "--mcmc-steps >= 1, --map-starts >= 1, 0 <= --prior-refresh < 1 and --seeds >= 1"
+        )
 
     def report(post, loaded):
         how = (
@@ -64,10 +74,14 @@ def _posterior(args) -> int:
             if loaded
             else f"sampled in {post.wall_seconds / 60:.1f} min ({post.evaluations} simulations),"
         )
+        mixing = (
+            f"ESS min {np.nanmin(post.ess):.0f}, split R-hat max {np.nanmax(post.rhat):.2f}"
+            if post.sampler == "emcee"
+            else f"{post.stages} stages, {post.ess[0]:.0f} distinct particles, log evidence {post.log_evidence:.1f}"
+        )
         print(
             f"{post.participant} seed {post.seed}: {how} {args.out}; acceptance {post.acceptance:.2f}, "
-            f"ESS min {np.nanmin(post.ess):.0f}, split R-hat max {np.nanmax(post.rhat):.2f}, noise "
-            f"{post.noise[0]:.2f} mm / {post.noise[1]:.2f} deg",
+            f"{mixing}, noise {post.noise[0]:.2f} mm / {post.noise[1]:.2f} deg",
             flush=True,
         )
 
@@ -81,6 +95,11 @@ def _posterior(args) -> int:
         on_run=report,
         report=args.report,
         trials="model" if args.model_trials else "built-in",
+        sampler=args.sampler,
+        particles=args.particles,
+        mcmc_steps=args.mcmc_steps,
+        map_starts=args.map_starts,
+        prior_refresh_share=args.prior_refresh,
     )
     if "coverage_90" in table:
         for participant, rows in table.groupby("participant", sort=False):
@@ -135,19 +154,42 @@ def add_commands(command: Callable[..., object]) -> None:
 
     s = command(
         "posterior",
-        help="Bayesian calibration: the posterior of the 22 materials given the calibration trial (emcee)",
+        help="Bayesian calibration: the posterior of the 22 materials given the calibration trial (emcee or SMC)",
         description="Samples the posterior of the 22 ligament materials (Table 2 prior, z units) given the "
-        "participant's calibration trial, with the translation and rotation noise scales integrated out, by "
-        "emcee's ensemble MCMC (one batched solver call per step, walkers x steps simulations; the first half "
-        "is burn-in), started around the MAP. Per participant and seed it saves the samples and diagnostics "
-        "(.npz + .json; a saved run is loaded, not rerun) and posterior predictive kinematics of both trials; "
-        "for built-in participants, the coverage of the 50 %% and 90 %% credible intervals of the hidden "
-        "truth (coverage.csv) and a figure of the intervals against the truth.",
+        "participant's calibration trial, with the translation and rotation noise scales integrated out, from "
+        "the MAP (the best of --map-starts trust-region Gauss-Newton runs): by emcee's ensemble MCMC (one batched "
+        "solver call per step, walkers x steps simulations; the first half is burn-in) or by SMCPy's adaptive "
+        "tempered SMC bridging from a heavy-tailed start around the MAP (--sampler smc). Per participant and "
+        "seed it saves the samples and diagnostics (.npz + .json; a saved run is loaded, not rerun) and "
+        "posterior predictive kinematics of both trials; for built-in participants, the coverage of the 50 % "
+        "and 90 % credible intervals of the hidden truth (coverage.csv) and a figure of the intervals against "
+        "the truth.",
     )
     s.add_argument("participants", nargs="+", help="participant names (`wrist-bench participants` lists them)")
     s.add_argument("--seeds", type=int, default=1, help="runs per participant, seeds 0 .. N-1 (default 1)")
     s.add_argument("--walkers", type=int, default=48, help="ensemble walkers (default 48; >= 44)")
     s.add_argument("--steps", type=int, default=1200, help="ensemble steps (default 1200 = bayes.STEPS, ~12 min a run)")
+    s.add_argument(
+        "--sampler",
+        choices=("emcee", "smc"),
+        default="emcee",
+        help="emcee (ensemble MCMC from the MAP; default) or smc (SMCPy's adaptive tempered SMC from the prior; "
+        "files get a _smc suffix)",
+    )
+    s.add_argument("--particles", type=int, default=256, help="SMC particles (default 256 = bayes.PARTICLES; >= 44)")
+    s.add_argument("--mcmc-steps", type=int, default=5, help="SMC random-walk steps per particle and stage (default 5)")
+    s.add_argument(
+        "--map-starts",
+        type=int,
+        default=24,
+        help="Gauss-Newton starts of the MAP search that both samplers start from (default 24 = bayes.MAP_STARTS)",
+    )
+    s.add_argument(
+        "--prior-refresh",
+        type=float,
+        default=0.2,
+        help="emcee's share of moves that redraw one material from its prior (default 0.2 = bayes.PRIOR_REFRESH)",
+    )
     s.add_argument("--out", default="runs/posterior", help="output folder (default runs/posterior)")
     s.add_argument("--report", help="folder of coverage.csv and the figures (default: --out)")
     s.add_argument(
