@@ -57,7 +57,7 @@ def test_smc_recovers_a_linear_gaussian_posterior_and_its_evidence():
     assert np.all((out["acceptance"] > 0) & (out["acceptance"] <= 1))
 
 
-def test_emcee_spreads_over_a_slack_ligaments_plateau():
+def test_emcee_with_the_prior_refresh_keeps_a_hinges_exact_marginal():
     """A hinge, as a reference strain makes a ligament slack: the likelihood of z₀ is flat up to 0.5
     and falls off a cliff beyond, z₁ is well identified; walkers start in a tight ball at the hinge
     (as from a MAP where the ligament just engages). z₀'s sampled 5/50/95 % quantiles match the exact

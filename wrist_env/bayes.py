@@ -233,12 +233,10 @@ def prior_refresh(coords: np.ndarray, random) -> tuple[np.ndarray, np.ndarray]:
     a Metropolis-within-Gibbs independence move. Returns the proposal (W, 22) and the Hastings
     factors log π(old) − log π(new), which cancel the prior in the acceptance: a ligament that is
     slack over a range of its reference strain is accepted anywhere in that range in one move."""
-    from scipy.stats import truncnorm
-
     n, dim = coords.shape
     rows, which = np.arange(n), random.randint(dim, size=n)
     old = coords[rows, which]
-    new = truncnorm.rvs(-posterior.BOUND_Z, posterior.BOUND_Z, size=n, random_state=random)
+    new = posterior.material_prior().rvs(size=n, random_state=random)
     factors = np.where(np.abs(old) <= posterior.BOUND_Z, 0.5 * (new**2 - old**2), -np.inf)
     out = coords.copy()
     out[rows, which] = new
@@ -292,11 +290,11 @@ class DefensiveStart:
     Laplace approximation misses. rvs(n, random_state) → (n, 22); logpdf(x (n, 22)) → (n,), normalized."""
 
     def __init__(self, mean: np.ndarray, cov: np.ndarray):
-        from scipy.stats import multivariate_t, truncnorm
+        from scipy.stats import multivariate_t
 
         self.student = multivariate_t(mean, START_SCALE**2 * cov, df=START_DF)
-        self.prior = truncnorm(-posterior.BOUND_Z, posterior.BOUND_Z)
-        inside = _inside(self.student.rvs(100_000, random_state=np.random.default_rng(0)))
+        self.prior = posterior.material_prior()
+        inside = posterior.in_box(self.student.rvs(100_000, random_state=np.random.default_rng(0)))
         self.log_inside = np.log(max(inside.mean(), 1e-5))  # the truncated t's normalizer, Monte Carlo
 
     def rvs(self, n: int, random_state=None) -> np.ndarray:
@@ -306,7 +304,7 @@ class DefensiveStart:
         draws = np.empty((0, out.shape[1]))
         while len(draws) < len(from_t):
             batch = self.student.rvs(4 * len(from_t) + 16, random_state=rng)
-            draws = np.vstack([draws, batch[_inside(batch)]])
+            draws = np.vstack([draws, batch[posterior.in_box(batch)]])
         out[from_t] = draws[: len(from_t)]
         return out
 
@@ -314,11 +312,7 @@ class DefensiveStart:
         x = np.atleast_2d(x)
         student = np.log1p(-PRIOR_SHARE) + self.student.logpdf(x) - self.log_inside
         prior = np.log(PRIOR_SHARE) + self.prior.logpdf(x).sum(axis=1)
-        return np.where(_inside(x), np.logaddexp(student, prior), -np.inf)
-
-
-def _inside(x: np.ndarray) -> np.ndarray:
-    return np.all(np.abs(x) <= posterior.BOUND_Z, axis=-1)
+        return np.where(posterior.in_box(x), np.logaddexp(student, prior), -np.inf)
 
 
 def sample_smc(
@@ -333,7 +327,6 @@ def sample_smc(
     (particles, dim), "log_likelihood" (particles,), "phi" (stages + 1,), "acceptance" (stages,): the
     share of particles each stage's moves changed, "log_evidence"}.
     """
-    from scipy.stats import truncnorm
     from smcpy import AdaptiveSampler, VectorMCMC, VectorMCMCKernel
     from smcpy.paths import GeometricPath
 
@@ -345,7 +338,7 @@ def sample_smc(
             out = np.asarray(self.model(inputs), dtype=np.float64)
             return np.where(np.isfinite(out), out, FAILED_LOG_LIKELIHOOD)
 
-    priors = [truncnorm(-posterior.BOUND_Z, posterior.BOUND_Z) for _ in range(dim)]
+    priors = [posterior.material_prior() for _ in range(dim)]
     mcmc = VectorMCMC(log_like, None, priors, log_like_func=Batched)
     names = [f"z{i}" for i in range(dim)]
     path = GeometricPath(proposal=start)
@@ -519,12 +512,11 @@ def study(
 
     out = Path(out)
     suffix = ("" if trials == "built-in" else f"_{trials}") + ("" if sampler == "emcee" else f"_{sampler}")
-    size = (
+    size = (  # the table's columns
         {"walkers": walkers, "steps": steps}
         if sampler == "emcee"
         else {"particles": particles, "mcmc_steps": mcmc_steps}
     )
-    settings = {**size, "prior_refresh_share": prior_refresh_share} if sampler == "emcee" else size
     rows, posteriors = [], {}
     for participant in participants:
         truth = design.z_scores(builtin.truth(participant)) if participant in builtin.BUILTIN else None
@@ -540,8 +532,12 @@ def study(
                     progress=progress,
                     trials=trials,
                     sampler=sampler,
+                    walkers=walkers,
+                    steps=steps,
+                    particles=particles,
+                    mcmc_steps=mcmc_steps,
                     map_starts=map_starts,
-                    **settings,
+                    prior_refresh_share=prior_refresh_share,
                 )
                 post.save(path)
             if on_run is not None:

@@ -63,11 +63,22 @@ def residuals(task: Task, poses: np.ndarray, reference: np.ndarray | None = None
     return np.stack(out)
 
 
+def in_box(z: ArrayLike) -> np.ndarray:
+    """Whether z (..., 22) lies in the prior's box |z| ≤ 3, shape (...)."""
+    return np.all(np.abs(np.asarray(z, dtype=np.float64)) <= BOUND_Z, axis=-1)
+
+
+def material_prior():
+    """One material's prior as a frozen SciPy distribution: N(0, 1) truncated to |z| ≤ 3 (normalized)."""
+    from scipy.stats import truncnorm
+
+    return truncnorm(-BOUND_Z, BOUND_Z)
+
+
 def log_prior(z: ArrayLike) -> np.ndarray:
     """Log density (..., ) of z (..., 22) under the population prior, up to a constant; −inf outside |z| ≤ 3."""
     z = np.asarray(z, dtype=np.float64)
-    inside = np.all(np.abs(z) <= BOUND_Z, axis=-1)
-    return np.where(inside, -0.5 * np.sum(z**2, axis=-1), -np.inf)
+    return np.where(in_box(z), -0.5 * np.sum(z**2, axis=-1), -np.inf)
 
 
 def map_objective(task: Task, evaluation: Evaluation, z: ArrayLike) -> float:
