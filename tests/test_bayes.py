@@ -244,3 +244,18 @@ def test_a_model_trials_study_keeps_its_own_files_and_says_so(built, tmp_path, m
     assert (tmp_path / "coverage_model.csv").exists() and not (tmp_path / "coverage.csv").exists()
     assert bayes.Posterior.load(tmp_path / "posterior_P1_seed1_model.npz").trials == "model"
     assert (tmp_path / "posterior_intervals_P1_model.png").exists()
+
+
+@pytest.mark.parametrize("bad", [["--prior-refresh", "1"], ["--walkers", "40"], ["--map-starts", "0"]])
+def test_the_command_refuses_sampler_settings_out_of_range(bad, capsys):
+    with pytest.raises(SystemExit, match="--prior-refresh < 1"):
+        main(["posterior", "P1", *bad])
+
+
+def test_the_commands_defaults_are_the_samplers_own(capsys):
+    with pytest.raises(SystemExit):
+        main(["posterior", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    for flag, value in [("--steps", bayes.STEPS), ("--map-starts", bayes.MAP_STARTS)]:
+        assert f"{flag.upper().lstrip('-').replace('-', '_')} " in text and f"default {value}" in text
+    assert f"(default {bayes.PRIOR_REFRESH})" in text

@@ -62,6 +62,7 @@ def _posterior(args) -> int:
         or args.particles < 44
         or args.mcmc_steps < 1
         or args.map_starts < 1
+        or not 0 <= args.prior_refresh < 1
     ):
         raise SystemExit(
             "wrist-bench posterior: needs --walkers >= 44 (2 x 22), --steps >= 4, --particles >= 44, "
@@ -117,6 +118,7 @@ def _posterior(args) -> int:
 
 
 def add_commands(command: Callable[..., object]) -> None:
+    from wrist_env import bayes  # the sampler's defaults have one owner (its import adds ~0.1 s to wrist_env's)
 
     s = command(
         "sensitivity",
@@ -167,28 +169,33 @@ def add_commands(command: Callable[..., object]) -> None:
     )
     s.add_argument("participants", nargs="+", help="participant names (`wrist-bench participants` lists them)")
     s.add_argument("--seeds", type=int, default=1, help="runs per participant, seeds 0 .. N-1 (default 1)")
-    s.add_argument("--walkers", type=int, default=48, help="ensemble walkers (default 48; >= 44)")
-    s.add_argument("--steps", type=int, default=1200, help="ensemble steps (default 1200 = bayes.STEPS, ~12 min a run)")
+    s.add_argument("--walkers", type=int, default=bayes.WALKERS, help="ensemble walkers (default %(default)s; >= 44)")
+    s.add_argument("--steps", type=int, default=bayes.STEPS, help="ensemble steps (default %(default)s, ~12 min a run)")
     s.add_argument(
         "--sampler",
         choices=("emcee", "smc"),
         default="emcee",
-        help="emcee (ensemble MCMC from the MAP; default) or smc (SMCPy's adaptive tempered SMC from the prior; "
+        help="emcee (ensemble MCMC from the MAP; default) or smc (SMCPy's adaptive tempered SMC from a heavy-tailed start around the MAP; "
         "files get a _smc suffix)",
     )
-    s.add_argument("--particles", type=int, default=256, help="SMC particles (default 256 = bayes.PARTICLES; >= 44)")
-    s.add_argument("--mcmc-steps", type=int, default=5, help="SMC random-walk steps per particle and stage (default 5)")
+    s.add_argument("--particles", type=int, default=bayes.PARTICLES, help="SMC particles (default %(default)s; >= 44)")
+    s.add_argument(
+        "--mcmc-steps",
+        type=int,
+        default=bayes.MCMC_STEPS,
+        help="SMC random-walk steps per particle and stage (default %(default)s)",
+    )
     s.add_argument(
         "--map-starts",
         type=int,
-        default=24,
-        help="Gauss-Newton starts of the MAP search that both samplers start from (default 24 = bayes.MAP_STARTS)",
+        default=bayes.MAP_STARTS,
+        help="Gauss-Newton starts of the MAP search that both samplers start from (default %(default)s)",
     )
     s.add_argument(
         "--prior-refresh",
         type=float,
-        default=0.2,
-        help="emcee's share of moves that redraw one material from its prior (default 0.2 = bayes.PRIOR_REFRESH)",
+        default=bayes.PRIOR_REFRESH,
+        help="emcee's share of moves that redraw one material from its prior (default %(default)s)",
     )
     s.add_argument("--out", default="runs/posterior", help="output folder (default runs/posterior)")
     s.add_argument("--report", help="folder of coverage.csv and the figures (default: --out)")
