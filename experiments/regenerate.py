@@ -8,11 +8,11 @@ need the `[nevergrad]` extra) with its IOHanalyzer files (`[ioh]`), and the full
 Monte Carlo study (P1 + P2, 2 × 12,500) with its report, what a trial identifies (Morris and Sobol
 sensitivity and the Fisher matrix at the hidden truth, P1–P3), the best calibrators with and without
 the prior (`leaderboards/prior/`) and the Bayesian calibrator's coverage on the trials and on the
-model's own trials (`leaderboards/posterior/`: emcee as committed, with 8 MAP starts; SMC on the
-model's trials). The studies' run logs go to a fresh
+model's own trials (`leaderboards/posterior/`: emcee at 300 steps with the default 24 MAP starts
+and prior refresh; SMC on the model's trials). The studies' run logs go to a fresh
 folder `runs/regenerate-<commit>/` (a killed run resumes there when rerun at the same commit).
 
-Run: `python experiments/regenerate.py` (~3 h 30 min on a 2-core machine); `--figures-only` skips the
+Run: `python experiments/regenerate.py` (~4 h on a 2-core machine); `--figures-only` skips the
 studies (~6 min).
 """
 
@@ -66,15 +66,13 @@ def steps(runs: Path, figures_only: bool) -> list[list[str]]:
         ],
         [
             "posterior",
-            *("P1", "P2", "P3", "--seeds", "3", "--walkers", "48", "--steps", "300", "--map-starts", "8"),
-            *("--prior-refresh", "0"),
+            *("P1", "P2", "P3", "--seeds", "3", "--steps", "300"),
             *("--out", str(runs / "posterior"), "--report", "leaderboards/posterior"),
         ],
         [
             "posterior",
-            *("P1", "P2", "P3", "--seeds", "3", "--walkers", "48", "--steps", "300", "--map-starts", "8"),
-            *("--prior-refresh", "0"),
-            *("--model-trials", "--out", str(runs / "posterior"), "--report", "leaderboards/posterior"),
+            *("P1", "P2", "P3", "--seeds", "3", "--steps", "300", "--model-trials"),
+            *("--out", str(runs / "posterior"), "--report", "leaderboards/posterior"),
         ],
         [
             "posterior",

@@ -105,9 +105,12 @@ def test_the_command_samples_p1_and_writes_coverage_and_figures(built, tmp_path,
     post = bayes.Posterior.load(tmp_path / "posterior_P1_seed0.npz")
     assert post.samples.shape == (4 * 48, design.N_MATERIAL) and post.predictive.shape[:3] == (2, 3, 2)
     assert json.loads((tmp_path / "posterior_P1_seed0.json").read_text())["evaluations"] == post.evaluations
+    assert post.settings == {"walkers": 48, "steps": 8, "map_starts": 2, "prior_refresh": bayes.PRIOR_REFRESH}
     capsys.readouterr()
     assert main(args) == 0
     assert "loaded" in capsys.readouterr().out
+    assert main([*args, "--prior-refresh", "0"]) == 2  # a saved run is not taken for one with other settings
+    assert "posterior_P1_seed0.npz was sampled with" in capsys.readouterr().err
 
 
 def test_smc_from_a_defensive_start_off_the_mode_recovers_the_same_posterior():

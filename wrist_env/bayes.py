@@ -42,6 +42,7 @@ import numpy as np
 
 from wrist_env import design, posterior
 from wrist_env.envs.task import Task, cost_poses, task
+from wrist_env.errors import StoreError
 from wrist_env.frames import pose_to_dof
 
 WALKERS = 48
@@ -85,6 +86,7 @@ class Posterior:
     calibration and held-out trial; observed (2, 2, n_frames, 6) the trials' own DOF.
     trials: "built-in" (the participant's trials) or "model" (`model_trials`: no model error).
     sampler: "emcee" or "smc"; log_evidence and stages: SMC's log marginal likelihood and tempering stages.
+    settings: the sampler's settings (`sampler_settings`); None in files saved before they were recorded.
     """
 
     participant: str
@@ -105,6 +107,7 @@ class Posterior:
     sampler: str = "emcee"
     log_evidence: float = float("nan")
     stages: int = 0
+    settings: dict | None = None
 
     ARRAYS = ("samples", "log_prob", "map_z", "autocorr", "ess", "rhat", "noise", "predictive", "observed")
 
@@ -468,7 +471,23 @@ def calibrate(
         trials,
         sampler,
         **extra,
+        settings=sampler_settings(sampler, walkers, steps, particles, mcmc_steps, map_starts, prior_refresh_share),
     )
+
+
+def sampler_settings(
+    sampler: str,
+    walkers: int = WALKERS,
+    steps: int = STEPS,
+    particles: int = PARTICLES,
+    mcmc_steps: int = MCMC_STEPS,
+    map_starts: int = MAP_STARTS,
+    prior_refresh_share: float = PRIOR_REFRESH,
+) -> dict:
+    """The settings that shape a run of `sampler` (a saved run records them; the study's table lists them)."""
+    if sampler == "emcee":
+        return {"walkers": walkers, "steps": steps, "map_starts": map_starts, "prior_refresh": prior_refresh_share}
+    return {"particles": particles, "mcmc_steps": mcmc_steps, "map_starts": map_starts}
 
 
 def _dof(t: Task, poses: np.ndarray) -> np.ndarray:
@@ -501,8 +520,8 @@ def study(
     z inside the 50 % and 90 % intervals, `truth_rank`, recovery of the posterior mean, the MAP and the
     population design, diagnostics) as `out/coverage.csv` and the figures; returns the table.
     on_run(posterior, loaded) is called after each run; report: the folder of the table and figures
-    (default `out`); trials: "built-in" or "model" (`model_trials`; files and figures get a `_model`
-    suffix); sampler: "emcee" (walkers, steps) or "smc" (particles, mcmc_steps; suffix `_smc`);
+    (default `out`); a saved run sampled with other settings is an error; trials: "built-in" or "model"
+    (`model_trials`; files and figures get a `_model` suffix); sampler: "emcee" (walkers, steps) or "smc" (particles, mcmc_steps; suffix `_smc`);
     map_starts: Gauss–Newton starts of the MAP search; prior_refresh_share: emcee's share of
     `prior_refresh` moves."""
     import pandas as pd
@@ -512,11 +531,7 @@ def study(
 
     out = Path(out)
     suffix = ("" if trials == "built-in" else f"_{trials}") + ("" if sampler == "emcee" else f"_{sampler}")
-    size = (  # the table's columns
-        {"walkers": walkers, "steps": steps}
-        if sampler == "emcee"
-        else {"particles": particles, "mcmc_steps": mcmc_steps}
-    )
+    settings = sampler_settings(sampler, walkers, steps, particles, mcmc_steps, map_starts, prior_refresh_share)
     rows, posteriors = [], {}
     for participant in participants:
         truth = design.z_scores(builtin.truth(participant)) if participant in builtin.BUILTIN else None
@@ -525,6 +540,11 @@ def study(
             loaded = path.exists()
             if loaded:
                 post = Posterior.load(path)
+                if post.settings is not None and post.settings != settings:
+                    raise StoreError(
+                        f"{path} was sampled with {post.settings}, not the {settings} asked for: "
+                        "delete it or choose another output folder"
+                    )
             else:
                 post = calibrate(
                     participant,
@@ -548,7 +568,7 @@ def study(
                 "trials": post.trials,
                 "seed": seed,
                 "sampler": post.sampler,
-                **size,
+                **settings,
                 "evaluations": post.evaluations,
                 "wall_seconds": round(post.wall_seconds, 1),
                 "acceptance": post.acceptance,
