@@ -521,8 +521,8 @@ def study(
     population design, diagnostics) as `out/coverage.csv` and the figures; returns the table.
     on_run(posterior, loaded) is called after each run; report: the folder of the table and figures
     (default `out`); a saved run sampled with other settings is an error; trials: "built-in" or "model"
-    (`model_trials`; files and figures get a `_model` suffix); sampler: "emcee" (walkers, steps) or "smc" (particles, mcmc_steps; suffix `_smc`);
-    map_starts: Gauss–Newton starts of the MAP search; prior_refresh_share: emcee's share of
+    (`model_trials`; files and figures get a `_model` suffix); sampler: "emcee" (walkers, steps) or
+    "smc" (particles, mcmc_steps; suffix `_smc`); map_starts: Gauss–Newton starts of the MAP search; prior_refresh_share: emcee's share of
     `prior_refresh` moves."""
     import pandas as pd
 

@@ -173,10 +173,10 @@ def add_commands(command: Callable[..., object]) -> None:
     s.add_argument("--steps", type=int, default=bayes.STEPS, help="ensemble steps (default %(default)s, ~12 min a run)")
     s.add_argument(
         "--sampler",
-        choices=("emcee", "smc"),
-        default="emcee",
-        help="emcee (ensemble MCMC from the MAP; default) or smc (SMCPy's adaptive tempered SMC from a heavy-tailed start around the MAP; "
-        "files get a _smc suffix)",
+        choices=bayes.SAMPLERS,
+        default=bayes.SAMPLERS[0],
+        help="emcee (ensemble MCMC from the MAP; default) or smc (SMCPy's adaptive tempered SMC from a "
+        "heavy-tailed start around the MAP; files get a _smc suffix)",
     )
     s.add_argument("--particles", type=int, default=bayes.PARTICLES, help="SMC particles (default %(default)s; >= 44)")
     s.add_argument(
