@@ -7,9 +7,9 @@ Residuals: the six-DOF errors (`frames.error_dof`, mm and deg, at the centroid) 
 and the lunate at every frame of a trial, each over the 4DCT tracking noise of its DOF, `NOISE`
 (0.2 mm, 0.5°). The synthetic trials carry 0.2 mm and 0.5° RMS rigid noise (0.12 mm, 0.29° per
 axis); at the hidden truth the default model's residuals measure 0.12–0.19 mm and 0.5–0.8° RMS per
-DOF (P2's grip trial 0.2–0.4 mm, 1.1–2.7°: the default model's coarser contact differs from the
-trials' finer one). So `NOISE` is the per-DOF noise the model can be expected to reach; a design
-that fits much closer fits noise and model error.
+DOF (P2's grip trial 0.2–0.4 mm, 1.1–2.7°: the model is driven by the trial's capitate poses, whose
+tracking noise moves the proximal row; `experiments/model_error.py`). So `NOISE` is the per-DOF noise
+the model can be expected to reach; a design that fits much closer fits noise and model error.
 
 MAP objective (what `+prior` calibrators minimize): the negative log posterior under Gaussian
 noise of SD `NOISE`, up to a constant,
