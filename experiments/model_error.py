@@ -32,8 +32,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from make_trials import HIGH_FIDELITY_BUILD, HIGH_FIDELITY_SOLVER, capitate_motion  # noqa: E402
 
 from wrist_env import bayes, design, posterior  # noqa: E402
-from wrist_env.cost import COST_BONES  # noqa: E402
-from wrist_env.envs.task import task  # noqa: E402
+from wrist_env.envs.task import cost_poses, task  # noqa: E402
 from wrist_env.frames import cardan_rotation  # noqa: E402
 from wrist_env.model import BONES  # noqa: E402
 from wrist_env.participants import builtin  # noqa: E402
@@ -63,25 +62,24 @@ def rows(name: str) -> list[dict]:
     fine = load_model(name, HIGH_FIDELITY_BUILD)
     angles, load = capitate_motion(builtin.info(name).task, "unresisted")
     run = simulate(fine, builtin.truth(name), loaded(fine, cardan_rotation(angles), load), HIGH_FIDELITY_SOLVER)
-    poses = np.transpose(run.poses, (1, 0, 2, 3))
-    clean = np.stack([poses[BONES.index(b)] for b in COST_BONES])
+    capitate, clean = run.poses[:, CAPITATE], cost_poses(run.poses)
     map_z, *_ = bayes.map_estimate(calibration)
     out = []
     for label, z in (("truth", design.z_scores(builtin.truth(name))), ("MAP", map_z)):
         d = design.with_z(design.population(), z)
 
-        def residuals(capitate: np.ndarray) -> np.ndarray:
+        def residuals(driven: np.ndarray) -> np.ndarray:
             return posterior.residuals(
-                calibration, simulate(calibration.model, d, experimental(calibration.model, capitate)).poses, clean
+                calibration, simulate(calibration.model, d, experimental(calibration.model, driven)).poses, clean
             )
 
-        gap = residuals(poses[CAPITATE])
+        gap = residuals(capitate)
         trial = posterior.residuals(calibration, calibration.evaluate(d).result.poses)
         row = {"participant": name, "design": label, "gap_ss": float(np.sum(gap**2))}
         for part in ("all", "translation", "rotation"):
             rng = np.random.default_rng(7)
             ss = [
-                float(np.sum(residuals(capitate_noise(poses[CAPITATE], fine.centroid[CAPITATE], rng, part)) ** 2))
+                float(np.sum(residuals(capitate_noise(capitate, fine.centroid[CAPITATE], rng, part)) ** 2))
                 for _ in range(DRAWS)
             ]
             row[f"capitate_noise_{part}_ss_median"] = float(np.median(ss))
