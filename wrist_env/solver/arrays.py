@@ -53,7 +53,9 @@ class SolverSettings:
     trilinear distance (which jumps at cell faces, so no state balances
     exactly: `experiments/solver_accuracy.py`).
     mass_scale, inertia_scale: mass scaling of the free bones (inertia_scale
-    multiplies rotational inertia on top of mass_scale). active_band_mm: a
+    multiplies rotational inertia on top of mass_scale). node_mass_t: the mass
+    of the RSC membrane's free nodes, raised per design where its connectors
+    are too stiff for dt_s (`node_mass`). active_band_mm: a
     contact sample is looked up every step while it is within this distance
     of contact (a pair's set is refilled once its samples may have moved half
     of it: `forces.contact_forces`).
@@ -180,6 +182,48 @@ def membrane(model: Model, grd: Grids) -> Membrane:
     )
 
 
+ACROSS_SHARE = 0.25
+"""Stiffness of the RSC membrane's across connectors as a share of its along connectors'."""
+COURANT = 1.5
+"""Largest dt·ω the membrane's free nodes may reach (ω² = their stiffest mode's stiffness over their
+mass, `node_mass`). Measured on P1's calibration trial with the population design and the RSC
+stiffer: frames stop settling (a net force of 8–23 N left after the hold limit) from dt·ω ≈ 1.70
+(RSC +2.1 SD: 1.67 settles, +2.4 SD: 1.73 does not; a design with the RSC at +2.9 SD settles at
+node masses giving 1.60, not 1.70); 1.5 is 0.9 of that. The population design is at 1.46."""
+
+
+def membrane_eigenvalue(model: Model, mem: Membrane) -> float:
+    """The stiffest mode (N/mm) of the RSC membrane's free nodes at rest per N/mm of its along
+    connectors (across ones at `ACROSS_SHARE`): the largest eigenvalue of their stiffness matrix,
+    stretched connectors' axial stiffness only, the nodes attached to bones held."""
+    free = np.asarray(model.membrane_bone) < 0
+    index = np.cumsum(free) - 1
+    n = int(free.sum())
+    K = np.zeros((3 * n, 3 * n))
+    for (i, j), kind in zip(mem.connectors, mem.kind):
+        d = mem.rest[j] - mem.rest[i]
+        block = (1.0 if kind == 0 else ACROSS_SHARE) * np.outer(d, d) / (d @ d)
+        for a, b in ((i, j), (j, i)):
+            if free[a]:
+                ra = slice(3 * index[a], 3 * index[a] + 3)
+                K[ra, ra] += block
+                if free[b]:
+                    K[ra, 3 * index[b] : 3 * index[b] + 3] -= block
+    return float(np.linalg.eigvalsh(K)[-1]) if n else 0.0
+
+
+def node_mass(st: Settings, eigenvalue: float, m_l0: np.ndarray, m_K: np.ndarray) -> float:
+    """Mass (t) of the membrane's free nodes for one design's connectors (m_l0, m_K of `design_arrays`):
+    st.node_mass, raised to keep dt·ω ≤ `COURANT` where ω² = (eigenvalue × the along connectors'
+    stiffness + the node–scaphoid contact stiffness) / mass (`membrane_eigenvalue`). Mass scaling to
+    the time step, as explicit finite-element codes do; a quasi-static answer does not depend on it."""
+    if st.node_mass <= 0.0 or len(m_K) == 0:
+        return float(st.node_mass)
+    k_along = float(np.max(m_K / m_l0))
+    stiffest = eigenvalue * k_along + st.membrane_contact_stiffness
+    return max(float(st.node_mass), stiffest * (st.dt / COURANT) ** 2)
+
+
 def design_arrays(
     model: Model, fib: Fibres, mem: Membrane, design: Design
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -189,7 +233,7 @@ def design_arrays(
     mean is the bundle's reference length); K = (k / n_fibres)·l0, so the bundle's
     fibres share its stiffness k. The RSC's k is the membrane's stiffness along
     its length: its n_across longitudinal chains of (n_along − 1) connectors in
-    parallel; across connectors take a quarter of the along connectors' stiffness.
+    parallel; across connectors take `ACROSS_SHARE` of the along connectors' stiffness.
     """
     k, r, torn = ligament_arrays(design)
     lig = fib.ligament
@@ -201,7 +245,7 @@ def design_arrays(
     n_along_segments = int(np.sum(kind == 0)) / max(n_across, 1)
     k_along = k[RSC] * n_along_segments / max(n_across, 1)
     m_l0 = mem.rest_length / r[RSC]
-    m_k = np.where(kind == 0, k_along, 0.25 * k_along)
+    m_k = np.where(kind == 0, k_along, ACROSS_SHARE * k_along)
     m_K = 0.0 if torn[RSC] else 1.0
     return f_l0, f_K, m_l0, m_K * m_k * m_l0
 

@@ -22,7 +22,7 @@ from wrist_env.model import Model
 from wrist_env.solver import arrays, kernel
 from wrist_env.solver.kernel import CAPITATE, LEVER_MM, LUNATE, SCAPHOID
 from wrist_env.solver.rigid import rotate_in_place
-from wrist_env.solver.simulate import prepare
+from wrist_env.solver.simulate import prepare, stiffness
 
 JACOBIAN_STEP = 1e-6  # finite-difference step of the Jacobian (rad, mm)
 MAX_EVALUATIONS = 60  # residual evaluations per frame (each with a Jacobian): where contact stalls it, stop
@@ -141,8 +141,7 @@ def nearest(model: Model, design: Design, driver, result, settings: arrays.Solve
     if not result.ok:
         raise ValueError(f"the run failed ({result.message}); there is no state to start from")
     p = prepare(model, settings, driver.mode)
-    f_l0, f_K, m_l0, m_K = arrays.design_arrays(model, p.fibres, p.membrane, design)
-    stiffness = kernel.Stiffness(f_l0, f_K, m_l0, m_K)
+    design_stiffness = stiffness(p, design)
     free_nodes = np.flatnonzero(np.asarray(model.membrane_bone) < 0).astype(np.int64)
     n_unknown = 12 + (3 if driver.mode == arrays.LOADED else 0) + 3 * len(free_nodes)
     loaded = driver.mode == arrays.LOADED
@@ -156,7 +155,20 @@ def nearest(model: Model, design: Design, driver, result, settings: arrays.Solve
         nodes0 = np.ascontiguousarray(result.membrane_nodes[f])
         load = float(driver.load_n[f])
 
-        args = (R0, x0, nodes0, free_nodes, p.bodies, p.grids, p.law, p.fibres, stiffness, p.membrane, p.settings, load)
+        args = (
+            R0,
+            x0,
+            nodes0,
+            free_nodes,
+            p.bodies,
+            p.grids,
+            p.law,
+            p.fibres,
+            design_stiffness,
+            p.membrane,
+            p.settings,
+            load,
+        )
 
         def fun(q):
             return _residual(q, *args, out).copy()

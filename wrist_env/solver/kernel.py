@@ -111,7 +111,7 @@ def _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, rebuild
     (N·mm; 0 unless `want_energy`)."""
     R, x, v, w, nodes, _ = state
     active, n_active, ref, F, T, node_force, stats, bundle = work
-    f_l0, f_K, m_l0, m_K = stiffness
+    f_l0, f_K, m_l0, m_K, _ = stiffness
     com0 = bod.com0
     if rebuild:
         ref[:] = np.nan
@@ -170,11 +170,11 @@ def _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, loa
         for k in range(3):
             v[CAPITATE, k] = (v[CAPITATE, k] + dt * bod.inv_mass[CAPITATE] * F[CAPITATE, k]) * lin
             x[CAPITATE, k] += dt * v[CAPITATE, k]
-    if st.node_mass > 0.0:
+    if stiffness.node_mass > 0.0:
         for i in range(nodes.shape[0]):
             if mem.bone[i] < 0:
                 for k in range(3):
-                    nv[i, k] = (nv[i, k] + dt / st.node_mass * node_force[i, k]) * lin
+                    nv[i, k] = (nv[i, k] + dt / stiffness.node_mass * node_force[i, k]) * lin
                     nodes[i, k] += dt * nv[i, k]
     if step_index % 100 == 0:
         for b in (SCAPHOID, LUNATE):
@@ -204,8 +204,8 @@ def _converged(F, T, bundle, st):
 
 
 @njit(cache=True, error_model="numpy")
-def _kinetic(R, v, w, nv, bod, st):
-    """Kinetic energy (N·mm) of the free bodies and membrane nodes (mass-scaled)."""
+def _kinetic(R, v, w, nv, bod, st, node_mass):
+    """Kinetic energy (N·mm) of the free bodies and membrane nodes of mass `node_mass` (t) (mass-scaled)."""
     ke = 0.0
     for b in (SCAPHOID, LUNATE):
         # body-frame angular velocity Rᵀw against the neutral-pose inertia
@@ -222,7 +222,7 @@ def _kinetic(R, v, w, nv, bod, st):
     if st.driver == LOADED:
         ke += 0.5 * bod.mass[CAPITATE] * (v[CAPITATE, 0] ** 2 + v[CAPITATE, 1] ** 2 + v[CAPITATE, 2] ** 2)
     for i in range(nv.shape[0]):
-        ke += 0.5 * st.node_mass * (nv[i, 0] ** 2 + nv[i, 1] ** 2 + nv[i, 2] ** 2)
+        ke += 0.5 * node_mass * (nv[i, 0] ** 2 + nv[i, 1] ** 2 + nv[i, 2] ** 2)
     return ke
 
 
@@ -233,8 +233,9 @@ Work = namedtuple("Work", ["active", "n_active", "ref", "F", "T", "node_force", 
 """A run's scratch: active contact samples, their count per pair and the pair transforms when they
 were filled (n_pairs, 12; NaN to refill), forces (5, 3) N and torques
 (5, 3) N·mm on the bodies, membrane node forces (M, 3) N, per-pair contact stats, bundle forces (N)."""
-Stiffness = namedtuple("Stiffness", ["f_l0", "f_K", "m_l0", "m_K"])
-"""A design's zero-load lengths (mm) and stiffnesses of the fibres and the membrane connectors."""
+Stiffness = namedtuple("Stiffness", ["f_l0", "f_K", "m_l0", "m_K", "node_mass"])
+"""A design's zero-load lengths (mm) and stiffnesses of the fibres and the membrane connectors, and the
+membrane's free-node mass (t) its connectors need (`arrays.node_mass`)."""
 Frames = namedtuple("Frames", ["rotation", "com", "load"])
 """The capitate's targets per frame: rotation (n_frames, 3, 3), centre of mass (n_frames, 3) mm (for the
 loaded driver only the start: the centre is free), compressive load (n_frames,) N along +y."""
@@ -346,7 +347,7 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
             contact[f, p, R_AREA] = area
             contact[f, p, R_FORCE] = stats[p, C_FORCE]
         bundle_out[f] = bundle
-        energy_out[f, 0] = _kinetic(R, v, w, nv, bod, st)
+        energy_out[f, 0] = _kinetic(R, v, w, nv, bod, st, stiffness.node_mass)
         energy_out[f, 1] = energy
         residual_out[f, 0] = max(np.linalg.norm(F[SCAPHOID]), np.linalg.norm(F[LUNATE]))
         residual_out[f, 1] = max(np.linalg.norm(T[SCAPHOID]), np.linalg.norm(T[LUNATE]))
@@ -359,7 +360,9 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
 def run_batch(bod, grids, law, fib, stiffness, mem, st, frames, out):
     """`run` for many designs: `Stiffness` and `Outputs` arrays with a leading design axis."""
     for i in prange(stiffness.f_l0.shape[0]):
-        design = Stiffness(stiffness.f_l0[i], stiffness.f_K[i], stiffness.m_l0[i], stiffness.m_K[i])
+        design = Stiffness(
+            stiffness.f_l0[i], stiffness.f_K[i], stiffness.m_l0[i], stiffness.m_K[i], stiffness.node_mass[i]
+        )
         filled = Outputs(
             out.poses[i],
             out.contact[i],

@@ -155,6 +155,7 @@ class Prepared:
     membrane: arrays.Membrane
     settings: arrays.Settings
     law: np.ndarray
+    membrane_eigenvalue: float
 
     def check(self, model: Model, driver: Driver) -> None:
         if model is not self.model or driver.mode != self.mode:
@@ -168,16 +169,24 @@ def prepare(model: Model, settings: arrays.SolverSettings | None = None, mode: i
     """The kernel arrays of `model` under `settings` (default `SolverSettings()`) for drivers of `mode`."""
     s = settings or arrays.SolverSettings()
     grd = arrays.grids(model, s.smooth_normals)
+    mem = arrays.membrane(model, grd)
     return Prepared(
         model,
         int(mode),
         arrays.bodies(model, s),
         grd,
         arrays.fibres(model),
-        arrays.membrane(model, grd),
+        mem,
         arrays.settings_tuple(s, mode),
         np.ascontiguousarray(model.contact_law, dtype=np.float64),
+        arrays.membrane_eigenvalue(model, mem),
     )
+
+
+def stiffness(p: Prepared, design: Design) -> kernel.Stiffness:
+    """The kernel's per-design arrays (`arrays.design_arrays`) and the membrane's node mass (`arrays.node_mass`)."""
+    f_l0, f_K, m_l0, m_K = arrays.design_arrays(p.model, p.fibres, p.membrane, design)
+    return kernel.Stiffness(f_l0, f_K, m_l0, m_K, arrays.node_mass(p.settings, p.membrane_eigenvalue, m_l0, m_K))
 
 
 def _prepared(model, settings, driver, prepared) -> Prepared:
@@ -199,9 +208,8 @@ def simulate(
 
     prepared: `prepare(model, settings, driver.mode)`, to skip rebuilding the kernel arrays."""
     p = _prepared(model, settings, driver, prepared)
-    f_l0, f_K, m_l0, m_K = arrays.design_arrays(model, p.fibres, p.membrane, design)
     out = _outputs(0, len(driver.rotation), len(model.membrane_nodes))
-    _run(kernel.run, p, kernel.Stiffness(f_l0, f_K, m_l0, m_K), driver, out)
+    _run(kernel.run, p, stiffness(p, design), driver, out)
     return _result(out, driver, int(out.status[0]))
 
 
@@ -215,12 +223,12 @@ def simulate_batch(
 ) -> list[Result]:
     """Simulate many designs in parallel (Numba prange); same results as one at a time."""
     p = _prepared(model, settings, driver, prepared)
-    per = [arrays.design_arrays(model, p.fibres, p.membrane, d) for d in designs]
-    f_l0, f_K, m_l0, m_K = (np.ascontiguousarray(np.stack([q[i] for q in per])) for i in range(4))
+    per = [stiffness(p, d) for d in designs]
+    stacked = kernel.Stiffness(*(np.ascontiguousarray(np.stack(field)) for field in zip(*per)))
     out = _outputs(len(per), len(driver.rotation), len(model.membrane_nodes))
     previous = numba.set_parallel_chunksize(1)  # designs differ in cost: hand them out one at a time
     try:
-        _run(kernel.run_batch, p, kernel.Stiffness(f_l0, f_K, m_l0, m_K), driver, out)
+        _run(kernel.run_batch, p, stacked, driver, out)
     finally:
         numba.set_parallel_chunksize(previous)
     return [_result(kernel.Outputs(*(o[i] for o in out)), driver, int(out.status[i, 0])) for i in range(len(per))]

@@ -1,0 +1,74 @@
+"""The membrane's node mass keeps the explicit step stable for every RSC stiffness in the action box."""
+
+import numpy as np
+import pytest
+
+from wrist_env import design
+from wrist_env.participants import registry
+from wrist_env.solver import arrays
+from wrist_env.solver.forces import membrane_forces, place_nodes
+from wrist_env.solver.ligaments import EPSILON_L
+from wrist_env.solver.simulate import experimental, prepare, simulate, stiffness
+
+pytestmark = pytest.mark.slow  # builds models or runs simulations/studies (minutes)
+
+RSC_STIFFNESS = design.NAMES.index("RSC.stiffness")
+
+
+def stiff_rsc() -> design.Design:
+    """The population design with the RSC at the top of the action box (+3 SD), nothing torn."""
+    action = np.r_[np.zeros(design.N_MATERIAL), np.ones(design.N_DESIGN - design.N_MATERIAL)]
+    action[RSC_STIFFNESS] = 1.0
+    return design.from_action(action)
+
+
+def test_membrane_eigenvalue_matches_the_force_kernels_jacobian(p1):
+    """The stiffest mode from the assembled axial stiffness equals the largest eigenvalue of the
+    finite-difference Jacobian of `membrane_forces` on the free nodes, with every connector just into
+    its linear region (where the tension adds a geometric stiffness of ~4 % of the axial one)."""
+    p = prepare(p1)
+    mem = p.membrane
+    _, _, l0, K = arrays.design_arrays(p1, p.fibres, mem, stiff_rsc())
+    m_l0 = mem.rest_length / (1.0 + 2.0 * EPSILON_L + 0.01)  # every connector into its linear region
+    m_K = K / l0 * m_l0  # the same N/mm per connector
+    R, x = np.tile(np.eye(3), (5, 1, 1)), p1.com.copy()
+    nodes = mem.rest.copy()
+    place_nodes(R, x, p1.com, mem, nodes)
+    free = np.flatnonzero(np.asarray(p1.membrane_bone) < 0)
+
+    def forces(q):
+        moved = nodes.copy()
+        moved[free] += q.reshape(-1, 3)
+        out = np.zeros_like(nodes)
+        membrane_forces(R, x, p1.com, mem, moved, m_l0, m_K, 0.0, np.zeros((5, 3)), np.zeros((5, 3)), out, False)
+        return out[free].ravel()
+
+    h = 1e-6
+    J = np.array([(forces(h * e) - forces(-h * e)) / (2 * h) for e in np.eye(3 * len(free))]).T
+    numeric = np.linalg.eigvalsh(-(J + J.T) / 2)[-1]
+    assembled = p.membrane_eigenvalue * np.max(m_K / m_l0)
+    print(f"stiffest mode: assembled {assembled:.2f} N/mm, force kernels' Jacobian {numeric:.2f} N/mm")
+    assert assembled == pytest.approx(numeric, rel=0.02)
+
+
+def test_node_mass_is_raised_only_where_the_step_needs_it(p1):
+    p = prepare(p1)
+    population = stiffness(p, design.population())
+    assert population.node_mass == arrays.SolverSettings().node_mass_t  # the population's runs unchanged
+    stiff = stiffness(p, stiff_rsc())
+    k_along = np.max(stiff.m_K / stiff.m_l0)
+    omega = np.sqrt((p.membrane_eigenvalue * k_along + p.settings.membrane_contact_stiffness) / stiff.node_mass)
+    assert stiff.node_mass > population.node_mass
+    assert p.settings.dt * omega == pytest.approx(arrays.COURANT)
+
+
+def test_a_stiff_rsc_settles_every_frame(p1):
+    """With the nodes at `node_mass_t` whatever the design, the RSC's +3 SD design chattered on P1's
+    calibration trial (9,823 steps, 8.8 N left on a free bone); with their mass raised every frame settles."""
+    driver = experimental(p1, registry.trial("P1", "calibrate").pose("capitate"))
+    s = arrays.SolverSettings()
+    run = simulate(p1, stiff_rsc(), driver)
+    assert run.ok, run.message
+    assert run.steps[1:].max() < s.ramp_steps + s.max_hold_steps  # no frame ran out of hold steps
+    assert np.max(run.residual[:, 0]) < 0.5  # N
+    assert run.steps.sum() < 3000  # the population design takes ~2,200
