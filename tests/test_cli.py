@@ -68,6 +68,7 @@ def test_simulate_json_has_every_frame_and_the_wall_time(capsys, built):
             "internal_energy_nmm",
             "residual",
             "steps",
+            "settled",
         ):
             assert key in frame, key
         values = numbers({k: v for k, v in frame.items()})

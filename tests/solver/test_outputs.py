@@ -116,6 +116,7 @@ def test_result_to_dict_is_strict_json_with_every_output(p1, sweep):
     for key in ("kinetic_energy_nmm", "internal_energy_nmm"):
         assert np.isfinite(frame[key])
     assert set(frame["residual"]) == {"force_n", "moment_nmm"} and frame["steps"] > 0
+    assert frame["settled"] is True
 
 
 def test_result_to_dict_of_a_failed_run_has_nulls(p1, sweep):
@@ -127,6 +128,7 @@ def test_result_to_dict_of_a_failed_run_has_nulls(p1, sweep):
         nan(sweep.energy),
         nan(sweep.residual),
         sweep.steps,
+        np.zeros_like(sweep.settled),
         nan(sweep.membrane_nodes),
         np.full(5, np.nan),
         1,

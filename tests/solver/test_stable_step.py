@@ -1,4 +1,7 @@
-"""The membrane's node mass keeps the explicit step stable for every RSC stiffness in the action box."""
+"""The membrane's node mass keeps the explicit step stable for every RSC stiffness in the action box;
+every frame says whether it settled."""
+
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -72,3 +75,13 @@ def test_a_stiff_rsc_settles_every_frame(p1):
     assert run.steps[1:].max() < s.ramp_steps + s.max_hold_steps  # no frame ran out of hold steps
     assert np.max(run.residual[:, 0]) < 0.5  # N
     assert run.steps.sum() < 3000  # the population design takes ~2,200
+
+
+def test_settled_says_which_frames_ran_out_of_hold_steps(p1):
+    driver = experimental(p1, registry.trial("P1", "calibrate").pose("capitate"))
+    run = simulate(p1, design.population(), driver)
+    assert run.settled.dtype == bool and run.settled.all()
+    short = replace(arrays.SolverSettings(), min_hold_steps=1, max_hold_steps=2)  # no frame can settle in 2 steps
+    cut = simulate(p1, design.population(), driver, short)
+    assert cut.ok and not cut.settled.any()
+    assert np.all(cut.steps[1:] == short.ramp_steps + short.max_hold_steps)

@@ -118,6 +118,7 @@ def outputs(result: Result, report: CostReport | None = None) -> dict:
         "kinetic_energy_nmm": energy[:, 0],
         "internal_energy_nmm": energy[:, 1],
         "steps": np.asarray(result.steps, dtype=np.int64),
+        "settled": np.asarray(result.settled, dtype=bool),
     }
     if report is not None:
         r = report.to_dict()

@@ -239,10 +239,13 @@ membrane's free-node mass (t) its connectors need (`arrays.node_mass`)."""
 Frames = namedtuple("Frames", ["rotation", "com", "load"])
 """The capitate's targets per frame: rotation (n_frames, 3, 3), centre of mass (n_frames, 3) mm (for the
 loaded driver only the start: the centre is free), compressive load (n_frames,) N along +y."""
-Outputs = namedtuple("Outputs", ["poses", "contact", "bundle", "energy", "residual", "steps", "nodes", "status"])
+Outputs = namedtuple(
+    "Outputs", ["poses", "contact", "bundle", "energy", "residual", "steps", "settled", "nodes", "status"]
+)
 """What a run fills: poses (n_frames, 5, 4, 4); contact (n_frames, n_pairs, 4) (`forces.CONTACT_FIELDS`);
 bundle forces (n_frames, n_ligaments) N; kinetic and internal energy (n_frames, 2) N·mm; largest net
-force (N) and moment (N·mm) on the free bones (n_frames, 2); steps per frame (n_frames,); RSC membrane
+force (N) and moment (N·mm) on the free bones (n_frames, 2); steps per frame (n_frames,); 1 where the
+frame's hold ended in equilibrium, 0 where it ran out of hold steps (n_frames,); RSC membrane
 node positions (n_frames, M, 3) mm; status (1,)."""
 
 SETTLE, MOVE = -2, -1
@@ -272,7 +275,7 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
     at most settle_steps).
     """
     frame_R, frame_x, frame_load = frames
-    poses, contact, bundle_out, energy_out, residual_out, steps_out, nodes_out, status = out
+    poses, contact, bundle_out, energy_out, residual_out, steps_out, settled_out, nodes_out, status = out
     com0 = bod.com0
     n_frames = frame_R.shape[0]
     R = np.zeros((N_BONES, 3, 3))
@@ -305,6 +308,7 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
         axis = matrix_to_rotvec(Rb @ Ra.T)
         shift = xb - xa
         k = 0
+        settled = False
         while k < ramp + most:
             s = smoothstep((k + 1) / ramp) if ramp > 0 else 1.0
             capx = interpolate_pose(Ra, xa, axis, capR, shift, s)
@@ -313,6 +317,7 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
             step += 1
             k += 1
             if k >= ramp + st.min_hold_steps and _converged(F, T, bundle, st):
+                settled = True
                 break
         taken += k
         bad = False
@@ -352,6 +357,7 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
         residual_out[f, 0] = max(np.linalg.norm(F[SCAPHOID]), np.linalg.norm(F[LUNATE]))
         residual_out[f, 1] = max(np.linalg.norm(T[SCAPHOID]), np.linalg.norm(T[LUNATE]))
         steps_out[f] = taken
+        settled_out[f] = 1 if settled else 0
         nodes_out[f] = nodes
         taken = 0
 
@@ -370,6 +376,7 @@ def run_batch(bod, grids, law, fib, stiffness, mem, st, frames, out):
             out.energy[i],
             out.residual[i],
             out.steps[i],
+            out.settled[i],
             out.nodes[i],
             out.status[i],
         )

@@ -92,7 +92,7 @@ def result_to_dict(result: Result, model: Model) -> dict:
        "poses": {bone: 4×4 neutral → frame, RCS mm},
        "contact": {pair: {"mean_pressure_mpa", "peak_pressure_mpa", "area_mm2", "force_n"}},
        "ligament_force_n": {ligament: N}, "kinetic_energy_nmm", "internal_energy_nmm",
-       "residual": {"force_n", "moment_nmm"}, "steps"}, ...]}
+       "residual": {"force_n", "moment_nmm"}, "steps", "settled"}, ...]}
     """
     n = len(result.poses)
     angles = cardan_deg(result.poses)
@@ -112,6 +112,7 @@ def result_to_dict(result: Result, model: Model) -> dict:
                 "internal_energy_nmm": _num(result.energy[f, 1]),
                 "residual": {"force_n": _num(result.residual[f, 0]), "moment_nmm": _num(result.residual[f, 1])},
                 "steps": int(result.steps[f]),
+                "settled": bool(result.settled[f]),
             }
         )
     return {

@@ -108,6 +108,8 @@ class Result:
     residual (n_frames, 2): largest net force (N) and moment (N·mm) on the free bones.
     steps (n_frames,): explicit steps since the previous frame (ramp + hold to equilibrium;
         frame 0 includes settling and the move to the first pose).
+    settled (n_frames,): whether the frame's hold ended in equilibrium (False: it ran out of hold
+        steps, and its outputs are where the bones were then).
     membrane_nodes (n_frames, M, 3): the RSC membrane's nodes (`model.membrane_nodes` order), RCS mm.
     status: 0 ok, otherwise failed (see `message`); a failed run's frames are NaN.
     """
@@ -118,6 +120,7 @@ class Result:
     energy: np.ndarray
     residual: np.ndarray
     steps: np.ndarray
+    settled: np.ndarray
     membrane_nodes: np.ndarray
     angle_deg: np.ndarray
     status: int
@@ -136,6 +139,7 @@ def _outputs(n: int, n_frames: int, n_nodes: int) -> kernel.Outputs:
         np.full(shape + (n_frames, len(ALL_LIGAMENT_NAMES)), np.nan),
         np.full(shape + (n_frames, 2), np.nan),
         np.full(shape + (n_frames, 2), np.nan),
+        np.zeros(shape + (n_frames,), np.int64),
         np.zeros(shape + (n_frames,), np.int64),
         np.full(shape + (n_frames, n_nodes, 3), np.nan),
         np.zeros(shape + (1,), np.int64),
@@ -241,8 +245,20 @@ def _run(entry, p: Prepared, stiffness: kernel.Stiffness, driver: Driver, out: k
 
 
 def _result(out: kernel.Outputs, driver: Driver, status: int) -> Result:
-    poses, contact, bundle, energy, residual, steps, nodes, _ = out
+    poses, contact, bundle, energy, residual, steps, settled, nodes, _ = out
     if status != kernel.OK:
         for a in (poses, contact, bundle, energy, residual, nodes):
             a[...] = np.nan
-    return Result(poses, contact, bundle, energy, residual, steps, nodes, driver.angle_deg, status, STATUS[status])
+    return Result(
+        poses,
+        contact,
+        bundle,
+        energy,
+        residual,
+        steps,
+        settled.astype(bool),
+        nodes,
+        driver.angle_deg,
+        status,
+        STATUS[status],
+    )
