@@ -187,9 +187,10 @@ ACROSS_SHARE = 0.25
 COURANT = 1.5
 """Largest dt·ω the membrane's free nodes may reach (ω² = their stiffest mode's stiffness over their
 mass, `node_mass`). Measured on P1's calibration trial with the population design and the RSC
-stiffer: frames stop settling (a net force of 8–23 N left after the hold limit) from dt·ω ≈ 1.70
-(RSC +2.1 SD: 1.67 settles, +2.4 SD: 1.73 does not; a design with the RSC at +2.9 SD settles at
-node masses giving 1.60, not 1.70); 1.5 is 0.9 of that. The population design is at 1.46."""
+stiffer, nodes at 2e-7 t: RSC +1.8 SD (dt·ω 1.67) settles in 2,141 steps, +2.1 SD (1.70) in 3,710,
++2.4 SD (1.73) not at all (8 N left after the hold limit); a design with the RSC at +2.9 SD settles
+at node masses giving 1.60, not 1.70. So the limit is ≈ 1.70, and 1.5 is ~0.9 of it. The
+population design is at 1.46."""
 
 
 def membrane_eigenvalue(model: Model, mem: Membrane) -> float:
