@@ -8,6 +8,11 @@ tighter equilibrium tolerance, 8× longer holds). Printed per motion: steps per
 simulation, frames that ran out of hold steps, and the largest centre-of-mass
 distance (mm) and rotation (°) of a moving bone from the reference — median,
 95th percentile, maximum, and the share of designs within 0.1 mm and 0.5°.
+Because a soft design can reach different equilibria by different paths, the
+reference is run twice more along other paths (a quarter of the default's time
+step, and ramps twice as slow): a design whose three converged runs agree
+within 0.1 mm and 0.5° is path-independent, and the share within is printed
+for those designs too (for the others no run has a converged answer to match).
 With --newton K, the population design and the first K−1 Monte Carlo designs
 are also polished by the quasi-static Newton reference
 (`wrist_env.solver.equilibrium.nearest`): the distance from each explicit
@@ -51,6 +56,13 @@ def reference_settings(base: SolverSettings) -> SolverSettings:
     )
 
 
+def path_settings(reference: SolverSettings) -> dict[str, SolverSettings]:
+    """Two more converged runs along other paths: half the reference's step (tolerance and holds kept,
+    so twice the hold steps) and ramps twice as slow."""
+    quarter = replace(reference.halved(), max_hold_steps=2 * reference.max_hold_steps)
+    return {"quarter": quarter, "slow": replace(reference, ramp_steps=2 * reference.ramp_steps)}
+
+
 def largest_distance(a: np.ndarray, b: np.ndarray, com0: np.ndarray) -> tuple[float, float]:
     """Largest centre-of-mass distance (mm) and rotation (deg) of a moving bone over the frames."""
     d = distance(a, b, com0).max(axis=0)
@@ -65,19 +77,39 @@ def drivers(name: str, model):
 
 
 def reference(name: str, model, designs, base: SolverSettings) -> dict[str, np.ndarray]:
+    """Poses and success of the reference runs: "<motion>" and "<motion>_ok" (the reference), and the
+    same with "_quarter" and "_slow" (`path_settings`)."""
     settings = reference_settings(base)
     key = hashlib.sha1(repr(settings).encode()).hexdigest()[:8]  # a new default gets a new reference
-    path = CACHE / f"{name}_{len(designs) - 1}_{key}.npz"
+    path = CACHE / f"{name}_{len(designs) - 1}_{key}_paths.npz"
     if path.exists():
         return dict(np.load(path))
     out = {}
+    runs_of = {"": settings} | {f"_{k}": s for k, s in path_settings(settings).items()}
     for motion, driver in drivers(name, model).items():
-        runs = simulate_batch(model, designs, driver, settings)
-        out[motion] = np.stack([r.poses for r in runs])
-        out[motion + "_ok"] = np.array([r.ok for r in runs])
+        for suffix, s in runs_of.items():
+            runs = simulate_batch(model, designs, driver, s)
+            out[motion + suffix] = np.stack([r.poses for r in runs])
+            out[motion + suffix + "_ok"] = np.array([r.ok for r in runs])
     path.parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(path, **out)
     return out
+
+
+def path_independent(ref: dict[str, np.ndarray], motion: str, com: np.ndarray) -> np.ndarray:
+    """Which designs' three converged runs (reference, quarter step, slow ramps) all succeed and agree
+    within `TOLERANCE`."""
+    out = []
+    for i in range(len(ref[motion])):
+        ok = all(ref[f"{motion}{s}_ok"][i] for s in ("", "_quarter", "_slow"))
+        out.append(ok and all(within(ref[motion][i], ref[f"{motion}{s}"][i], com) for s in ("_quarter", "_slow")))
+    return np.array(out)
+
+
+def within(a: np.ndarray, b: np.ndarray, com: np.ndarray) -> bool:
+    """Every moving bone of runs a and b within `TOLERANCE` at every frame."""
+    d = largest_distance(a, b, com)
+    return d[0] <= TOLERANCE[0] and d[1] <= TOLERANCE[1]
 
 
 def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int) -> None:
@@ -88,13 +120,15 @@ def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int) -
         runs = simulate_batch(model, designs, driver, settings)
         both = [i for i, r in enumerate(runs) if r.ok and ref[motion + "_ok"][i]]
         d = np.array([largest_distance(runs[i].poses, ref[motion][i], model.com) for i in both])
-        within = np.mean((d[:, 0] <= TOLERANCE[0]) & (d[:, 1] <= TOLERANCE[1]))
+        share_within = np.mean((d[:, 0] <= TOLERANCE[0]) & (d[:, 1] <= TOLERANCE[1]))
         steps = np.array([r.steps.sum() for r in runs])
         capped_frames = [int(np.sum(r.steps[1:] >= settings.ramp_steps + settings.max_hold_steps)) for r in runs]
         capped = sum(capped_frames)
         settled = np.array([capped_frames[i] == 0 for i in both])
         close = (d[:, 0] <= TOLERANCE[0]) & (d[:, 1] <= TOLERANCE[1])
         frames = sum(len(r.steps) - 1 for r in runs)
+        independent = path_independent(ref, motion, model.com)
+        matched = [runs[i].ok and within(runs[i].poses, ref[motion][i], model.com) for i in np.flatnonzero(independent)]
         pop = largest_distance(runs[0].poses, ref[motion][0], model.com)
         print(
             f"{name} {motion}: {steps[0]} steps (population), {steps.mean():.0f} mean; "
@@ -103,10 +137,12 @@ def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int) -
             f"  from the reference: population {pop[0]:.3f} mm {pop[1]:.2f}°; designs median "
             f"{np.median(d[:, 0]):.3f} mm {np.median(d[:, 1]):.2f}°, 95th pct {np.percentile(d[:, 0], 95):.3f} mm "
             f"{np.percentile(d[:, 1], 95):.2f}°, max {d[:, 0].max():.3f} mm {d[:, 1].max():.2f}°; "
-            f"within 0.1 mm and 0.5°: {100 * within:.0f} %\n"
+            f"within 0.1 mm and 0.5°: {100 * share_within:.0f} %\n"
             f"  designs with every frame settled: {100 * np.mean(close[settled]):.0f} % of {settled.sum()} within; "
             f"with a frame out of hold steps: {100 * np.mean(close[~settled]) if (~settled).any() else 0:.0f} % "
-            f"of {(~settled).sum()}"
+            f"of {(~settled).sum()}\n"
+            f"  path-independent designs (reference, quarter step and slow ramps agree): {independent.sum()} of "
+            f"{len(independent)}; of them within 0.1 mm and 0.5°: {100 * np.mean(matched):.0f} %"
         )
         for i in tqdm(range(min(n_newton, len(runs))), desc=f"{name} {motion} Newton", leave=False):
             if not runs[i].ok:

@@ -8,8 +8,9 @@ from test_verification import EPSILON_L, OSCILLATORS, oscillator, undamped
 
 from wrist_env import design
 from wrist_env.design import LIGAMENT_NAMES
+from wrist_env.participants import registry
 from wrist_env.solver.arrays import SolverSettings
-from wrist_env.solver.equilibrium import nearest
+from wrist_env.solver.equilibrium import nearest, tangent_stiffness
 from wrist_env.solver.simulate import experimental, idealized, simulate
 
 SCAPHOID = 2
@@ -73,3 +74,61 @@ def test_population_sweep_is_near_its_equilibrium(p1):
     eq = nearest(p1, design.population(), driver, result)
     assert eq.distance[:, 0].max() < 0.1 and eq.distance[:, 1].max() < 0.5, eq.distance
     assert eq.residual[:, 0].max() < result.residual[:, 0].max(), (eq.residual, result.residual)
+
+
+def test_tangent_stiffness_of_two_opposed_bundles_is_the_closed_form():
+    """The scaphoid between two opposed bundles on one line through its centre of mass, mid-way: along
+    the line the stiffness is Σ T'(ε_i)/l0_i, across it the tensions' geometric stiffness Σ T_i/L_i
+    (Blankevoort, DESIGN.md, written here), and nothing resists a rotation about the centre of mass."""
+    fib, materials = OSCILLATORS["two bundles opposed"]
+    model = oscillator(fib)
+    vector = design.population().vector.copy()
+    for lig, (k, r) in materials.items():
+        vector[lig], vector[len(LIGAMENT_NAMES) + lig] = k, r
+    dsg = design.Design.from_vector(vector)
+    settings = replace(
+        undamped(SolverSettings()),
+        dt_s=1e-6,
+        settle_steps=0,
+        move_steps=0,
+        ramp_steps=0,
+        min_hold_steps=7,
+        max_hold_steps=7,
+        inertia_scale=1.0,
+        max_disp_mm=1e3,
+    )
+    driver = experimental(model, np.tile(np.eye(4), (2, 1, 1)))
+    result = simulate(model, dsg, driver, settings)
+    y = result.poses[-1, SCAPHOID, :3, 3] @ AXIS  # the centre of mass's shift along the line
+    a = np.array([p for _, p in fib])
+    l0 = np.array([abs(p) / materials[g][1] for g, p in fib])
+    K = np.array([materials[g][0] * l for (g, _), l in zip(fib, l0)])
+    length = np.abs(y - a)
+    strain = length / l0 - 1.0
+    slope = np.where(strain <= 0.0, 0.0, np.where(strain <= 2 * EPSILON_L, K * strain / (2 * EPSILON_L), K))  # dT/dε
+    assert np.all(strain > 0.0), strain  # both taut: the line's stiffness has both terms
+    along = np.sum(slope / l0)
+    across = np.sum([tension(Ki, e) / L for Ki, e, L in zip(K, strain, length)])
+
+    s = tangent_stiffness(model, dsg, driver, result, frame=1, settings=settings)
+    shift = s.stiffness[:3, :3]
+    normal = np.cross(AXIS, [1.0, 0.0, 0.0])
+    normal /= np.linalg.norm(normal)
+    assert np.isclose(AXIS @ shift @ AXIS, along, rtol=1e-4), (AXIS @ shift @ AXIS, along)
+    assert np.isclose(normal @ shift @ normal, across, rtol=1e-4), (normal @ shift @ normal, across)
+    assert np.abs(s.stiffness[3:6, :]).max() < 1e-6 * along
+    assert np.allclose(s.mass[:3, :3], model.mass[SCAPHOID] * settings.mass_scale * np.eye(3))
+
+
+def test_population_trial_sits_in_a_stable_equilibrium_the_step_resolves(p1):
+    """At a settled frame of P1's population calibration trial the free bones' condensed stiffness is
+    nearly symmetric (the contact and ligament forces derive from energies) and positive definite (a
+    stable equilibrium), and the default time step is below the explicit integrator's stability
+    limit 2/ω_max of its stiffest mode."""
+    driver = experimental(p1, registry.trial("P1", "calibrate").pose("capitate"))
+    result = simulate(p1, design.population(), driver)
+    s = tangent_stiffness(p1, design.population(), driver, result, frame=8)
+    omega = s.frequencies()
+    assert s.asymmetry < 0.1, s.asymmetry
+    assert np.all(np.isfinite(omega)) and omega[0] > 0.0, omega
+    assert SolverSettings().dt_s < 2.0 / omega[-1], (SolverSettings().dt_s, 2.0 / omega[-1])

@@ -136,39 +136,48 @@ def distance(a: np.ndarray, b: np.ndarray, com0: np.ndarray) -> np.ndarray:
     return out
 
 
+def _unknowns(model: Model, driver) -> tuple[np.ndarray, int]:
+    """The membrane's free nodes and the number of unknowns (`moved_state`)."""
+    free_nodes = np.flatnonzero(np.asarray(model.membrane_bone) < 0).astype(np.int64)
+    return free_nodes, 12 + (3 if driver.mode == arrays.LOADED else 0) + 3 * len(free_nodes)
+
+
+def _frame_args(p, design_stiffness, free_nodes, driver, result, f: int) -> tuple:
+    """`_residual`'s arguments after q for frame f of `result`: its state and the kernel arrays."""
+    R0 = np.ascontiguousarray(result.poses[f, :, :3, :3])
+    x0 = np.ascontiguousarray(np.einsum("bij,bj->bi", R0, p.bodies.com0) + result.poses[f, :, :3, 3])
+    nodes0 = np.ascontiguousarray(result.membrane_nodes[f])
+    return (
+        R0,
+        x0,
+        nodes0,
+        free_nodes,
+        p.bodies,
+        p.grids,
+        p.law,
+        p.fibres,
+        design_stiffness,
+        p.membrane,
+        p.settings,
+        float(driver.load_n[f]),
+    )
+
+
 def nearest(model: Model, design: Design, driver, result, settings: arrays.SolverSettings | None = None) -> Equilibrium:
     """The equilibrium nearest each frame of `result` (a successful `simulate(model, design, driver)`)."""
     if not result.ok:
         raise ValueError(f"the run failed ({result.message}); there is no state to start from")
     p = prepare(model, settings, driver.mode)
     design_stiffness = stiffness(p, design)
-    free_nodes = np.flatnonzero(np.asarray(model.membrane_bone) < 0).astype(np.int64)
-    n_unknown = 12 + (3 if driver.mode == arrays.LOADED else 0) + 3 * len(free_nodes)
+    free_nodes, n_unknown = _unknowns(model, driver)
     loaded = driver.mode == arrays.LOADED
     com0 = model.com
     poses = result.poses.copy()
     residual = np.zeros((driver.n_frames, 2))
     out = np.zeros(n_unknown)
     for f in range(driver.n_frames):
-        R0 = np.ascontiguousarray(result.poses[f, :, :3, :3])
-        x0 = np.ascontiguousarray(np.einsum("bij,bj->bi", R0, com0) + result.poses[f, :, :3, 3])
-        nodes0 = np.ascontiguousarray(result.membrane_nodes[f])
-        load = float(driver.load_n[f])
-
-        args = (
-            R0,
-            x0,
-            nodes0,
-            free_nodes,
-            p.bodies,
-            p.grids,
-            p.law,
-            p.fibres,
-            design_stiffness,
-            p.membrane,
-            p.settings,
-            load,
-        )
+        args = _frame_args(p, design_stiffness, free_nodes, driver, result, f)
+        R0, x0, nodes0 = args[:3]
 
         def fun(q):
             return _residual(q, *args, out).copy()
@@ -188,3 +197,62 @@ def nearest(model: Model, design: Design, driver, result, settings: arrays.Solve
             LEVER_MM * max(np.linalg.norm(r[3:6]), np.linalg.norm(r[9:12])),
         )
     return Equilibrium(poses, residual, distance(result.poses, poses, com0))
+
+
+@dataclass(frozen=True)
+class Stiffness:
+    """The free bones' tangent stiffness at one frame of an explicit run, the RSC membrane's free nodes
+    condensed out (they follow quasi-statically).
+
+    Coordinates, per free bone (scaphoid, lunate): shift (mm, world) then rotation (rad, world);
+    the capitate's shift after them under the loaded driver. stiffness (n, n): N/mm, N/rad and
+    N·mm/rad, symmetrized; mass (n, n): the explicit solver's (mass-scaled) mass (t) and inertia
+    (t·mm²) in the same coordinates. `frequencies` solves K u = ω² M u.
+    """
+
+    stiffness: np.ndarray
+    mass: np.ndarray
+    asymmetry: float
+    """‖K − Kᵀ‖ / ‖K‖ of the unsymmetrized condensed stiffness (a conservative system's is 0)."""
+
+    def frequencies(self) -> np.ndarray:
+        """Natural angular frequencies (rad/s) of the linearized free bones, ascending (NaN where ω² < 0)."""
+        from scipy.linalg import eigh
+
+        w2 = eigh(self.stiffness, self.mass, eigvals_only=True)
+        return np.sqrt(np.where(w2 >= 0.0, w2, np.nan))
+
+
+def tangent_stiffness(
+    model: Model, design: Design, driver, result, frame: int, settings: arrays.SolverSettings | None = None
+) -> Stiffness:
+    """`Stiffness` of the free bones at `frame` of `result` (a successful `simulate(model, design, driver)`):
+    central differences of the force kernels (`JACOBIAN_STEP`), no time step or damping."""
+    if not result.ok:
+        raise ValueError(f"the run failed ({result.message}); there is no state to linearize")
+    p = prepare(model, settings, driver.mode)
+    free_nodes, n_unknown = _unknowns(model, driver)
+    args = _frame_args(p, stiffness(p, design), free_nodes, driver, result, frame)
+    J = _jacobian(np.zeros(n_unknown), *args, JACOBIAN_STEP)
+    n_bones = n_unknown - 3 * len(free_nodes)
+    # unknowns per bone are (rotation, shift) and residuals (force, moment / LEVER_MM): reorder to
+    # (shift, rotation) against (force, moment) so that K = −∂(force, moment)/∂(shift, rotation)
+    order = np.arange(n_unknown)
+    rows = np.ones(n_unknown)
+    for k in range(2):
+        order[6 * k : 6 * k + 6] = np.r_[6 * k + 3 : 6 * k + 6, 6 * k : 6 * k + 3]
+        rows[6 * k + 3 : 6 * k + 6] = LEVER_MM
+    K = -(J * rows[:, None])[:, order]
+    bones, nodes = slice(0, n_bones), slice(n_bones, n_unknown)
+    condensed = K[bones, bones]
+    if len(free_nodes):  # slack connectors leave nodes without stiffness: pseudo-inverse
+        condensed = condensed - K[bones, nodes] @ np.linalg.pinv(K[nodes, nodes], rcond=1e-9) @ K[nodes, bones]
+    R0 = args[0]
+    mass = np.zeros((n_bones, n_bones))
+    for k, b in enumerate((SCAPHOID, LUNATE)):
+        mass[6 * k : 6 * k + 3, 6 * k : 6 * k + 3] = p.bodies.mass[b] * np.eye(3)
+        mass[6 * k + 3 : 6 * k + 6, 6 * k + 3 : 6 * k + 6] = R0[b] @ p.bodies.inertia[b] @ R0[b].T
+    if n_bones > 12:
+        mass[12:, 12:] = p.bodies.mass[CAPITATE] * np.eye(3)
+    asymmetry = float(np.linalg.norm(condensed - condensed.T) / np.linalg.norm(condensed))
+    return Stiffness(0.5 * (condensed + condensed.T), mass, asymmetry)

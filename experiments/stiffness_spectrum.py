@@ -1,0 +1,69 @@
+"""What sets the explicit solver's step count: the free bones' natural frequencies at equilibrium.
+
+For the population design on each participant's idealized sweep and calibration trial, linearizes
+the force kernels at three settled frames (`equilibrium.tangent_stiffness`: central differences,
+the RSC membrane's free nodes condensed out) and prints the free bones' natural frequencies
+ω (rad/s, from K u = ω² M u with the solver's scaled masses), the spread ω_max / ω_min, and the
+time step each limits: dt·ω_max for the bones and dt·ω for the membrane's free nodes at the node
+mass the design runs with (`arrays.node_mass`). An explicit step is stable below dt·ω = 2
+(`arrays.COURANT` = 1.5 for the nodes); a slow mode needs ~1 / (dt·ω_min) steps per e-fold of its
+error, so the hold's step count follows ω_max / ω_min once the step sits at the stiffest mode's limit.
+
+Run: `python experiments/stiffness_spectrum.py [P1 P2 P3]` (~10 s per participant).
+"""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from wrist_env import design
+from wrist_env.participants import registry
+from wrist_env.participants.registry import load_model
+from wrist_env.solver import arrays
+from wrist_env.solver.equilibrium import tangent_stiffness
+from wrist_env.solver.simulate import experimental, idealized, prepare, simulate, stiffness
+
+
+def node_courant(model, dsg, driver, settings: arrays.SolverSettings) -> float:
+    """dt·ω of the membrane's stiffest free-node mode at the design's node mass (`arrays.node_mass`)."""
+    p = prepare(model, settings, driver.mode)
+    st = stiffness(p, dsg)
+    k_along = float(np.max(st.m_K / st.m_l0))
+    stiffest = p.membrane_eigenvalue * k_along + settings.membrane_contact_stiffness
+    return settings.dt_s * float(np.sqrt(stiffest / st.node_mass))
+
+
+def report(name: str, settings: arrays.SolverSettings) -> None:
+    model = load_model(name)
+    dsg = design.population()
+    motions = {
+        "sweep": idealized(model),
+        "trial": experimental(model, registry.trial(name, "calibrate").pose("capitate")),
+    }
+    for motion, driver in motions.items():
+        result = simulate(model, dsg, driver, settings)
+        frames = [1, driver.n_frames // 2, driver.n_frames - 1]
+        print(f"{name} {motion}: membrane nodes dt·ω {node_courant(model, dsg, driver, settings):.2f}")
+        for f in frames:
+            omega = tangent_stiffness(model, dsg, driver, result, f, settings).frequencies()
+            print(
+                f"  frame {f:2d}: ω {np.nanmin(omega):6.0f} … {np.nanmax(omega):6.0f} rad/s "
+                f"(spread {np.nanmax(omega) / np.nanmin(omega):4.1f}); bones dt·ω_max {settings.dt_s * np.nanmax(omega):.2f}, "
+                f"dt·ω_min {settings.dt_s * np.nanmin(omega):.3f}; {result.steps[f]} steps"
+            )
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("participants", nargs="*", default=["P1", "P2", "P3"])
+    args = parser.parse_args(argv)
+    settings = arrays.SolverSettings()
+    print(f"time step {settings.dt_s:g} s; explicit stability limit dt·ω = 2")
+    for name in args.participants:
+        report(name, settings)
+
+
+if __name__ == "__main__":
+    main()
