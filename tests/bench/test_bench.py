@@ -63,6 +63,7 @@ def test_tiny_benchmark_logs_every_evaluation_once_and_writes_the_leaderboard(p1
     for name in LEADERBOARD_FILES:
         assert (tmp_path / "lb" / name).is_file(), name
     assert "Tables 3–4" in path.read_text()
+    assert "whose hold ran out before equilibrium" in path.read_text()  # every summary records it
     # a second call finds every cell finished and runs nothing
     again = benchmark([p1], TINY, 2, 12, tmp_path / "runs", workers=2, progress=False)
     assert not again.ran and len(again.skipped) == len(TINY) * 2

@@ -23,3 +23,33 @@ def test_ecdf_targets_are_51_log_spaced_precisions_between_population_and_best_k
 def test_a_participant_without_runs_gets_no_targets():
     refs = {"P2": SimpleNamespace(population={"calibrate": {"cost": 4.0}})}
     assert ecdf_targets(["P2"], refs, {}).empty
+
+
+def test_best_cost_counts_runs_whose_calibrated_design_did_not_settle():
+    """`unsettled` in best_cost.csv: the runs whose calibrated design has a frame that ran out of hold
+    steps on the calibration trial; a failed design counts none; NaN for summaries logged before it."""
+    import pandas as pd
+
+    from wrist_env.bench.leaderboard.tables import best_cost
+
+    refs = {"P1": SimpleNamespace(population={"calibrate": {"cost": 4.0}}, truth=None)}
+    frame = pd.DataFrame(
+        {
+            "participant": ["P1"] * 5,
+            "calibrator": ["cmaes"] * 3 + ["random"] * 2,
+            "best_cost": [1.0, 1.1, 1.2, 2.0, 2.1],
+            "calibrate_unsettled_frames": [0, 3, 1, np.nan, 0],
+        }
+    )
+    table = best_cost(frame, refs, ["P1"], ["cmaes", "random"]).set_index("calibrator")
+    assert table.loc["cmaes", "unsettled"] == 2
+    assert np.isnan(table.loc["random", "unsettled"])
+
+
+def test_a_calibrated_design_reports_its_unsettled_frames():
+    """`calibrate._score` counts the frames whose hold ran out (info["settled"] False); None if failed."""
+    from wrist_env.bench.calibrate import _score
+
+    info = {"rmse": {}, "error_p75": {}, "settled": np.array([True, False, True, False])}
+    assert _score(SimpleNamespace(cost=1.5, failed=False, info=info))["unsettled_frames"] == 2
+    assert _score(SimpleNamespace(cost=1000.0, failed=True, info=info))["unsettled_frames"] is None

@@ -117,8 +117,9 @@ class CalibrationRun:
 
     result: the OptimizeResult (x: the best 22 normalized materials).
     design: the calibrated design (injury intact); `design.as_dict()` in physical units.
-    calibrate / validate: {"cost", "failed", "rmse", "error_p75"} of the calibrated design on the
-        calibration trial and on the held-out resisted trial (rmse, error_p75: {bone: {DOF: mm or deg}}).
+    calibrate / validate: {"cost", "failed", "rmse", "error_p75", "unsettled_frames"} of the calibrated
+        design on the calibration trial and on the held-out resisted trial (rmse, error_p75: {bone: {DOF:
+        mm or deg}}; unsettled_frames: frames whose hold ran out before equilibrium, None if failed).
     recovery_z: RMS of z(calibrated) − z(truth) over the 22 materials (Table 2 SD units); None
         without a hidden truth. recovery_z_population: the same for the population design.
     replayed: evaluations taken from the log instead of simulated (a resumed run).
@@ -184,6 +185,7 @@ def _score(evaluation) -> dict:
         "failed": bool(evaluation.failed),
         "rmse": info.get("rmse"),
         "error_p75": info.get("error_p75"),
+        "unsettled_frames": None if evaluation.failed else int(np.sum(~np.asarray(info["settled"], dtype=bool))),
     }
 
 

@@ -76,6 +76,18 @@ def readme(board: Leaderboard, title: str | None = None) -> str:
             }
         )
     lines += [md_table(pd.concat([table, pd.DataFrame(ref_rows)], ignore_index=True)), ""]
+    if best.unsettled.notna().all():
+        flagged = best[best.unsettled > 0]
+        which = "; ".join(
+            f"{r.calibrator} on {r.participant}: {int(r.unsettled)} of {r.runs}" for r in flagged.itertuples()
+        )
+        lines += [
+            "Calibrated designs with a frame whose hold ran out before equilibrium (`unsettled` in "
+            "`best_cost.csv`: that frame's pose is where the solver stopped, not a balanced one): "
+            + (which or "none")
+            + ".",
+            "",
+        ]
     lines += ["![convergence](convergence.png)", ""]
 
     lines += [

@@ -88,6 +88,7 @@ def best_cost(
             if sub.empty:
                 continue
             v = sub.best_cost.to_numpy()
+            unsettled = sub.calibrate_unsettled_frames.to_numpy(dtype=float)
             rows.append(
                 {
                     "participant": p,
@@ -98,6 +99,8 @@ def best_cost(
                     "max": float(v.max()),
                     "population": refs[p].population["calibrate"]["cost"],
                     "truth": refs[p].truth["calibrate"]["cost"] if refs[p].truth else np.nan,
+                    # runs whose calibrated design has a frame that did not settle (NaN: logged before it was)
+                    "unsettled": float(np.sum(unsettled > 0)) if np.isfinite(unsettled).all() else np.nan,
                 }
             )
     return pd.DataFrame(rows)
@@ -381,6 +384,10 @@ def _runs_frame(summaries, curves_by_key, targets, budgets) -> pd.DataFrame:
             "best_cost": s["best_cost"],
             "best_eval": s["best_eval"],
             "calibrate_cost": s["calibrate"]["cost"],
+            # NaN in summaries logged before it was recorded; a failed design counts none
+            "calibrate_unsettled_frames": (s["calibrate"]["unsettled_frames"] or 0)
+            if "unsettled_frames" in s["calibrate"]
+            else np.nan,
             "validate_cost": s["validate"]["cost"],
             "validate_failed": s["validate"]["failed"],
             "recovery_z": s["recovery_z"],
