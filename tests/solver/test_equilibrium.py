@@ -25,10 +25,10 @@ def tension(K, strain):
     return K * strain * strain / (4 * EPSILON_L) if strain <= 2 * EPSILON_L else K * (strain - EPSILON_L)
 
 
-def test_two_opposed_bundles_reach_the_closed_form_equilibrium():
-    """A free scaphoid between two opposed fibre bundles on one line, left mid-oscillation by a
-    few undamped steps: the Newton reference lands where the two tensions balance (brentq on
-    the force balance written here), to 1e-6 mm, with no net force left."""
+def two_bundles_mid_oscillation():
+    """A free scaphoid between two opposed fibre bundles on one line through its centre of mass, left
+    mid-oscillation by a few undamped steps: (model, design, driver, settings, run, fibre origins a (mm
+    along the line), zero-load lengths l0 (mm), scales K (N))."""
     fib, materials = OSCILLATORS["two bundles opposed"]
     model = oscillator(fib)
     vector = design.population().vector.copy()
@@ -38,11 +38,6 @@ def test_two_opposed_bundles_reach_the_closed_form_equilibrium():
     a = np.array([p for _, p in fib])
     l0 = np.array([abs(p) / materials[g][1] for g, p in fib])
     K = np.array([materials[g][0] * l for (g, _), l in zip(fib, l0)])
-
-    def net(y):  # force along the line on the body at y
-        return sum(-tension(Ki, abs(y - ai) / l0i - 1.0) * np.sign(y - ai) for ai, l0i, Ki in zip(a, l0, K))
-
-    y_star = brentq(net, a.min() + 1e-3, a.max() - 1e-3)
     settings = replace(
         undamped(SolverSettings()),
         dt_s=1e-6,
@@ -57,6 +52,18 @@ def test_two_opposed_bundles_reach_the_closed_form_equilibrium():
     driver = experimental(model, np.tile(np.eye(4), (2, 1, 1)))
     result = simulate(model, dsg, driver, settings)
     assert result.ok
+    return model, dsg, driver, settings, result, a, l0, K
+
+
+def test_two_opposed_bundles_reach_the_closed_form_equilibrium():
+    """The two opposed bundles (`two_bundles_mid_oscillation`): the Newton reference lands where the two
+    tensions balance (brentq on the force balance written here), to 1e-6 mm, with no net force left."""
+    model, dsg, driver, settings, result, a, l0, K = two_bundles_mid_oscillation()
+
+    def net(y):  # force along the line on the body at y
+        return sum(-tension(Ki, abs(y - ai) / l0i - 1.0) * np.sign(y - ai) for ai, l0i, Ki in zip(a, l0, K))
+
+    y_star = brentq(net, a.min() + 1e-3, a.max() - 1e-3)
     start = result.poses[-1, SCAPHOID, :3, 3] @ AXIS
     eq = nearest(model, dsg, driver, result, settings)
     y = eq.poses[-1, SCAPHOID, :3, 3] @ AXIS
@@ -77,32 +84,11 @@ def test_population_sweep_is_near_its_equilibrium(p1):
 
 
 def test_tangent_stiffness_of_two_opposed_bundles_is_the_closed_form():
-    """The scaphoid between two opposed bundles on one line through its centre of mass, mid-way: along
-    the line the stiffness is Σ T'(ε_i)/l0_i, across it the tensions' geometric stiffness Σ T_i/L_i
-    (Blankevoort, DESIGN.md, written here), and nothing resists a rotation about the centre of mass."""
-    fib, materials = OSCILLATORS["two bundles opposed"]
-    model = oscillator(fib)
-    vector = design.population().vector.copy()
-    for lig, (k, r) in materials.items():
-        vector[lig], vector[len(LIGAMENT_NAMES) + lig] = k, r
-    dsg = design.Design.from_vector(vector)
-    settings = replace(
-        undamped(SolverSettings()),
-        dt_s=1e-6,
-        settle_steps=0,
-        move_steps=0,
-        ramp_steps=0,
-        min_hold_steps=7,
-        max_hold_steps=7,
-        inertia_scale=1.0,
-        max_disp_mm=1e3,
-    )
-    driver = experimental(model, np.tile(np.eye(4), (2, 1, 1)))
-    result = simulate(model, dsg, driver, settings)
+    """The two opposed bundles mid-way (`two_bundles_mid_oscillation`): along the line the stiffness is
+    Σ T'(ε_i)/l0_i, across it the tensions' geometric stiffness Σ T_i/L_i (Blankevoort, DESIGN.md,
+    written here), and nothing resists a rotation about the centre of mass."""
+    model, dsg, driver, settings, result, a, l0, K = two_bundles_mid_oscillation()
     y = result.poses[-1, SCAPHOID, :3, 3] @ AXIS  # the centre of mass's shift along the line
-    a = np.array([p for _, p in fib])
-    l0 = np.array([abs(p) / materials[g][1] for g, p in fib])
-    K = np.array([materials[g][0] * l for (g, _), l in zip(fib, l0)])
     length = np.abs(y - a)
     strain = length / l0 - 1.0
     slope = np.where(strain <= 0.0, 0.0, np.where(strain <= 2 * EPSILON_L, K * strain / (2 * EPSILON_L), K))  # dT/dε
