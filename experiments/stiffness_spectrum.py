@@ -30,8 +30,7 @@ def node_courant(model, dsg, driver, settings: arrays.SolverSettings) -> float:
     """dt·ω of the membrane's stiffest free-node mode at the design's node mass (`arrays.node_mass`)."""
     p = prepare(model, settings, driver.mode)
     st = stiffness(p, dsg)
-    k_along = float(np.max(st.m_K / st.m_l0))
-    stiffest = p.membrane_eigenvalue * k_along + settings.membrane_contact_stiffness
+    stiffest = arrays.membrane_stiffest(p.settings, p.membrane_eigenvalue, st.m_l0, st.m_K)
     return settings.dt_s * float(np.sqrt(stiffest / st.node_mass))
 
 

@@ -213,6 +213,12 @@ def membrane_eigenvalue(model: Model, mem: Membrane) -> float:
     return float(np.linalg.eigvalsh(K)[-1]) if n else 0.0
 
 
+def membrane_stiffest(st: Settings, eigenvalue: float, m_l0: np.ndarray, m_K: np.ndarray) -> float:
+    """Stiffness (N/mm) of the membrane's stiffest free-node mode for one design's connectors (m_l0, m_K of
+    `design_arrays`): `membrane_eigenvalue` × the along connectors' stiffness + the node–scaphoid contact's."""
+    return eigenvalue * float(np.max(m_K / m_l0)) + st.membrane_contact_stiffness
+
+
 def node_mass(st: Settings, eigenvalue: float, m_l0: np.ndarray, m_K: np.ndarray) -> float:
     """Mass (t) of the membrane's free nodes for one design's connectors (m_l0, m_K of `design_arrays`):
     st.node_mass, raised to keep dt·ω ≤ `COURANT` where ω² = (eigenvalue × the along connectors'
@@ -220,9 +226,7 @@ def node_mass(st: Settings, eigenvalue: float, m_l0: np.ndarray, m_K: np.ndarray
     the time step, as explicit finite-element codes do; a quasi-static answer does not depend on it."""
     if st.node_mass <= 0.0 or len(m_K) == 0:
         return float(st.node_mass)
-    k_along = float(np.max(m_K / m_l0))
-    stiffest = eigenvalue * k_along + st.membrane_contact_stiffness
-    return max(float(st.node_mass), stiffest * (st.dt / COURANT) ** 2)
+    return max(float(st.node_mass), membrane_stiffest(st, eigenvalue, m_l0, m_K) * (st.dt / COURANT) ** 2)
 
 
 def design_arrays(

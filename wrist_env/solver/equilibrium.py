@@ -200,7 +200,7 @@ def nearest(model: Model, design: Design, driver, result, settings: arrays.Solve
 
 
 @dataclass(frozen=True)
-class Stiffness:
+class Tangent:
     """The free bones' tangent stiffness at one frame of an explicit run, the RSC membrane's free nodes
     condensed out (they follow quasi-statically).
 
@@ -225,8 +225,8 @@ class Stiffness:
 
 def tangent_stiffness(
     model: Model, design: Design, driver, result, frame: int, settings: arrays.SolverSettings | None = None
-) -> Stiffness:
-    """`Stiffness` of the free bones at `frame` of `result` (a successful `simulate(model, design, driver)`):
+) -> Tangent:
+    """`Tangent` stiffness of the free bones at `frame` of `result` (a successful `simulate(model, design, driver)`):
     central differences of the force kernels (`JACOBIAN_STEP`), no time step or damping."""
     if not result.ok:
         raise ValueError(f"the run failed ({result.message}); there is no state to linearize")
@@ -255,4 +255,4 @@ def tangent_stiffness(
     if n_bones > 12:
         mass[12:, 12:] = p.bodies.mass[CAPITATE] * np.eye(3)
     asymmetry = float(np.linalg.norm(condensed - condensed.T) / np.linalg.norm(condensed))
-    return Stiffness(0.5 * (condensed + condensed.T), mass, asymmetry)
+    return Tangent(0.5 * (condensed + condensed.T), mass, asymmetry)
