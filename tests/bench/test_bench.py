@@ -57,6 +57,7 @@ def test_tiny_benchmark_logs_every_evaluation_once_and_writes_the_leaderboard(p1
     rows = RunLog(tmp_path / "runs").read(dedupe=False)
     assert len(rows) == 1 * len(TINY) * 2 * 12
     assert _duplicates(rows) == 0 and np.isfinite(rows.cost).all()
+    assert rows.unsettled.notna().sum() == (~rows.failed).sum()  # every run that ran counts its unsettled frames
     for _, group in rows.groupby(list(KEY_FIELDS)):
         assert group["eval"].tolist() == list(range(12))
     path = write_leaderboard(tmp_path / "runs", tmp_path / "lb")

@@ -178,6 +178,11 @@ class CalibrationRun:
         return out
 
 
+def unsettled_frames(evaluation) -> int | None:
+    """Frames of an evaluated run whose hold ran out before equilibrium; None if the run failed."""
+    return None if evaluation.failed else int(np.sum(~np.asarray(evaluation.info["settled"], dtype=bool)))
+
+
 def _score(evaluation) -> dict:
     info = evaluation.info
     return {
@@ -185,7 +190,7 @@ def _score(evaluation) -> dict:
         "failed": bool(evaluation.failed),
         "rmse": info.get("rmse"),
         "error_p75": info.get("error_p75"),
-        "unsettled_frames": None if evaluation.failed else int(np.sum(~np.asarray(info["settled"], dtype=bool))),
+        "unsettled_frames": unsettled_frames(evaluation),
     }
 
 
@@ -260,6 +265,7 @@ def calibrate(
             cost,
             np.array([e.failed for e in evaluations]),
             np.stack([rmse_vector(e.info) for e in evaluations]),
+            [unsettled_frames(e) for e in evaluations],
         )
         return y
 
@@ -268,8 +274,8 @@ def calibrate(
         if state["new"]:
             state["batch"] = max(state["batch"], logged_batches)  # after a replay: the next free batch number
             if run_log is not None:
-                cost, failed, rmse = state["pending"]
-                run_log.append(key, state["batch"], n, x, cost, failed, rmse, objective=y)
+                cost, failed, rmse, unsettled = state["pending"]
+                run_log.append(key, state["batch"], n, x, cost, failed, rmse, objective=y, unsettled=unsettled)
         else:
             state["replayed"] += k
         state["batch"] += 1

@@ -15,8 +15,9 @@ It is a `wrist_env.runs.store.RunStore` (parts in `evals/`, records in
 budget), its index in the run (`eval`, 0-based, the optimizer's order) and
 batch (`batch`), the 22 normalized material variables (`x.<name>`), the
 kinematic cost on the calibration trial, `failed`, the RMSE of the 12
-scaphoid and lunate DOF (`rmse.<bone>.<DOF>`, mm and deg; NaN if failed), and
-the `objective` the calibrator minimized (the cost, or the MAP objective).
+scaphoid and lunate DOF (`rmse.<bone>.<DOF>`, mm and deg; NaN if failed),
+the `objective` the calibrator minimized (the cost, or the MAP objective), and
+`unsettled`, the frames whose hold ran out before equilibrium (null if failed).
 
 No evaluation is logged twice: `append` refuses a batch whose file or eval
 indices already exist, and `read` drops duplicate (run key, eval) rows (the
@@ -65,10 +66,12 @@ SCHEMA = pa.schema(
     + [(c, pa.float64()) for c in X_COLUMNS]
     + [("cost", pa.float64()), ("failed", pa.bool_())]
     + [(c, pa.float64()) for c in RMSE_COLUMNS]
-    + [("objective", pa.float64())]
+    + [("objective", pa.float64()), ("unsettled", pa.int64())]
 )
 """Columns of the evaluation log; `time` is the Unix time the batch finished; `objective` is the value
-the calibrator was told (the cost, or a `+prior` calibrator's MAP objective; null in logs older than it)."""
+the calibrator was told (the cost, or a `+prior` calibrator's MAP objective); `unsettled` the frames of
+the run whose hold ran out before equilibrium (its outputs are where the bones were then; null if the
+run failed). Both are null in logs older than them."""
 
 _PART = re.compile(r"^part-(?P<cell>.+)-b(?P<batch>\d+)-e(?P<start>\d+)-(?P<end>\d+)\.parquet$")
 _CELL = re.compile(r"^cell-(?P<cell>.+)-n(?P<n>\d+)\.parquet$")
@@ -126,11 +129,13 @@ class RunLog:
         failed: ArrayLike,
         rmse: np.ndarray,
         objective: ArrayLike | None = None,
+        unsettled: ArrayLike | None = None,
     ) -> Path:
         """Log one batch: evaluations start … start + k − 1 of `key`, atomically, never twice.
 
         x (k, 22) normalized materials; cost (k,); failed (k,); rmse (k, 12) in `RMSE_COLUMNS` order;
-        objective (k,) the values told to the calibrator (default: the cost).
+        objective (k,) the values told to the calibrator (default: the cost); unsettled (k,) frames that
+        did not settle per evaluation, None where it failed (default: all null).
         """
         x = np.atleast_2d(np.asarray(x, dtype=np.float64))
         k = len(x)
@@ -163,6 +168,9 @@ class RunLog:
         columns["failed"] = failed
         columns.update({c: rmse[:, i] for i, c in enumerate(RMSE_COLUMNS)})
         columns["objective"] = cost if objective is None else np.asarray(objective, dtype=np.float64).reshape(k)
+        columns["unsettled"] = [None] * k if unsettled is None else [None if u is None else int(u) for u in unsettled]
+        if len(columns["unsettled"]) != k:
+            raise ValueError(f"unsettled must have {k} entries, but got {len(columns['unsettled'])}")
         table = pa.Table.from_pydict(columns, schema=SCHEMA)
         return self.store.write_part(f"part-{key.name}-b{batch:05d}-e{start:06d}-{start + k:06d}", table)
 

@@ -4,7 +4,8 @@
 only) and writes to the folder `out`:
 
 - best_cost.csv: best calibration cost at the budget per participant and calibrator, median and
-  IQR (25th–75th percentile) over seeds;
+  IQR (25th–75th percentile) over seeds; `unsettled`: runs whose calibrated design has a frame whose
+  hold ran out before equilibrium; `unsettled_evals`: the share of the runs' evaluations with one;
 - targets.csv, evals_to_target.csv: evaluations to reach each cost target (TARGETS), the number
   of runs that reached it and COCO's expected running time (ERT);
 - ecdf.png: COCO-style ECDF of (run, target) pairs solved against evaluations;

@@ -88,6 +88,13 @@ def readme(board: Leaderboard, title: str | None = None) -> str:
             + ".",
             "",
         ]
+    if best.unsettled_evals.notna().all():
+        worst = best.loc[best.unsettled_evals.idxmax()]
+        lines += [
+            "Evaluations on the way with such a frame (`unsettled_evals`, a share of each calibrator's "
+            f"evaluations): at most {worst.unsettled_evals:.1%} ({worst.calibrator} on {worst.participant}).",
+            "",
+        ]
     lines += ["![convergence](convergence.png)", ""]
 
     lines += [

@@ -67,6 +67,17 @@ def curves(evals: pd.DataFrame) -> dict:
     return out
 
 
+def unsettled_shares(evals: pd.DataFrame) -> dict:
+    """{(participant, optimizer, seed, budget): share of the run's simulated (not failed) evaluations with a
+    frame whose hold ran out before equilibrium}; NaN for a run logged before the log recorded it."""
+    out = {}
+    for key, group in evals.groupby(["participant", "optimizer", "seed", "budget"], sort=True):
+        ran = group[~group.failed.astype(bool)]
+        u = ran["unsettled"].to_numpy(dtype=float) if "unsettled" in ran else np.full(len(ran), np.nan)
+        out[key] = float(np.mean(u > 0)) if len(u) and np.isfinite(u).all() else np.nan
+    return out
+
+
 def hit(curve: np.ndarray, target: float) -> int | None:
     """Evaluations (1-based count) until the best-so-far cost is ≤ target; None if never."""
     idx = np.flatnonzero(curve <= target)
@@ -101,6 +112,8 @@ def best_cost(
                     "truth": refs[p].truth["calibrate"]["cost"] if refs[p].truth else np.nan,
                     # runs whose calibrated design has a frame that did not settle (NaN: logged before it was)
                     "unsettled": float(np.sum(unsettled > 0)) if np.isfinite(unsettled).all() else np.nan,
+                    # share of all the runs' evaluations with such a frame (NaN: logged before it was)
+                    "unsettled_evals": float(sub.unsettled_evals.to_numpy(dtype=float).mean()),
                 }
             )
     return pd.DataFrame(rows)
@@ -368,9 +381,11 @@ def ecdf_targets(participants: Iterable[str], refs: dict[str, Reference], curves
     return pd.DataFrame(rows, columns=["participant", "k", "value"])
 
 
-def _runs_frame(summaries, curves_by_key, targets, budgets) -> pd.DataFrame:
-    """One row per run: its key, costs, recovery, held-out RMSE and evaluations to each target."""
+def _runs_frame(summaries, curves_by_key, targets, budgets, unsettled_by_key=None) -> pd.DataFrame:
+    """One row per run: its key, costs, recovery, held-out RMSE and evaluations to each target;
+    unsettled_by_key: `unsettled_shares` of the run log."""
     rows = []
+    unsettled_by_key = unsettled_by_key or {}
     for s in summaries:
         key = (s["participant"], s["optimizer"], s["seed"], s["budget"])
         curve = curves_by_key.get(key, np.array([s["best_cost"]]))
@@ -388,6 +403,7 @@ def _runs_frame(summaries, curves_by_key, targets, budgets) -> pd.DataFrame:
             "calibrate_unsettled_frames": (s["calibrate"]["unsettled_frames"] or 0)
             if "unsettled_frames" in s["calibrate"]
             else np.nan,
+            "unsettled_evals": unsettled_by_key.get(key, np.nan),
             "validate_cost": s["validate"]["cost"],
             "validate_failed": s["validate"]["failed"],
             "recovery_z": s["recovery_z"],
@@ -417,7 +433,7 @@ def build(runs: str | Path, references: dict[str, Reference] | None = None) -> L
             refs[p] = reference(p)
     by_key = curves(evals)
     targets = _targets(participants, refs)
-    runs_frame = _runs_frame(summaries, by_key, targets, budgets)
+    runs_frame = _runs_frame(summaries, by_key, targets, budgets, unsettled_shares(evals))
     chosen = best_runs(summaries)
     return Leaderboard(
         str(runs),
