@@ -10,7 +10,8 @@ sensitivity and the Fisher matrix at the hidden truth, P1–P3), the best calibr
 the prior (`leaderboards/prior/`) and the Bayesian calibrator's coverage on the trials and on the
 model's own trials (`leaderboards/posterior/`: emcee at 300 steps with the default 24 MAP starts
 and prior refresh; SMC on the model's trials; where the built-in trials' model error comes from,
-`experiments/model_error.py`). The studies' run logs go to a fresh
+`experiments/model_error.py`, and the truth's standing under other likelihoods,
+`experiments/capitate_likelihood.py`). The studies' run logs go to a fresh
 folder `runs/regenerate-<commit>/` (a killed run resumes there when rerun at the same commit).
 
 Run: `python experiments/regenerate.py` (~4 h on a 2-core machine); `--figures-only` skips the
@@ -81,6 +82,7 @@ def steps(runs: Path, figures_only: bool) -> list[list[str]]:
             *("--out", str(runs / "posterior"), "--report", "leaderboards/posterior"),
         ],
         ["python", "experiments/model_error.py"],
+        ["python", "experiments/capitate_likelihood.py"],
     ]
 
 
