@@ -9,12 +9,13 @@ Monte Carlo study (P1 + P2, 2 × 12,500) with its report, what a trial identifie
 sensitivity and the Fisher matrix at the hidden truth, P1–P3), the best calibrators with and without
 the prior (`leaderboards/prior/`) and the Bayesian calibrator's coverage on the trials and on the
 model's own trials (`leaderboards/posterior/`: emcee at 300 steps with the default 24 MAP starts
-and prior refresh; SMC on the model's trials; where the built-in trials' model error comes from,
+and prior refresh, and on the model's trials at the default 1,200 steps too, ~2.3 h, in
+`leaderboards/posterior/steps1200/`; SMC on the model's trials; where the built-in trials' model error comes from,
 `experiments/model_error.py`, and the truth's standing under other likelihoods,
 `experiments/capitate_likelihood.py`). The studies' run logs go to a fresh
 folder `runs/regenerate-<commit>/` (a killed run resumes there when rerun at the same commit).
 
-Run: `python experiments/regenerate.py` (~4 h on a 2-core machine); `--figures-only` skips the
+Run: `python experiments/regenerate.py` (~6 h on a 2-core machine); `--figures-only` skips the
 studies (~6 min).
 """
 
@@ -75,6 +76,11 @@ def steps(runs: Path, figures_only: bool) -> list[list[str]]:
             "posterior",
             *("P1", "P2", "P3", "--seeds", "3", "--steps", "300", "--model-trials"),
             *("--out", str(runs / "posterior"), "--report", "leaderboards/posterior"),
+        ],
+        [
+            "posterior",
+            *("P1", "P2", "P3", "--seeds", "3", "--model-trials"),
+            *("--out", str(runs / "posterior1200"), "--report", "leaderboards/posterior/steps1200"),
         ],
         [
             "posterior",
