@@ -73,7 +73,7 @@ def unsettled_shares(evals: pd.DataFrame) -> dict:
     out = {}
     for key, group in evals.groupby(["participant", "optimizer", "seed", "budget"], sort=True):
         ran = group[~group.failed.astype(bool)]
-        u = ran["unsettled"].to_numpy(dtype=float) if "unsettled" in ran else np.full(len(ran), np.nan)
+        u = ran["unsettled"].to_numpy(dtype=float)  # the log's schema gives older logs the column, null
         out[key] = float(np.mean(u > 0)) if len(u) and np.isfinite(u).all() else np.nan
     return out
 
@@ -381,11 +381,10 @@ def ecdf_targets(participants: Iterable[str], refs: dict[str, Reference], curves
     return pd.DataFrame(rows, columns=["participant", "k", "value"])
 
 
-def _runs_frame(summaries, curves_by_key, targets, budgets, unsettled_by_key=None) -> pd.DataFrame:
+def _runs_frame(summaries, curves_by_key, targets, budgets, unsettled_by_key) -> pd.DataFrame:
     """One row per run: its key, costs, recovery, held-out RMSE and evaluations to each target;
     unsettled_by_key: `unsettled_shares` of the run log."""
     rows = []
-    unsettled_by_key = unsettled_by_key or {}
     for s in summaries:
         key = (s["participant"], s["optimizer"], s["seed"], s["budget"])
         curve = curves_by_key.get(key, np.array([s["best_cost"]]))
