@@ -48,7 +48,7 @@ def save_dataclass(obj: DataclassInstance, path: str | Path) -> None:
     def write_npz(tmp: Path) -> None:
         with open(tmp, "wb") as fh:
             np.savez_compressed(fh, **arrays)
-        digest["sha256"] = _sha256(tmp)
+        digest["sha256"] = sha256_file(tmp)
 
     atomic_write(path.with_suffix(".npz"), write_npz)
     header = {"class": type(obj).__name__, "format": FORMAT_VERSION, "npz_sha256": digest["sha256"], "fields": meta}
@@ -71,7 +71,7 @@ def load_dataclass(cls: type[_D], path: str | Path) -> _D:
             f"v{header.get('format') if isinstance(header, dict) else '?'}, not {cls.__name__} v{FORMAT_VERSION}"
         )
     try:
-        digest = _sha256(npz)
+        digest = sha256_file(npz)
     except OSError as e:
         raise StoreError(f"{npz}: cannot be read ({e}); delete {js} to rebuild") from None
     if header.get("npz_sha256") != digest:
@@ -98,7 +98,8 @@ def load_dataclass(cls: type[_D], path: str | Path) -> _D:
     return cls(**{f.name: kwargs[f.name] for f in dataclasses.fields(cls) if f.name in kwargs})
 
 
-def _sha256(path: Path) -> str:
+def sha256_file(path: str | Path) -> str:
+    """The SHA-256 (hex) of a file's bytes."""
     h = hashlib.sha256()
     with open(path, "rb") as fh:
         for block in iter(lambda: fh.read(1 << 20), b""):
@@ -164,6 +165,13 @@ def write_json(path: str | Path, data: object) -> Path:
     """Strict JSON (no NaN; sorted keys), atomically (`atomic_write`)."""
     text = json.dumps(data, indent=1, allow_nan=False, sort_keys=True, default=_jsonable) + "\n"
     return atomic_write(path, lambda p: Path(p).write_text(text))
+
+
+def json_sha256(data: object) -> str:
+    """The SHA-256 (hex) of `data` as canonical JSON (sorted keys, no spaces): equal for a dict and the
+    same dict written by `write_json` and read back."""
+    text = json.dumps(data, sort_keys=True, allow_nan=False, separators=(",", ":"), default=_jsonable)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 
 def read_json(path: str | Path, what: str = "file", advice: str = "") -> dict | list:

@@ -75,3 +75,46 @@ def test_a_held_lock_refuses_a_second_holder_that_will_not_wait(tmp_path):
                 pass
     with RunStore(tmp_path).lock(wait=False):  # released
         pass
+
+
+def test_a_part_changed_after_it_was_written_fails_its_checksum(tmp_path):
+    import pyarrow.parquet as pq
+
+    store = RunStore(tmp_path, parts="p")
+    path = store.write_part("a", TABLE)
+    assert (tmp_path / "p" / "a.parquet.sha256").is_file()
+    pq.write_table(pa.table({"x": [1, 3]}), path)  # a valid file, one value edited
+    with pytest.raises(StoreError, match=re.escape(str(path)) + r".*SHA-256.*a.parquet.sha256.*changed.*do this"):
+        store.read_parts(advice="do this")
+    assert [name for name, _ in store.damaged_parts()] == ["a"]
+    with pytest.warns(UserWarning, match="a.parquet"):
+        target = store.quarantine(path, "changed")
+    assert (tmp_path / "damaged" / "a.parquet.sha256").is_file() and target.is_file()
+    store.write_part("a", TABLE)  # written again, with its own checksum
+    assert store.read_parts()["x"].to_pylist() == [1, 2]
+
+
+def test_a_part_without_a_checksum_is_read_unchecked(tmp_path):
+    store = RunStore(tmp_path, parts="p")
+    store.write_part("a", TABLE)
+    (tmp_path / "p" / "a.parquet.sha256").unlink()  # a log written before checksums
+    assert store.read_parts()["x"].to_pylist() == [1, 2]
+
+
+def test_a_record_changed_after_it_was_written_fails_its_checksum(tmp_path):
+    store = RunStore(tmp_path)
+    store.write_record("cell", {"nfev": 3, "best_cost": 1.5})
+    path = store.record_path("cell")
+    assert store.read_record("cell") == {"nfev": 3, "best_cost": 1.5}
+    path.write_text(path.read_text().replace("1.5", "0.5"))
+    with pytest.raises(StoreError, match=re.escape(str(path)) + ".*damaged record.*SHA-256.*do this"):
+        store.read_record("cell", advice="do this")
+
+
+def test_the_checksum_of_a_part_never_moved_into_place_is_cleaned(tmp_path):
+    store = RunStore(tmp_path, parts="p")
+    store.write_part("a", TABLE)
+    orphan = tmp_path / "p" / "b.parquet.sha256"  # its writer was killed between the two files
+    orphan.write_text("0" * 64)
+    assert store.clean(min_age_s=0) == 1 and not orphan.exists()
+    assert (tmp_path / "p" / "a.parquet.sha256").is_file()

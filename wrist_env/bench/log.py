@@ -37,15 +37,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import pyarrow as pa
-import pyarrow.parquet as pq
 from numpy.typing import ArrayLike
 
 from wrist_env.cost import COST_BONES
 from wrist_env.design import N_MATERIAL, NAMES
 from wrist_env.errors import StoreError
 from wrist_env.frames import DOF_NAMES
-from wrist_env.io import atomic_write
-from wrist_env.runs.store import RunStore, read_parquet
+from wrist_env.runs.store import RunStore, read_parquet, remove_file, write_parquet
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -73,8 +71,48 @@ the calibrator was told (the cost, or a `+prior` calibrator's MAP objective); `u
 the run whose hold ran out before equilibrium (its outputs are where the bones were then; null if the
 run failed). Both are null in logs older than them."""
 
+SUMMARY_KEYS = (
+    "participant",
+    "optimizer",
+    "seed",
+    "budget",
+    "nfev",
+    "best_cost",
+    "best_eval",
+    "calibrate",
+    "validate",
+    "recovery_z",
+    "recovery_z_population",
+)
+"""Fields of a cell summary the leaderboard reads; `calibrate` and `validate` hold `SCORE_KEYS`."""
+SCORE_KEYS = ("cost", "failed", "rmse")
+
 _PART = re.compile(r"^part-(?P<cell>.+)-b(?P<batch>\d+)-e(?P<start>\d+)-(?P<end>\d+)\.parquet$")
 _CELL = re.compile(r"^cell-(?P<cell>.+)-n(?P<n>\d+)\.parquet$")
+
+
+def _match(name: str) -> re.Match | None:
+    return _PART.match(name) or _CELL.match(name)
+
+
+def _span(m: re.Match) -> tuple[int, int]:
+    """(first, end) evaluation of a batch or compacted cell file, from its name's match."""
+    return (int(m["start"]), int(m["end"])) if "start" in m.groupdict() else (0, int(m["n"]))
+
+
+def _check_summary(path: Path, summary) -> None:
+    """`StoreError` naming `path` if `summary` lacks a field the leaderboard reads."""
+    if not isinstance(summary, dict):
+        raise StoreError(f"{path}: not a cell summary (a JSON {type(summary).__name__}); {RERUN}")
+    missing = [k for k in SUMMARY_KEYS if k not in summary]
+    for t in ("calibrate", "validate"):
+        if t in summary:
+            missing += [f"{t}.{k}" for k in SCORE_KEYS if not isinstance(summary[t], dict) or k not in summary[t]]
+    nfev = summary.get("nfev")
+    if not isinstance(nfev, int) or isinstance(nfev, bool):
+        missing.append("an integer nfev")
+    if missing:
+        raise StoreError(f"{path}: not a whole cell summary (no {', '.join(missing)}); {RERUN}")
 
 
 class DuplicateEvaluationError(RuntimeError):
@@ -181,10 +219,10 @@ class RunLog:
             return None
         path = self.evals_dir / f"cell-{key.name}-n{len(frame):06d}.parquet"
         table = pa.Table.from_pandas(frame, schema=SCHEMA, preserve_index=False)
-        atomic_write(path, lambda p: pq.write_table(table, p))
+        write_parquet(path, table)
         for p in self._files(key):
             if p != path:
-                p.unlink(missing_ok=True)
+                remove_file(p)
         return path
 
     def write_summary(self, key: RunKey, summary: dict) -> Path:
@@ -198,51 +236,57 @@ class RunLog:
 
     def repair(self) -> int:
         """Make the log consistent before a run: remove temporary files; move to `damaged/` every
-        unreadable Parquet file (with the later batches of its cell, so the cell resumes from the
-        gap), every unreadable summary and every summary whose evaluations are not all logged (those
-        cells run again, by replay where their evaluations are logged). Returns the files moved."""
+        unreadable or changed Parquet file and every batch after a gap (a deleted file), each with the
+        later batches of its cell, so the cell resumes from the gap; and every unreadable, incomplete
+        or changed summary and every summary whose evaluations are not all logged (those cells run
+        again, by replay where their evaluations are logged). Returns the files moved."""
         self.store.clean()
         moved = 0
-        by_cell: dict[str, list[tuple[int, Path]]] = {}
-        for p in self._files():
-            m = _PART.match(p.name) or _CELL.match(p.name)
-            by_cell.setdefault(m["cell"], []).append((int(m["start"]) if "start" in m.groupdict() else 0, p))
-        for name, damaged in self.store.damaged_parts(SCHEMA):
+        for name, _ in self.store.damaged_parts(SCHEMA):
             path = self.store.part_path(name)
-            m = _PART.match(path.name) or _CELL.match(path.name)
-            if m is None:
-                continue
-            first = int(m["start"]) if "start" in m.groupdict() else 0
-            for start, p in sorted(by_cell.get(m["cell"], [])):
-                if p == path or start >= first:
-                    moved += (
-                        self.store.quarantine(
-                            p,
-                            "damaged Parquet file, its evaluations are re-simulated"
-                            if p == path
-                            else f"follows the damaged {path.name} in its cell, re-simulated",
-                        )
-                        is not None
-                    )
-        progress = self.progress()  # after the damaged parts were moved
+            m = _match(path.name)
+            if m is not None:
+                moved += self._drop_from(path, "damaged Parquet file, its evaluations are re-simulated")
+        for files in self._by_cell().values():
+            end = 0
+            for start, stop, path in files:
+                if start > end:
+                    reason = f"evaluations {end}…{start - 1} of its cell are missing (a file deleted?), re-simulated"
+                    moved += self._drop_from(path, reason)
+                    break
+                end = max(end, stop)
+        return moved + self._repair_summaries()
+
+    def _by_cell(self) -> dict[str, list[tuple[int, int, Path]]]:
+        """{cell name: [(first eval, end eval, file)] sorted}, from the file names."""
+        out: dict[str, list[tuple[int, int, Path]]] = {}
+        for p in self._files():
+            m = _match(p.name)
+            out.setdefault(m["cell"], []).append((*_span(m), p))
+        return {cell: sorted(files) for cell, files in out.items()}
+
+    def _drop_from(self, path: Path, reason: str) -> int:
+        """Move `path` and every later file of its cell to `damaged/`; returns how many moved."""
+        m = _match(path.name)
+        first, moved = _span(m)[0], 0
+        for start, _, p in self._by_cell().get(m["cell"], []):
+            if p == path or start >= first:
+                why = reason if p == path else f"follows {path.name} in its cell, re-simulated"
+                moved += self.store.quarantine(p, why) is not None
+        return moved
+
+    def _repair_summaries(self) -> int:
+        """Move aside every summary `summary` would refuse (the cell runs again); returns how many."""
+        progress, moved = self.progress(), 0
         for name in self.store.record_names():
-            path = self.store.record_path(name)
             try:
-                summary = self.store.read_record(name)
-                n = int(summary["nfev"])
-            except (StoreError, KeyError, TypeError, ValueError):
-                moved += (
-                    self.store.quarantine(path, "damaged cell summary, the cell runs again (by replay)") is not None
-                )
-                continue
-            logged = progress.get(name, 0)
-            if logged < n:
-                moved += (
-                    self.store.quarantine(
-                        path, f"the cell's summary counts {n} evaluations, but {logged} are logged; the cell runs again"
-                    )
-                    is not None
-                )
+                self._finished(name, progress)
+            except IncompleteCellError as e:
+                reason = f"{str(e).split(': ', 1)[1].split('; ')[0]}; the cell runs again"
+                moved += self.store.quarantine(self.store.record_path(name), reason) is not None
+            except StoreError:
+                reason = "damaged cell summary, the cell runs again (by replay)"
+                moved += self.store.quarantine(self.store.record_path(name), reason) is not None
         return moved
 
     # reading
@@ -253,7 +297,7 @@ class RunLog:
         pattern = "*.parquet" if key is None else f"*-{key.name}-*.parquet"
         out = []
         for p in sorted(self.evals_dir.glob(pattern)):
-            m = _PART.match(p.name) or _CELL.match(p.name)
+            m = _match(p.name)
             if m and (key is None or m["cell"] == key.name):
                 out.append(p)
         return out
@@ -325,9 +369,8 @@ class RunLog:
         summary = self.store.read_record(name, advice=RERUN)
         if summary is None:
             return None
-        n = summary.get("nfev") if isinstance(summary, dict) else None
-        if not isinstance(n, int):
-            raise StoreError(f"{self.store.record_path(name)}: not a cell summary (no evaluation count); {RERUN}")
+        _check_summary(self.store.record_path(name), summary)
+        n = summary["nfev"]
         if progress.get(name, 0) < n:
             raise IncompleteCellError(
                 f"{self.store.record_path(name)}: the cell finished with {n} evaluations, but "

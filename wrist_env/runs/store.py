@@ -3,15 +3,19 @@
 A `RunStore(root, parts=...)` is a folder::
 
     root/<parts>/<name>.parquet   write-once parts (one batch of evaluations, one chunk of runs)
-    root/<records>/<name>.json    JSON records (a finished benchmark cell's summary)
+    root/<parts>/<name>.parquet.sha256   the part's SHA-256, written just before it
+    root/<records>/<name>.json    JSON records (a finished benchmark cell's summary; its SHA-256 inside)
     root/locks/<name>.lock        flocks: a key's lock while a process runs it, "store" for a whole study
     root/damaged/                 files moved aside by `quarantine` (never deleted)
 
 Every file is written by `wrist_env.io.atomic_write` (temporary name, fsync,
 `os.replace`, folder fsync): a reader, or a writer killed midway, never sees
-half a file. A part name that exists is never overwritten. A damaged part or
-record (truncated, empty, garbage) is a `StoreError` naming the file and what
-to do; the studies move such files to `damaged/` on resume and redo their work.
+half a file. A part name that exists is never overwritten. Every part and
+record carries a SHA-256 (a part's in `<file>.sha256`, a record's under
+`record_sha256`), checked on every read; files written before checksums have
+none and are read unchecked. A damaged part or record (truncated, empty,
+garbage, or not the bytes it was written with) is a `StoreError` naming the
+file and what to do; the studies move such files to `damaged/` on resume and redo their work.
 Nothing here knows what a row means: `wrist_env.bench.log` (the benchmark's
 evaluations) and `wrist_env.montecarlo.study` (the Monte Carlo runs) do.
 """
@@ -21,6 +25,7 @@ from __future__ import annotations
 import fcntl
 import os
 import shutil
+import time
 import warnings
 from collections.abc import Iterable, Iterator
 from contextlib import contextmanager
@@ -30,8 +35,10 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from wrist_env.errors import StoreError
-from wrist_env.io import atomic_write, clean_temporary, read_json, write_json
+from wrist_env.io import atomic_write, clean_temporary, json_sha256, read_json, sha256_file, write_json
 
+CHECKSUM = ".sha256"
+RECORD_CHECKSUM = "record_sha256"
 DAMAGED = "damaged"
 LOCKS = "locks"
 STORE_LOCK = "store"
@@ -45,16 +52,65 @@ class StoreBusyError(StoreError):
     """Another process holds a lock this one was not allowed to wait for."""
 
 
+def checksum_path(path: str | Path) -> Path:
+    """Where a Parquet file's SHA-256 is kept: `<file>.sha256` beside it."""
+    path = Path(path)
+    return path.with_name(path.name + CHECKSUM)
+
+
+def write_parquet(path: str | Path, table: pa.Table) -> Path:
+    """Write a Parquet file atomically, its SHA-256 (`checksum_path`) moved into place just before it."""
+
+    def write(tmp: Path) -> None:
+        pq.write_table(table, tmp)
+        digest = sha256_file(tmp) + "\n"
+        atomic_write(checksum_path(path), lambda c: Path(c).write_text(digest))
+
+    return atomic_write(path, write)
+
+
+def remove_file(path: str | Path) -> None:
+    """Remove a Parquet file and its SHA-256 (either may be gone already)."""
+    Path(path).unlink(missing_ok=True)
+    checksum_path(path).unlink(missing_ok=True)
+
+
+def _advice(advice: str) -> str:
+    return f"; {advice}" if advice else ""
+
+
+def verify_checksum(path: str | Path, advice: str = "") -> None:
+    """`StoreError` naming `path` if its bytes are not the ones its `.sha256` was written with
+    (a file without one, written before checksums, passes)."""
+    path, side = Path(path), checksum_path(path)
+    try:
+        expected = side.read_text().strip()
+    except FileNotFoundError:
+        return
+    except (OSError, UnicodeDecodeError) as e:
+        raise StoreError(f"{side}: unreadable checksum ({type(e).__name__}){_advice(advice)}") from None
+    try:
+        actual = sha256_file(path)
+    except OSError as e:
+        raise StoreError(f"{path}: cannot be read ({type(e).__name__}: {e}){_advice(advice)}") from None
+    if actual != expected:
+        raise StoreError(
+            f"{path}: damaged Parquet file (its SHA-256 {actual[:12]}… is not the {expected[:12]}… of "
+            f"{side.name}: changed since it was written){_advice(advice)}"
+        )
+
+
 def read_parquet(
     path: str | Path, schema: pa.Schema | None = None, columns: list[str] | None = None, advice: str = ""
 ) -> pa.Table:
-    """One Parquet file; `StoreError` naming it (and `advice`) if it is truncated, empty or not Parquet."""
+    """One Parquet file; `StoreError` naming it (and `advice`) if it is truncated, empty, not Parquet
+    or not the bytes it was written with."""
+    verify_checksum(path, advice)
     try:
         return pq.read_table(path, schema=schema, columns=columns)
     except (OSError, pa.ArrowException, ValueError) as e:
         raise StoreError(
-            f"{path}: damaged Parquet file ({type(e).__name__}: {str(e).splitlines()[0][:200]})"
-            + (f"; {advice}" if advice else "")
+            f"{path}: damaged Parquet file ({type(e).__name__}: {str(e).splitlines()[0][:200]}){_advice(advice)}"
         ) from None
 
 
@@ -88,7 +144,7 @@ class RunStore:
         path = self.part_path(name)
         if path.exists():
             raise PartExistsError(f"{path} is already in the store (parts are written once)")
-        return atomic_write(path, lambda p: pq.write_table(table, p))
+        return write_parquet(path, table)
 
     def read_part(
         self, name: str, schema: pa.Schema | None = None, columns: list[str] | None = None, advice: str = ""
@@ -120,7 +176,7 @@ class RunStore:
         return out
 
     def remove_part(self, name: str) -> None:
-        self.part_path(name).unlink(missing_ok=True)
+        remove_file(self.part_path(name))
 
     # records
 
@@ -130,12 +186,26 @@ class RunStore:
         return self.records_dir / f"{name}.json"
 
     def write_record(self, name: str, data: object) -> Path:
+        """Write a record (a dict gets its SHA-256 under `record_sha256`)."""
+        if isinstance(data, dict):
+            data = {**data, RECORD_CHECKSUM: json_sha256(data)}
         return write_json(self.record_path(name), data)
 
     def read_record(self, name: str, advice: str = "") -> dict | list | None:
-        """The record `name`, or None if there is none; `StoreError` naming it if it is damaged."""
+        """The record `name` (its checksum checked and dropped), or None if there is none; `StoreError`
+        naming it if it is damaged or not what was written."""
         path = self.record_path(name)
-        return read_json(path, "record", advice) if path.is_file() else None
+        if not path.is_file():
+            return None
+        data = read_json(path, "record", advice)
+        if isinstance(data, dict) and RECORD_CHECKSUM in data:
+            expected = data.pop(RECORD_CHECKSUM)
+            if json_sha256(data) != expected:
+                raise StoreError(
+                    f"{path}: damaged record (its SHA-256 is not the {str(expected)[:12]}… it was written "
+                    f"with: changed since){_advice(advice)}"
+                )
+        return data
 
     def record_names(self) -> list[str]:
         if not self.records_dir.is_dir():
@@ -156,13 +226,30 @@ class RunStore:
         while target.exists():
             target, k = self.damaged_dir / f"{path.name}.{k}", k + 1
         shutil.move(str(path), target)
+        if checksum_path(path).exists():
+            shutil.move(str(checksum_path(path)), checksum_path(target))
         warnings.warn(f"{path}: {reason}; moved to {target}", stacklevel=2)
         return target
 
     def clean(self, min_age_s: float = 60.0) -> int:
         """Remove temporary files killed writers left behind (at least `min_age_s` old, so a concurrent
         writer's file is spared); returns how many."""
-        return sum(clean_temporary(d, min_age_s) for d in (self.parts_dir, self.records_dir, self.root))
+        temporary = sum(clean_temporary(d, min_age_s) for d in (self.parts_dir, self.records_dir, self.root))
+        return temporary + self._clean_checksums(min_age_s)
+
+    def _clean_checksums(self, min_age_s: float) -> int:
+        """Remove the checksums of parts never moved into place (a writer killed between the two)."""
+        if not self.parts_dir.is_dir():
+            return 0
+        now, removed = time.time(), 0
+        for side in self.parts_dir.glob(f"*{CHECKSUM}"):
+            try:
+                if not side.with_name(side.name[: -len(CHECKSUM)]).exists() and now - side.stat().st_mtime >= min_age_s:
+                    side.unlink()
+                    removed += 1
+            except FileNotFoundError:
+                pass
+        return removed
 
     # locks
 
