@@ -79,6 +79,7 @@ def write_report(
     if table is None:
         raise StudyError(f"{runs} holds no logged runs")
     config = config_of(runs)
+    study_counts = {p: asdict(c) for p, c in counts(runs, complete=True).items()}
     frames = stats.frame_table(table)
     if frames.empty:
         raise StudyError(f"{runs}: no run succeeded")
@@ -96,7 +97,6 @@ def write_report(
     if not intact.empty:
         figures.figure10(frames, out / "figure10.png")
     numbers = stats.summary_numbers(frames)
-    study_counts = {p: asdict(c) for p, c in counts(runs).items()}
     summary = {
         "study": {
             "participants": list(config.participants),

@@ -29,6 +29,7 @@ process), or on a `dask.distributed` scheduler (`scheduler="tcp://…"`, or a
 
 from __future__ import annotations
 
+import json
 import time
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import asdict, dataclass, field
@@ -37,9 +38,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import pyarrow as pa
+import pyarrow.compute as pc
+import pyarrow.parquet as pq
 
-from wrist_env.errors import WristEnvError
+from wrist_env.errors import StoreError, WristEnvError
 from wrist_env.io import read_json, write_json
+from wrist_env.limits import MAX_BATCH, MAX_RUNS, MAX_SEED, MAX_WORKERS, check_int, check_unique
 from wrist_env.montecarlo import sampler
 from wrist_env.runs.executor import executor
 from wrist_env.runs.store import RunStore
@@ -72,12 +76,9 @@ class StudyConfig:
         object.__setattr__(self, "participants", tuple(self.participants))
         if not self.participants:
             raise StudyError("a study needs at least one participant")
-        if len(set(self.participants)) != len(self.participants):
-            raise StudyError(f"participants repeat: {list(self.participants)}")
-        if int(self.n) < 1:
-            raise StudyError(f"n must be at least 1, but got {self.n}")
-        if int(self.seed) < 0:
-            raise StudyError(f"seed must be >= 0, but got {self.seed}")
+        check_unique("participants", self.participants)
+        check_int("n", self.n, 1, MAX_RUNS, "a round's draws are held in memory")
+        check_int("seed", self.seed, 0, MAX_SEED)
         if not 0.0 <= self.tear_probability <= 1.0:
             raise StudyError(f"tear_probability must be in [0, 1], but got {self.tear_probability}")
 
@@ -154,35 +155,111 @@ def runs_log(out: str | Path) -> RunStore:
     return RunStore(Path(out), parts=RUNS)
 
 
+SETTINGS = b"wrist_env.study"
+"""The Parquet metadata key under which every part records the settings it was made with (`StudyConfig.key`)."""
+
+
+def with_settings(table: pa.Table, config: StudyConfig) -> pa.Table:
+    """A chunk's rows with the study's settings in their metadata (so a part says what made it)."""
+    return table.replace_schema_metadata({SETTINGS: json.dumps(config.key(), sort_keys=True)})
+
+
+def part_settings(store: RunStore, name: str) -> dict | None:
+    """The settings a part was made with (None: written before parts recorded them); StoreError if
+    the part cannot be read."""
+    path = store.part_path(name)
+    try:
+        raw = (pq.read_schema(path).metadata or {}).get(SETTINGS)
+        return None if raw is None else json.loads(raw)
+    except (OSError, pa.ArrowException, ValueError) as e:
+        raise StoreError(f"{path}: damaged Parquet part ({type(e).__name__}); {RERUN}") from None
+
+
+def _differences(old: dict, key: dict) -> str:
+    return ", ".join(f"{k} {old.get(k)!r} (asked {key[k]!r})" for k in key if old.get(k) != key[k])
+
+
+def check_settings(out: str | Path, config: StudyConfig) -> None:
+    """StudyError if a logged part was made under other settings than `config`'s, or if neither its
+    parts nor `study.json` say what they were made with (damaged parts are left to `repair`)."""
+    out, key = Path(out), config.key()
+    store, unrecorded = runs_log(out), []
+    for name in store.part_names():
+        try:
+            settings = part_settings(store, name)
+        except StoreError:
+            continue
+        if settings is None:
+            unrecorded.append(name)
+        elif settings != key:
+            raise StudyError(
+                f"{store.part_path(name)}: its runs were made with other settings ({_differences(settings, key)}); "
+                "use another --out or the same settings"
+            )
+    if unrecorded and not (out / MANIFEST).is_file():
+        raise StudyError(
+            f"{out}: {len(unrecorded)} parts (first {unrecorded[0]}.parquet) do not record their settings and there "
+            f"is no {MANIFEST} to say them; restore it, or use another --out"
+        )
+
+
 def repair(out: str | Path) -> int:
-    """Before a run: remove killed writers' temporary files and move damaged parts to `<out>/damaged/`
-    (their runs are then missing, and simulated again). Returns the parts moved."""
+    """Before a run: remove killed writers' temporary files and move to `<out>/damaged/` every damaged
+    part and every part that is not where the study writes it (a copy, or runs logged twice); their
+    runs are then missing, and simulated again. Returns the parts moved."""
     store = runs_log(out)
     store.clean(min_age_s=0.0)  # the caller holds the store lock: no live writer
-    moved = 0
-    for name, _ in store.damaged_parts(sampler.SCHEMA):
-        moved += (
-            store.quarantine(store.part_path(name), "damaged Parquet part, its runs are simulated again") is not None
-        )
-    return moved
+    damaged = [
+        (n, "damaged Parquet part, its runs are simulated again") for n, _ in store.damaged_parts(sampler.SCHEMA)
+    ]
+    return sum(store.quarantine(store.part_path(n), why) is not None for n, why in damaged + _stray_parts(store))
+
+
+def _stray_parts(store: RunStore) -> list[tuple[str, str]]:
+    """(name, reason) of the readable parts whose runs are not the ones their name says (a copy under
+    another name) or were logged by an earlier part."""
+    seen: dict[str, set[int]] = {}
+    out = []
+    for name in store.part_names():
+        try:
+            cols = store.read_part(name, columns=["participant", "sample_id"]).to_pydict()
+        except StoreError:
+            continue  # damaged: moved by `repair`
+        ids, participants = tuple(cols["sample_id"]), set(cols["participant"])
+        p = next(iter(participants)) if len(participants) == 1 else None
+        if p is None or not ids or ids != tuple(range(ids[0], ids[0] + len(ids))) or part_name(p, ids) != name:
+            out.append((name, "its runs are not the ones its name says (a copy?); moved aside, not used"))
+        elif seen.setdefault(p, set()) & set(ids):
+            out.append((name, "repeats runs an earlier part logged; moved aside, not used"))
+        else:
+            seen[p].update(ids)
+    return out
 
 
 def read_runs(out: str | Path, columns: list[str] | None = None) -> pa.Table | None:
     """Every logged run of the study in `out`, sorted by (participant, sample_id); None if empty.
-    StudyError if a run is logged twice; StoreError naming a damaged part."""
-    table = runs_log(out).read_parts(schema=sampler.SCHEMA, columns=columns, advice=RERUN)
-    if table is None:
+    StudyError naming both parts if a run is logged twice; StoreError naming a damaged part."""
+    store = runs_log(out)
+    names = store.part_names()
+    if not names:
         return None
+    tables = [store.read_part(n, sampler.SCHEMA, columns, RERUN) for n in names]
+    table = pa.concat_tables(tables)
     keys = ["participant", "sample_id"]
     if columns is not None and not set(keys) <= set(columns):
         return table
-    table = table.sort_by([(k, "ascending") for k in keys])
+    order = pc.sort_indices(table, sort_keys=[(k, "ascending") for k in keys])
+    table = table.take(order)
+    source = np.repeat(np.arange(len(names)), [t.num_rows for t in tables])[order.to_numpy()]
     p, s = table["participant"].to_numpy(zero_copy_only=False), table["sample_id"].to_numpy()
-    if len(p) > 1:
-        dup = (p[1:] == p[:-1]) & (s[1:] == s[:-1])
-        if dup.any():
-            i = int(np.flatnonzero(dup)[0])
-            raise StudyError(f"{Path(out) / RUNS}: run {p[i]} #{s[i]} is logged twice")
+    dup = (p[1:] == p[:-1]) & (s[1:] == s[:-1])
+    if dup.any():
+        i = int(np.flatnonzero(dup)[0])
+        first, second = sorted((names[source[i]], names[source[i + 1]]))
+        raise StudyError(
+            f"{store.part_path(second)}: run {p[i]} #{s[i]} is logged twice (also in {first}.parquet); "
+            "rerun the montecarlo command (same arguments) to move the copy aside"
+        )
     return table
 
 
@@ -192,10 +269,10 @@ def _manifest(out: Path, config: StudyConfig) -> None:
     participants = list(config.participants)
     if path.is_file():
         old = read_json(path, "study manifest", "it records the study's settings: restore it, or use another --out")
-        old_key = {k: old.get(k) for k in key}
-        if old_key != key:
-            diff = ", ".join(f"{k} {old_key[k]!r} (asked {key[k]!r})" for k in key if old_key[k] != key[k])
-            raise StudyError(f"{out} holds another study ({diff}); use another --out or the same settings")
+        if {k: old.get(k) for k in key} != key:
+            raise StudyError(
+                f"{out} holds another study ({_differences(old, key)}); use another --out or the same settings"
+            )
         participants = list(old.get("participants", [])) + [
             p for p in participants if p not in old.get("participants", [])
         ]
@@ -291,12 +368,12 @@ def run_study(
     bar of successful runs (postfix: excluded and failed so far). A second run on the same `out`
     while this one is running is refused (`StoreBusyError`).
     """
-    if int(batch) < 1:
-        raise StudyError(f"batch must be at least 1, but got {batch}")
+    batch = check_int("batch", batch, 1, MAX_BATCH)
+    workers = check_int("workers", workers, 0, MAX_WORKERS, "0 or 1: this process")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     with runs_log(out).lock(wait=False, what=f"a Monte Carlo study in {out}"):
-        return _run_locked(config, out, int(batch), scheduler, workers, tuple(str(f) for f in folders), progress)
+        return _run_locked(config, out, batch, scheduler, workers, tuple(str(f) for f in folders), progress)
 
 
 def _logged_outcomes(out: Path, participants) -> dict[str, dict[int, tuple[bool, bool]]]:
@@ -314,6 +391,7 @@ def _run_locked(
     config: StudyConfig, out: Path, batch: int, scheduler, workers, folders: tuple, progress: bool
 ) -> StudySummary:
     start_time = time.perf_counter()
+    check_settings(out, config)
     _manifest(out, config)
     repair(out)
     log = runs_log(out)
@@ -368,7 +446,7 @@ def _run_locked(
                     cols = table.select(["participant", "sample_id", "ok", "excluded"]).to_pydict()
                     p = cols["participant"][0]
                     ids = tuple(int(s) for s in cols["sample_id"])
-                    log.write_part(part_name(p, ids), table)
+                    log.write_part(part_name(p, ids), with_settings(table, config))
                     good = 0
                     for s, ok, ex_ in zip(ids, cols["ok"], cols["excluded"]):
                         outcomes[p][s] = (bool(ok), bool(ex_))
@@ -396,11 +474,23 @@ def config_of(out: str | Path, participants: Sequence[str] | None = None) -> Stu
     )
 
 
-def counts(out: str | Path) -> dict[str, ParticipantCounts]:
-    """Per-participant counts of a study folder, from its log."""
+def counts(out: str | Path, *, complete: bool = False) -> dict[str, ParticipantCounts]:
+    """Per-participant counts of a study folder, from its log. complete: StudyError naming the
+    missing runs unless every participant has its n successes (a finished study whose part was
+    deleted, or one still running, would otherwise be reported with counts that disagree)."""
     config = config_of(out)
     outcomes = _logged_outcomes(Path(out), config.participants)
-    return {p: _plan(p, config, outcomes[p])[1] for p in config.participants}
+    out_counts = {}
+    for p in config.participants:
+        rnd, out_counts[p] = _plan(p, config, outcomes[p])
+        if complete and rnd is not None:
+            m = rnd.missing
+            raise StudyError(
+                f"{Path(out) / RUNS}: the study is not complete: {p} has {out_counts[p].succeeded:,} of {config.n:,} "
+                f"successful runs and {len(m):,} runs of block {rnd.block} are missing (#{m[0]}…#{m[-1]}; a part "
+                f"deleted, or the study still running?); {RERUN}"
+            )
+    return out_counts
 
 
 def summary_dict(summary: StudySummary) -> dict:

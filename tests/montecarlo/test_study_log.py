@@ -1,0 +1,121 @@
+"""The Monte Carlo study's log without the solver (a stand-in `run_chunk`): settings, copies, gaps, checksums."""
+
+import re
+import shutil
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+from wrist_env import cli
+from wrist_env.errors import InputError, StoreError
+from wrist_env.montecarlo import StudyConfig, StudyError, read_runs, run_study, sampler
+from wrist_env.montecarlo.study import counts
+
+CONFIG = StudyConfig(("P1",), n=10, seed=0)
+
+
+def _fake_chunk(participant, sample_ids, blocks, actions, *, exclude_above_mpa=16.5, folders=()):
+    """`sampler.run_chunk`'s rows without simulating: every run ok, its outputs a function of its action."""
+    actions = np.asarray(actions, dtype=np.float64)
+    k = len(actions)
+    table = {
+        "participant": [participant] * k,
+        "sample_id": np.asarray(sample_ids, dtype=np.int64),
+        "block": np.asarray(blocks, dtype=np.int64),
+    }
+    table.update({n: actions[:, i] for i, n in enumerate(sampler.NAMES)})
+    table.update({c: actions[:, 22 + i] < 0 for i, c in enumerate(sampler.TEAR_COLUMNS)})
+    for c in sampler.FRAME_COLUMNS:
+        table[c] = sampler._frames(np.repeat(actions[:, :1], 3, axis=1))
+    table.update({"status": ["ok"] * k, "ok": [True] * k, "excluded": [False] * k})
+    import pyarrow as pa
+
+    return pa.Table.from_pydict(table, schema=sampler.SCHEMA)
+
+
+@pytest.fixture(autouse=True)
+def fake_solver(monkeypatch):
+    monkeypatch.setattr(sampler, "run_chunk", _fake_chunk)
+
+
+@pytest.fixture
+def study(tmp_path):
+    """A finished study of 10 runs in parts of 4, 4 and 2: its folder and log."""
+    out = tmp_path / "mc"
+    assert run_study(CONFIG, out, batch=4).done
+    return out, read_runs(out)
+
+
+def _cli(capsys, *argv) -> tuple[int, str]:
+    status = cli.main(list(argv))
+    return status, capsys.readouterr().err
+
+
+def test_a_resume_with_another_seed_after_study_json_is_deleted_is_refused(study, capsys):
+    out, log = study
+    (out / "study.json").unlink()
+    with pytest.raises(StudyError, match=r"P1-0000000-0000004.parquet: its runs were made with .*seed 0 \(asked 1\)"):
+        run_study(StudyConfig(("P1",), n=10, seed=1), out, batch=4)
+    status, err = _cli(capsys, "montecarlo", "P1", "--n", "10", "--seed", "1", "--out", str(out), "--no-progress")
+    assert status == 2 and err.count("\n") == 1 and "seed 0 (asked 1)" in err
+    assert not (out / "study.json").exists() and read_runs(out).equals(log)  # nothing written
+    assert run_study(CONFIG, out, batch=4).simulated == 0  # the same settings resume
+
+
+def test_parts_that_do_not_record_their_settings_need_study_json(study):
+    out, _ = study
+    for part in (out / "runs").glob("*.parquet"):  # parts as written before they recorded settings
+        pq.write_table(pq.read_table(part).replace_schema_metadata(None), part)
+        part.with_name(part.name + ".sha256").unlink()
+    assert run_study(CONFIG, out, batch=4).simulated == 0  # study.json says what they are
+    (out / "study.json").unlink()
+    with pytest.raises(StudyError, match="3 parts .* do not record their settings .* no study.json"):
+        run_study(StudyConfig(("P1",), n=10, seed=1), out)
+
+
+def test_a_copied_part_is_named_then_moved_aside(study):
+    out, log = study
+    part = sorted((out / "runs").glob("*.parquet"))[1]
+    shutil.copy(part, out / "runs" / "P1-copy.parquet")
+    with pytest.raises(StudyError, match=r"P1-copy.parquet: run P1 #4 is logged twice \(also in " + part.name):
+        read_runs(out)
+    with pytest.warns(UserWarning, match="P1-copy.parquet: its runs are not the ones its name says"):
+        assert run_study(CONFIG, out, batch=4).simulated == 0
+    assert read_runs(out).equals(log) and (out / "damaged" / "P1-copy.parquet").is_file()
+
+
+def test_a_deleted_part_of_a_finished_study_is_refused_by_the_report_then_resimulated(study, tmp_path, capsys):
+    out, log = study
+    sorted((out / "runs").glob("*.parquet"))[1].unlink()
+    with pytest.raises(StudyError, match=r"not complete: P1 has 6 of 10 successful runs .* \(#4…#7"):
+        counts(out, complete=True)
+    status, err = _cli(capsys, "montecarlo-report", "--runs", str(out), "--out", str(tmp_path / "report"))
+    assert status == 2 and "not complete" in err and not (tmp_path / "report").exists()
+    assert run_study(CONFIG, out, batch=4).simulated == 4 and read_runs(out).equals(log)
+
+
+def test_a_flipped_ok_is_named_then_resimulated(study):
+    out, log = study
+    part = sorted((out / "runs").glob("*.parquet"))[0]
+    table = pq.read_table(part)
+    flipped = table.set_column(table.schema.get_field_index("ok"), "ok", pq.read_table(part)["excluded"])
+    pq.write_table(flipped, part)  # a valid part, with its metadata, one column changed
+    with pytest.raises(StoreError, match=re.escape(part.name) + ".*SHA-256.*rerun the montecarlo command"):
+        read_runs(out)
+    with pytest.warns(UserWarning, match=re.escape(part.name)):
+        assert run_study(CONFIG, out, batch=4).simulated == 4
+    assert read_runs(out).equals(log) and (out / "damaged" / part.name).is_file()
+
+
+def test_sizes_are_refused_before_anything_is_allocated(tmp_path, capsys):
+    with pytest.raises(InputError, match=r"n must be an integer in \[1, 1,000,000\].*10000000000"):
+        StudyConfig(("P1",), n=10**10)
+    with pytest.raises(InputError, match=r"workers must be an integer in \[0, 256\].*-1"):
+        run_study(CONFIG, tmp_path, workers=-1)
+    with pytest.raises(InputError, match=r"batch must be an integer in \[1, 4,096\]"):
+        run_study(CONFIG, tmp_path, batch=10**6)
+    for argv, value in (("--n", "10000000000"), ("--workers", "-1"), ("--batch", "0"), ("--seed", "-2")):
+        status, err = _cli(capsys, "montecarlo", "P1", argv, value, "--out", str(tmp_path / "x"), "--no-progress")
+        assert status == 2 and err.count("\n") == 1 and value in err, (argv, err)
+    assert not (tmp_path / "x" / "runs").exists()
