@@ -245,3 +245,55 @@ def test_export_build_evaluate_and_make_an_env_from_a_clean_folder(tmp_path, cap
 
     _, reward, terminated, _, info = env.step(design.to_action(design.population()).astype(np.float32))
     assert terminated and reward == -out["cost"] and not info["failed"]
+
+
+ONE_LINE_USAGE_ERRORS = {
+    "calibrate seed -2": (["calibrate", "P1", "--seed", "-2"], r"seed must be an integer in \[0, 4,294,967,295\]"),
+    "calibrate budget 0": (["calibrate", "P1", "--budget", "0"], r"budget must be an integer in \[1, 1,000,000\]"),
+    "benchmark budget 0": (["benchmark", "--budget", "0"], r"budget must be an integer in \[1, 1,000,000\]"),
+    "benchmark seeds 0": (["benchmark", "--seeds", "0"], r"seeds must be an integer in \[1, 10,000\]"),
+    "workers -3": (["benchmark", "--workers", "-3"], r"workers must be an integer in \[1, 256\], but got -3"),
+    "workers 0": (["benchmark", "--workers", "0"], r"workers must be an integer in \[1, 256\], but got 0"),
+    "threads 0": (["benchmark", "--threads", "0"], r"threads must be an integer in \[1, 256\], but got 0"),
+    "participants twice": (
+        ["benchmark", "--participants", "P1", "P1", "--optimizers", "random"],
+        r"participants must not repeat, but got \['P1', 'P1'\] \(P1 more than once\)",
+    ),
+    "optimizers twice": (["benchmark", "--optimizers", "random", "random"], r"optimizers must not repeat"),
+    "montecarlo n huge": (["montecarlo", "P1", "--n", "10000000000"], r"n must be an integer in \[1, 1,000,000\]"),
+    "montecarlo workers -1": (["montecarlo", "P1", "--workers", "-1"], r"workers must be an integer in \[0, 256\]"),
+    "leaderboard no log": (["leaderboard", "--runs", "/nonexistent/log"], r"no run log at /nonexistent/log"),
+}
+
+
+@pytest.mark.parametrize("argv, message", ONE_LINE_USAGE_ERRORS.values(), ids=ONE_LINE_USAGE_ERRORS)
+def test_usage_errors_are_one_line_and_exit_2(argv, message, capsys, tmp_path):
+    import re
+
+    out = [] if argv[0] in ("calibrate", "leaderboard") else ["--out", str(tmp_path / "out"), "--no-progress"]
+    assert main(argv + out) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and re.search(message, err), err
+    assert not (tmp_path / "out").exists()  # refused before anything is written
+
+
+def _file(tmp_path):
+    (tmp_path / "a-file").write_text("")
+    return tmp_path / "a-file"
+
+
+OUT_THE_SYSTEM_REFUSES = {
+    "montecarlo into a file": lambda t: ["montecarlo", "P1", "--n", "2", "--no-progress", "--out", str(_file(t))],
+    "benchmark into a file": lambda t: ["benchmark", "--optimizers", "random", "--no-progress", "--out", str(_file(t))],
+    "leaderboard under /proc": lambda t: ["leaderboard", "--runs", str(t), "--out", "/proc/wrist-env/lb"],
+    "export under /proc": lambda t: ["export", "P1", "/proc/self/ex"],
+}
+
+
+@pytest.mark.parametrize("make_argv", OUT_THE_SYSTEM_REFUSES.values(), ids=OUT_THE_SYSTEM_REFUSES)
+def test_an_out_path_the_system_refuses_is_one_line_naming_it(make_argv, capsys, tmp_path):
+    argv = make_argv(tmp_path)
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("wrist-bench: error: ") and "Traceback" not in err
+    assert ("/proc/" in err) if "/proc/" in " ".join(argv) else str(tmp_path / "a-file") in err

@@ -35,3 +35,7 @@ class BuildError(WristEnvError, RuntimeError):
 
 class StoreError(InputError):
     """A saved file (a cached model, a run log) that is damaged, tampered with or not what it claims."""
+
+
+class UsageError(InputError):
+    """A command-line argument the command cannot take (exit status 2, like argparse's)."""

@@ -23,8 +23,8 @@ MAX_WORKERS = 256
 """Local worker processes (`--workers`)."""
 MAX_THREADS = 256
 """Numba threads per worker (`--threads`)."""
-MAX_SEED = 2**63 - 1
-"""Seeds are non-negative 64-bit integers (`--seed`)."""
+MAX_SEED = 2**32 - 1
+"""Seeds are non-negative 32-bit integers, as every calibrator takes (`--seed`)."""
 
 
 def check_int(name: str, value: object, low: int, high: int, why: str = "") -> int:
@@ -41,5 +41,5 @@ def check_unique(name: str, values) -> list:
     values = list(values)
     repeats = sorted({str(v) for v in values if values.count(v) > 1})
     if repeats:
-        raise InputError(f"{name} must not repeat, but {', '.join(repeats)} appear more than once in {values}")
+        raise InputError(f"{name} must not repeat, but got {values} ({', '.join(repeats)} more than once)")
     return values

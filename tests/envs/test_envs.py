@@ -106,3 +106,11 @@ def test_a_failed_run_gives_the_same_nan_free_info_single_and_vectorized():
                         assert value is not None and np.isfinite(value), (key, bone, dof, value)
                         got = vinfo[key][bone][dof][k]
                         assert np.asarray(vinfo[key][bone][dof]).dtype == np.float64 and got == value, (key, got, value)
+
+
+@pytest.mark.parametrize("num_envs", [0, -1, 10**9])
+def test_a_vector_env_size_out_of_bounds_is_refused_before_the_model_loads(num_envs):
+    from wrist_env.errors import InputError
+
+    with pytest.raises(InputError, match=rf"num_envs must be an integer in \[1, 4,096\], but got {num_envs}"):
+        gym.make_vec("wrist_env/Calibrate-P1-v0", num_envs=num_envs, vectorization_mode="vector_entry_point")

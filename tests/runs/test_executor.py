@@ -60,3 +60,15 @@ def test_local_workers_die_with_their_parent(tmp_path):
     finally:
         if proc.poll() is None:
             proc.kill()
+
+
+def test_an_unreachable_scheduler_is_one_line_naming_it(monkeypatch, tmp_path, capsys):
+    import importlib
+
+    from wrist_env.cli import main
+
+    monkeypatch.setattr(importlib.import_module("wrist_env.runs.executor"), "CONNECT_TIMEOUT_S", 1.0)
+    argv = ["montecarlo", "P1", "--n", "2", "--scheduler", "tcp://127.0.0.1:1", "--out", str(tmp_path), "--no-progress"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "cannot reach the dask scheduler 'tcp://127.0.0.1:1' within 1 s" in err

@@ -43,6 +43,7 @@ from wrist_env.cost import COST_BONES
 from wrist_env.design import N_MATERIAL, NAMES
 from wrist_env.errors import StoreError
 from wrist_env.frames import DOF_NAMES
+from wrist_env.limits import MAX_BUDGET, MAX_SEED, check_int
 from wrist_env.runs.store import RunStore, read_parquet, remove_file, write_parquet
 
 if TYPE_CHECKING:
@@ -127,6 +128,10 @@ class RunKey:
     optimizer: str
     seed: int
     budget: int
+
+    def __post_init__(self):
+        check_int("seed", self.seed, 0, MAX_SEED)
+        check_int("budget", self.budget, 1, MAX_BUDGET)
 
     @property
     def name(self) -> str:

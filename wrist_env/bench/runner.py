@@ -17,6 +17,7 @@ holds the other thread idle (README, "Benchmark", has the measurement).
 from __future__ import annotations
 
 import itertools
+import numbers
 import os
 import time
 from collections.abc import Callable, Iterable, Sequence
@@ -25,6 +26,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from wrist_env.bench.log import RunKey, RunLog
+from wrist_env.errors import InputError
+from wrist_env.limits import MAX_SEEDS, MAX_THREADS, MAX_WORKERS, check_int, check_unique
 from wrist_env.runs.executor import describe, executor, set_threads
 
 if TYPE_CHECKING:
@@ -53,11 +56,15 @@ class BenchmarkReport:
 def make_cells(
     participants: Sequence[str], optimizers: Sequence[str], seeds: int | Iterable[int], budget: int
 ) -> list[RunKey]:
-    """The cross product participants × optimizers × seeds (seeds: a count n → 0 … n−1, or a list)."""
-    seeds = list(range(seeds)) if isinstance(seeds, int) else [int(s) for s in seeds]
-    if budget < 1 or not seeds or not participants or not optimizers:
-        raise ValueError("a benchmark needs ≥ 1 participant, optimizer and seed, and a budget ≥ 1")
-    return [RunKey(p, o, s, int(budget)) for p, o, s in itertools.product(participants, optimizers, seeds)]
+    """The cross product participants × optimizers × seeds (seeds: a count n → 0 … n−1, or a list);
+    `InputError` if one is empty or repeats a name or seed, or a size is out of bounds (`limits`)."""
+    if isinstance(seeds, numbers.Integral):
+        seeds = list(range(check_int("seeds", seeds, 1, MAX_SEEDS)))
+    seeds = check_unique("seeds", seeds)
+    if not seeds or not participants or not optimizers:
+        raise InputError("a benchmark needs at least one participant, optimizer and seed")
+    participants, optimizers = check_unique("participants", participants), check_unique("optimizers", optimizers)
+    return [RunKey(p, o, s, budget) for p, o, s in itertools.product(participants, optimizers, seeds)]
 
 
 NO_STORAGE = ("memory", "none")
@@ -150,9 +157,13 @@ def benchmark(
     folders: participant folders to register (in every worker too).
     """
     start = time.perf_counter()
+    cells = make_cells(participants, optimizers, seeds, budget)
+    if workers is not None:
+        check_int("workers", workers, 1, MAX_WORKERS)
+    if threads is not None:
+        check_int("threads", threads, 1, MAX_THREADS)
     out_dir = Path(out_dir).resolve()
     out_dir.mkdir(parents=True, exist_ok=True)
-    cells = make_cells(participants, optimizers, seeds, budget)
     _check_names(cells, folders)
     if storage is None:
         storage = default_storage(out_dir)
@@ -166,7 +177,7 @@ def benchmark(
     todo = [k for k in cells if k not in done]
     cores = os.cpu_count() or 1
     if scheduler is None:
-        workers = max(1, min(int(workers or cores), max(1, len(todo))))
+        workers = max(1, min(cores if workers is None else workers, len(todo)))
         threads = threads if threads is not None else max(1, cores // workers)
     total = sum(k.budget for k in cells)
     bar = _bar(progress, total, sum(min(log.progress().get(k.name, 0), k.budget) for k in cells), len(cells), len(done))

@@ -31,7 +31,8 @@ def parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run one `wrist-bench` command; returns the exit status (2 for a project error, one line on stderr)."""
+    """Run one `wrist-bench` command; returns the exit status (2 for a project or file-system error: one line on
+    stderr)."""
     args = parser().parse_args(argv)
     from wrist_env.errors import WristEnvError
 
@@ -48,3 +49,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:  # `wrist-bench ... --json | head`: the reader left; say nothing more
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except OSError as exc:  # a path the system refuses (--out a file, read-only, under /proc, too long): one line
+        print(f"wrist-bench: error: {_os_error(exc)}", file=sys.stderr)
+        return 2
+
+
+def _os_error(exc: OSError) -> str:
+    """One line naming the file and the system's reason."""
+    where = f"{exc.filename}" + (f" -> {exc.filename2}" if exc.filename2 else "") + ": " if exc.filename else ""
+    return f"{where}{exc.strerror or exc} ({type(exc).__name__})"

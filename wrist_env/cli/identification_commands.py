@@ -5,6 +5,8 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
+from wrist_env.errors import UsageError
+
 
 def _sensitivity(args) -> int:
     from wrist_env import sensitivity
@@ -33,9 +35,7 @@ def _identifiability(args) -> int:
 
     unknown = [p for p in args.participants if p not in builtin.BUILTIN]
     if unknown:
-        raise SystemExit(
-            f"wrist-bench identifiability: {unknown} have no hidden truth; built-ins: {list(builtin.BUILTIN)}"
-        )
+        raise UsageError(f"{unknown} have no hidden truth; built-ins: {list(builtin.BUILTIN)}")
     materials, spectra = identifiability.study(args.participants, args.out)
     for (participant, trials), rows in materials.groupby(["participant", "trials"], sort=False):
         s = spectra[(spectra["participant"] == participant) & (spectra["trials"] == trials)]
@@ -64,8 +64,8 @@ def _posterior(args) -> int:
         or args.map_starts < 1
         or not 0 <= args.prior_refresh < 1
     ):
-        raise SystemExit(
-            "wrist-bench posterior: needs --walkers >= 44 (2 x 22), --steps >= 4, --particles >= 44, "
+        raise UsageError(
+            "needs --walkers >= 44 (2 x 22), --steps >= 4, --particles >= 44, "
             "--mcmc-steps >= 1, --map-starts >= 1, 0 <= --prior-refresh < 1 and --seeds >= 1"
         )
 

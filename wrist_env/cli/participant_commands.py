@@ -9,6 +9,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from wrist_env.errors import UsageError
+
 if TYPE_CHECKING:
     from wrist_env.design import Design
     from wrist_env.model import Model
@@ -120,7 +122,7 @@ def _simulate(args) -> int:
     from wrist_env.solver.outputs import cardan_deg, result_to_dict
 
     if args.frames is not None and args.frames < 1:
-        raise SystemExit("wrist-bench simulate: --frames must be at least 1")
+        raise UsageError("--frames must be at least 1")
     start = time.perf_counter()
     model = registry.load_model(args.participant)
     load_seconds = time.perf_counter() - start
@@ -249,7 +251,7 @@ def _figure(args) -> int:
     elif args.kind == "animation":
         path = figures.animation_figure(args.participant or "P1", out)
     else:
-        raise SystemExit(f"unknown figure {args.kind!r}")
+        raise UsageError(f"unknown figure {args.kind!r}")
     print(path)
     return 0
 

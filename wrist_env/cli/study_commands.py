@@ -10,6 +10,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from wrist_env.cli.participant_commands import PARTICIPANT_HELP
+from wrist_env.errors import UsageError
 
 
 def _calibrate(args) -> int:
@@ -19,8 +20,6 @@ def _calibrate(args) -> int:
     from wrist_env.participants import registry
 
     registry.require(args.participant)
-    if args.budget < 1:
-        raise SystemExit("wrist-bench calibrate: --budget must be at least 1")
     start = time.perf_counter()
     name = args.optimizer + (PRIOR_SUFFIX if args.prior and not args.optimizer.endswith(PRIOR_SUFFIX) else "")
     run = calibrate(args.participant, name, args.budget, args.seed, log=args.log, storage=args.storage)
@@ -74,8 +73,6 @@ def _benchmark(args) -> int:
     names = args.optimizers or list(optimizers.available())
     if args.prior:
         names = list(dict.fromkeys(names + [n + PRIOR_SUFFIX for n in names if not n.endswith(PRIOR_SUFFIX)]))
-    if args.seeds < 1 or args.budget < 1:
-        raise SystemExit("wrist-bench benchmark: --seeds and --budget must be at least 1")
     cells = make_cells(participants, names, args.seeds, args.budget)
     where = f"the dask scheduler {args.scheduler}" if args.scheduler else "local processes"
     print(
@@ -116,7 +113,7 @@ def _leaderboard(args) -> int:
     from wrist_env.bench.leaderboard import write_leaderboard
 
     if not Path(args.runs).is_dir():
-        raise SystemExit(f"wrist-bench leaderboard: no run log at {args.runs}")
+        raise UsageError(f"no run log at {args.runs}")
     path = write_leaderboard(args.runs, args.out, title=args.title)
     print(path)
     return 0
@@ -130,7 +127,7 @@ def _iohanalyzer(args) -> int:
     if importlib.util.find_spec("ioh") is None:
         raise SystemExit('wrist-bench iohanalyzer needs ioh, which is not installed: pip install -e ".[ioh]"')
     if not Path(args.runs).is_dir():
-        raise SystemExit(f"wrist-bench iohanalyzer: no run log at {args.runs}")
+        raise UsageError(f"no run log at {args.runs}")
     for folder in export(args.runs, args.out):
         print(folder)
     return 0
@@ -171,7 +168,7 @@ def _montecarlo_report(args) -> int:
     from wrist_env.montecarlo.report import write_report
 
     if not Path(args.runs).is_dir():
-        raise SystemExit(f"wrist-bench montecarlo-report: no Monte Carlo run log at {args.runs}")
+        raise UsageError(f"no Monte Carlo run log at {args.runs}")
     summary = write_report(args.runs, args.out, max_runs=args.max_runs)
     t5 = summary["table5"]
     print(

@@ -16,6 +16,7 @@ from numpy.typing import ArrayLike
 
 from wrist_env import design
 from wrist_env.envs.task import task
+from wrist_env.limits import MAX_BATCH, check_int
 
 OBSERVATION = np.zeros(design.N_DESIGN, dtype=np.float32)
 
@@ -56,7 +57,7 @@ class WristVectorEnv(VectorEnv):
     metadata = {"autoreset_mode": AutoresetMode.SAME_STEP, "render_modes": []}
 
     def __init__(self, num_envs: int = 1, participant: str = "P1", motion: str = "calibrate", **_):
-        self.num_envs = int(num_envs)
+        self.num_envs = check_int("num_envs", num_envs, 1, MAX_BATCH)
         self.participant, self.motion = participant, motion
         self.task = task(participant, motion)
         self.single_action_space, self.single_observation_space = _spaces()

@@ -21,6 +21,8 @@ import traceback
 from collections.abc import Callable, Iterable, Iterator
 from typing import TYPE_CHECKING, Any
 
+from wrist_env.errors import WristEnvError
+
 if TYPE_CHECKING:
     from concurrent.futures import Future
 
@@ -157,7 +159,7 @@ class Dask(Executor):
         from distributed import Client
 
         self.own = not isinstance(scheduler, Client)
-        self.client = Client(scheduler) if self.own else scheduler
+        self.client = _connect(scheduler) if self.own else scheduler
         self.scheduler = scheduler if isinstance(scheduler, str) else str(scheduler)
 
     def submit(self, fn: Callable, *args: Any, **kwargs: Any) -> distributed.Future:
@@ -166,6 +168,29 @@ class Dask(Executor):
     def close(self) -> None:
         if self.own:
             self.client.close()
+
+
+CONNECT_TIMEOUT_S = 30.0
+"""How long to wait for a dask scheduler to answer (s)."""
+
+
+class SchedulerError(WristEnvError, ConnectionError):
+    """A dask scheduler that cannot be reached."""
+
+
+def _connect(address: str) -> distributed.Client:
+    """A client of the scheduler at `address`; `SchedulerError` naming it if it does not answer
+    within `CONNECT_TIMEOUT_S`."""
+    from distributed import Client
+
+    timeout_s = CONNECT_TIMEOUT_S
+    try:
+        return Client(address, timeout=f"{timeout_s}s")
+    except (OSError, TimeoutError, ValueError) as e:
+        raise SchedulerError(
+            f"cannot reach the dask scheduler {address!r} within {timeout_s:g} s ({type(e).__name__}: "
+            f"{str(e).splitlines()[0][:200] if str(e) else 'no answer'}); is it running, and is the address right?"
+        ) from None
 
 
 def executor(
