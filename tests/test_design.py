@@ -60,3 +60,26 @@ def test_truncated_material_samples_stay_in_bounds_and_are_normal():
     a = design.sample_materials(20000, seed=1)
     assert a.shape == (20000, 22) and np.abs(a).max() <= 1.0
     assert np.std(a * 3) == pytest.approx(0.986, abs=0.02)  # SD of N(0,1) truncated at ±3
+
+
+@pytest.mark.parametrize(
+    "edit, match",
+    [
+        (lambda d: d.update({"SLIL_d.stifness": 1.0}), r"must be among the 27.*'SLIL_d.stifness'"),
+        (lambda d: d.update({"SLIL_d.stiffness": "80.0"}), r"must be numbers.*'SLIL_d.stiffness': '80.0'"),
+        (lambda d: d.update({"RSC.injury": True}), r"must be numbers.*'RSC.injury': True"),
+    ],
+    ids=["unknown key", "number as a string", "bool"],
+)
+def test_a_design_file_with_an_unknown_key_or_a_non_number_is_named(tmp_path, edit, match):
+    import json
+    import re
+
+    from wrist_env.errors import DesignError
+
+    data = design.population().as_dict()
+    edit(data)
+    path = tmp_path / "design.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(DesignError, match=re.escape(str(path)) + ": design variables " + match):
+        design.read_json(path)

@@ -11,6 +11,7 @@ Normalized action a in [-1, 1]^27 ↔ physical value:
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -149,9 +150,16 @@ class Design:
 
     @classmethod
     def from_dict(cls, data: dict) -> "Design":
+        """From {name: value} in physical units, exactly the 27 `NAMES`, each a JSON number."""
         missing = [n for n in NAMES if n not in data]
         if missing:
             raise DesignError(f"design is missing variables {missing}.")
+        unknown = [k for k in data if k not in NAMES]
+        if unknown:
+            raise DesignError(f"design variables must be among the 27 of `design.NAMES`, but got {unknown}.")
+        not_numbers = {n: data[n] for n in NAMES if isinstance(data[n], bool) or not isinstance(data[n], numbers.Real)}
+        if not_numbers:
+            raise DesignError(f"design variables must be numbers, but got {not_numbers}.")
         return cls.from_vector([data[n] for n in NAMES])
 
 

@@ -1,6 +1,7 @@
 """Participant folders: round trip, left-wrist mirroring, and one test per validation rule."""
 
 import dataclasses
+import os
 import re
 from pathlib import Path
 
@@ -164,6 +165,7 @@ BAD_TOML = [
     ("units", 'units = "mm"', 'units = "m"', ParticipantError, TOML, "units must be \"mm\", but got 'm'"),
     ("side", 'side = "right"', 'side = "R"', ParticipantError, TOML, "side must be one of.*got 'R'"),
     ("name", 'name = "P7"', 'name = "P-7"', ParticipantError, TOML, "name must match.*got 'P-7'"),
+    ("name too long", 'name = "P7"', f'name = "{"P" * 300}"', ParticipantError, TOML, r"name must match .*\{1,64\}"),
     ("age", "age = 41", 'age = "41"', ParticipantError, TOML, "age must be a number.*got '41'"),
     ("bone entry", 'lunate = "bones/lunate.stl"\n', "", ParticipantError, TOML, r"absent=\['lunate'\]"),
     (
@@ -251,7 +253,7 @@ def test_unreadable_mesh_file(folder):
 
 
 def test_mesh_file_without_triangles(folder):
-    (folder / "bones" / "lunate.stl").write_text("not a mesh\n")
+    (folder / "bones" / "lunate.stl").write_text("solid empty\nendsolid empty\n")
     with raises(MeshError, folder / "bones" / "lunate.stl", "must hold a triangle mesh.*faces.shape=\\(0, 3\\)"):
         load_participant_folder(folder)
 
@@ -478,6 +480,16 @@ def test_a_sliver_is_not_zero_area(folder):
     assert 1e-12 * np.linalg.norm(np.ptp(vertices, axis=0)) ** 2 < area < 1e-6
 
 
+def _never_read(monkeypatch, path) -> None:
+    """Fail the test if trimesh is asked to read `path` (other files are read as usual)."""
+    load = trimesh.load_mesh
+    monkeypatch.setattr(
+        folder_module.trimesh,
+        "load_mesh",
+        lambda file, **kw: pytest.fail("read") if Path(file) == path else load(file, **kw),
+    )
+
+
 @pytest.mark.parametrize("suffix", ["stl", "ascii.stl", "obj", "ply", "off"])
 def test_a_mesh_with_too_many_faces_is_refused(folder, monkeypatch, suffix):
     """Above `MAX_FACES` (here lowered to 1,000 for a carpal, and the lunate subdivided to 1,280 faces) a
@@ -491,12 +503,7 @@ def test_a_mesh_with_too_many_faces_is_refused(folder, monkeypatch, suffix):
     else:
         replace_mesh(folder, "lunate", vertices, faces, name=f"lunate.{suffix}")
     if suffix != "off":  # trimesh must not be asked to read it
-        load = trimesh.load_mesh
-        monkeypatch.setattr(
-            folder_module.trimesh,
-            "load_mesh",
-            lambda file, **kw: pytest.fail("read") if Path(file) == path else load(file, **kw),
-        )
+        _never_read(monkeypatch, path)
     with raises(
         MeshError,
         path,
@@ -540,3 +547,59 @@ def test_a_builtin_participant_round_trips_through_a_folder(tmp_path):
     for bone in BONES:
         np.testing.assert_array_equal(copy[bone].solid[copy[bone].faces], original[bone].solid[original[bone].faces])
     assert not copy["ulna"].solid.any() and 0 < copy["radius"].solid.sum() < len(copy["radius"].solid)
+
+
+@pytest.mark.parametrize(
+    "data, message",
+    [
+        (b"garbage " * 40, r"not an STL file: neither binary \(its header declares .* faces.*nor ASCII"),
+        (b"\0" * 80 + (0xFFFFFFF0).to_bytes(4, "little") + b"\0" * 100, r"declares 4,294,967,280 faces.*has 184"),
+        (b"short", r"not an STL file: 5 bytes, shorter than a binary STL's 84-byte header"),
+    ],
+    ids=["garbage", "header claims 0xFFFFFFF0 faces", "shorter than a header"],
+)
+def test_a_file_that_is_no_stl_is_called_that_before_trimesh_reads_it(folder, monkeypatch, data, message):
+    path = folder / "bones" / "lunate.stl"
+    path.write_bytes(data)
+    _never_read(monkeypatch, path)
+    with raises(MeshError, path, message):
+        load_participant_folder(folder)
+
+
+def test_a_padded_binary_stl_over_the_face_limit_is_refused_by_its_header(folder, monkeypatch):
+    monkeypatch.setitem(folder_module.MAX_FACES, "carpal", 1000)
+    replace_mesh(folder, "lunate", *trimesh.remesh.subdivide(*bone_meshes()["lunate"]))
+    path = folder / "bones" / "lunate.stl"
+    path.write_bytes(path.read_bytes() + b"\0" * 64)  # bytes past the 1,280 faces its header declares
+    _never_read(monkeypatch, path)
+    with raises(MeshError, path, "1,280 faces, more than the 1,000 a carpal mesh may have"):
+        load_participant_folder(folder)
+
+
+@pytest.mark.parametrize("kind", ["folder", "fifo"])
+def test_a_bone_path_that_is_no_regular_file_is_called_that(folder, kind):
+    path = folder / "bones" / "lunate.stl"
+    path.unlink()
+    path.mkdir() if kind == "folder" else os.mkfifo(path)
+    with raises(ParticipantError, folder / TOML, "is a folder" if kind == "folder" else "is not a regular file"):
+        load_participant_folder(folder)
+
+
+def test_a_byte_order_mark_in_participant_toml_is_dropped(folder):
+    path = folder / TOML
+    path.write_bytes(b"\xef\xbb\xbf" + path.read_bytes())
+    assert load_participant_folder(folder).name == "P7"
+
+
+def test_two_folders_with_one_name_are_refused(folder, tmp_path, monkeypatch):
+    import shutil
+
+    from wrist_env.participants import registry
+
+    monkeypatch.setattr(registry, "_FOLDERS", {})
+    monkeypatch.setattr(registry, "_SOURCES", {})
+    other = tmp_path / "other_wrist"
+    shutil.copytree(folder, other)
+    assert registry.add_folder(folder) == "P7" and registry.add_folder(folder) == "P7"  # the same folder again
+    with raises(ParticipantError, other / TOML, f"name 'P7' is taken by the folder {folder}"):
+        registry.add_folder(other)

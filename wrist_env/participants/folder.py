@@ -35,8 +35,9 @@ PARTICIPANT_FILE = "participant.toml"
 REQUIRED_KEYS = ("name", "side", "units", "bones", "trials")
 OPTIONAL_KEYS = ("sex", "age", "facet_type", "task", "frames")
 SIDES = ("right", "left")
-NAME_PATTERN = r"[A-Za-z0-9_]+"
-TRIAL_NAME_PATTERN = r"[A-Za-z0-9_-]+"
+NAME_PATTERN = r"[A-Za-z0-9_]{1,64}"
+TRIAL_NAME_PATTERN = r"[A-Za-z0-9_-]{1,64}"
+"""Names become parts of file names (the model cache, run logs): 64 characters at most."""
 CARPALS = ("scaphoid", "lunate", "capitate")
 METRES_DIAGONAL_MM = 1.0  # a bounding-box diagonal below this is a bone in metres
 CARPAL_DIAGONAL_MM = (5.0, 100.0)  # plausible bounding-box diagonal of a carpal bone
@@ -107,8 +108,7 @@ def load_participant_folder(path: str | Path) -> ParticipantSource:
     if not toml_path.is_file():
         raise ParticipantError(f"{toml_path} does not exist; a participant folder needs a {PARTICIPANT_FILE}.")
     try:
-        with open(toml_path, "rb") as f:
-            config = tomllib.load(f)
+        config = tomllib.loads(toml_path.read_bytes().decode("utf-8-sig"))  # a byte-order mark is dropped
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ParticipantError(f"{toml_path}: TOML syntax error: {exc}") from exc
 
@@ -280,10 +280,7 @@ def declared_faces(path: Path) -> int | None:
     header, or the facets of an ASCII STL and the face lines of an OBJ counted; None for other formats."""
     suffix = path.suffix.lower()
     if suffix == ".stl":
-        with open(path, "rb") as f:
-            head = f.read(84)
-        count = int.from_bytes(head[80:84], "little") if len(head) == 84 else -1
-        return count if path.stat().st_size == 84 + 50 * count else _count_token(path, b"endfacet")
+        return _stl_faces(path)
     if suffix == ".obj":
         return _count_token(path, b"\nf ")
     if suffix == ".ply":
@@ -292,6 +289,28 @@ def declared_faces(path: Path) -> int | None:
         found = re.search(rb"element\s+face\s+(\d+)", header)
         return int(found.group(1)) if found else None
     return None
+
+
+def _stl_faces(path: Path) -> int:
+    """The faces of a binary STL (its header's count, also when the file is padded past them) or of an
+    ASCII STL (its facets); MeshError naming the file if it is neither (never handed to trimesh)."""
+    with open(path, "rb") as f:
+        head = f.read(84)
+    size = path.stat().st_size
+    count = int.from_bytes(head[80:84], "little") if len(head) == 84 else -1
+    if size == 84 + 50 * count:
+        return count
+    facets = _count_token(path, b"endfacet")
+    if facets or head.lstrip().startswith(b"solid"):
+        return facets
+    if count >= 0 and size > 84 + 50 * count:
+        return count
+    raise MeshError(
+        f"{path}: not an STL file: neither binary (its header declares {count:,} faces, {84 + 50 * count:,} bytes, "
+        f"but the file has {size:,}) nor ASCII (no facets)."
+        if count >= 0
+        else f"{path}: not an STL file: {size} bytes, shorter than a binary STL's 84-byte header, and no facets."
+    )
 
 
 def _count_token(path: Path, token: bytes, chunk: int = 1 << 24) -> int:
@@ -428,7 +447,8 @@ def _listed_file(folder: Path, relative, where: str, toml_path: Path) -> Path:
             f"{root} (through '..' or a link); refused, not read."
         )
     if not file.is_file():
-        raise ParticipantError(f"{toml_path}: {where} = {relative!r}, but {file} does not exist.")
+        what = "is a folder" if file.is_dir() else "is not a regular file" if file.exists() else "does not exist"
+        raise ParticipantError(f"{toml_path}: {where} = {relative!r}, but {file} {what}.")
     return file
 
 

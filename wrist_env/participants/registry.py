@@ -64,6 +64,10 @@ def add_folder(folder: str | Path) -> str:
         raise ParticipantError(
             f"{Path(folder) / 'participant.toml'}: name {source.name!r} is taken by a built-in participant"
         )
+    if source.name in _FOLDERS and _FOLDERS[source.name].resolve() != Path(folder).resolve():
+        raise ParticipantError(
+            f"{Path(folder) / 'participant.toml'}: name {source.name!r} is taken by the folder {_FOLDERS[source.name]}"
+        )
     _FOLDERS[source.name] = Path(folder)
     _SOURCES[source.name] = source
     return source.name
@@ -134,6 +138,8 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
             return Model.load(builtin.shipped_model_path(name))
         except StoreError as e:
             warnings.warn(f"building instead of reading a damaged shipped model: {e}", stacklevel=2)
+    if cache:
+        check_cache(path)  # before a build of minutes, not after
     try:
         model = build_model(name, b, params, digest=digest)
     except BuildError as e:
@@ -141,8 +147,26 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
             raise BuildError(f"{_FOLDERS[name] / 'participant.toml'}: {e}") from e
         raise
     if cache:
-        model.save(path)
+        try:
+            model.save(path)
+        except OSError as e:  # the build is not lost: the model is used uncached
+            warnings.warn(f"{path}: the built model could not be cached ({type(e).__name__}: {e})", stacklevel=2)
     return model
+
+
+def check_cache(path: Path) -> None:
+    """`StoreError` naming the folder or file unless a model can be cached at `path` (`.npz` + `.json`)."""
+    advice = "set WRIST_ENV_CACHE to a writable folder, or load with cache=False"
+    for p in (path.with_suffix(".npz"), path.with_suffix(".json")):
+        if p.is_dir():
+            raise StoreError(f"{p}: a folder where the cached model goes; remove it, or {advice}")
+    probe = path.parent / f".{path.name}.probe.tmp"  # a temporary name `io.clean_temporary` knows
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as e:
+        raise StoreError(f"{path.parent}: the model cache cannot be written ({e.strerror or e}); {advice}") from None
 
 
 __all__ = [
