@@ -127,6 +127,13 @@ def test_nan(csv_path):
         read_trial_csv(csv_path, "u", "calibrate")
 
 
+def test_a_translation_shifted_by_a_million_mm_is_refused(csv_path):
+    shifted = lambda t: t.assign(m13=np.where((t.frame == 4) & (t.bone == "lunate"), t.m13 + 1e6, t.m13))  # noqa: E731
+    edit_csv(csv_path, shifted)
+    with raises(csv_path, r"within 100 mm of the neutral pose, but bone 'lunate' frame 4 is 1e\+06 mm away"):
+        read_trial_csv(csv_path, "u", "calibrate")
+
+
 def test_inf(csv_path):
     edit_csv(csv_path, lambda t: t.assign(m13=np.where((t.frame == 9) & (t.bone == "capitate"), np.inf, t.m13)))
     with raises(csv_path, "finite.*bone 'capitate' frame 9 has m13=inf"):

@@ -28,6 +28,9 @@ MATRIX_COLUMNS = tuple(f"m{r}{c}" for r in range(3) for c in range(4))
 COLUMNS = ("frame", "bone") + MATRIX_COLUMNS
 METRES_TRANSLATION_MM = 0.5  # all |t| below this while rotations vary ...
 METRES_ROTATION_DEG = 5.0  # ... by more than this: translations are in metres
+MAX_TRANSLATION_MM = 100.0
+"""A bone's pose moves it at most this far (mm, any axis) from its neutral place: the built-in trials stay
+within 8 mm; a larger value is a unit or export error (1e6 mm was accepted, at cost 1.4e6)."""
 MIRROR = np.diag([1.0, 1.0, -1.0, 1.0])
 """Left → right wrist reflection of the RCS (z → −z)."""
 
@@ -84,7 +87,7 @@ def validate_transforms(array: ArrayLike, source: str, bones: tuple[str, ...] | 
     """The transforms as float64 array of shape (..., 4, 4), or a TrialError naming `source` and the entry.
 
     Rules: finite; bottom row 0 0 0 1; rotation orthonormal (max |RᵀR − I| <= 1e-4) and proper
-    (det > 0); translations in mm, not metres. `bones` names axis 0 of a (n_bones, n_frames, 4, 4) array.
+    (det > 0); translations in mm, not metres, and within `MAX_TRANSLATION_MM`. `bones` names axis 0 of a (n_bones, n_frames, 4, 4) array.
     """
     shape = np.shape(array)
 
@@ -104,6 +107,12 @@ def validate_transforms(array: ArrayLike, source: str, bones: tuple[str, ...] | 
         cos = np.clip((np.trace(relative, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
         span_deg = float(np.degrees(np.arccos(cos)).max())
         max_t = float(np.abs(t[..., :3, 3]).max())
+        if max_t > MAX_TRANSLATION_MM:
+            worst = np.unravel_index(int(np.argmax(np.abs(t[..., :3, 3]).max(axis=-1))), t.shape[:-2])
+            raise TrialError(
+                f"{source}: translations must stay within {MAX_TRANSLATION_MM:g} mm of the neutral pose, but "
+                f"{where(worst)} is {max_t:.4g} mm away."
+            )
         if max_t < METRES_TRANSLATION_MM and span_deg > METRES_ROTATION_DEG:
             raise TrialError(
                 f"{source}: translations look like metres; use mm (largest |t| = {max_t:.3g} "

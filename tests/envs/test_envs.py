@@ -114,3 +114,14 @@ def test_a_vector_env_size_out_of_bounds_is_refused_before_the_model_loads(num_e
 
     with pytest.raises(InputError, match=rf"num_envs must be an integer in \[1, 4,096\], but got {num_envs}"):
         gym.make_vec("wrist_env/Calibrate-P1-v0", num_envs=num_envs, vectorization_mode="vector_entry_point")
+
+
+@pytest.mark.parametrize("bad", [np.nan, 3.0])
+def test_a_bad_row_of_a_vector_action_is_named(bad):
+    from wrist_env.errors import DesignError
+
+    env = gym.make_vec("wrist_env/Calibrate-P1-v0", num_envs=3, vectorization_mode="vector_entry_point")
+    actions = np.zeros((3, design.N_DESIGN))
+    actions[1, 4] = bad
+    with pytest.raises(DesignError, match=rf"row 1 of the actions: .*{design.NAMES[4]}={bad}"):
+        env.step(actions)

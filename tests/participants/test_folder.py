@@ -177,6 +177,14 @@ BAD_TOML = [
         "role \"calibrate\", but got .*'unresisted': 'other'",
     ),
     (
+        "two calibrate trials",
+        'role = "validate"',
+        'role = "calibrate"',
+        ParticipantError,
+        TOML,
+        "exactly one trial must have role \"calibrate\", but got .*'resisted': 'calibrate'",
+    ),
+    (
         "trial role",
         'role = "calibrate"',
         'role = "train"',

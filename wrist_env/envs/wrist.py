@@ -16,6 +16,7 @@ from numpy.typing import ArrayLike
 
 from wrist_env import design
 from wrist_env.envs.task import task
+from wrist_env.errors import DesignError
 from wrist_env.limits import MAX_BATCH, check_int
 
 OBSERVATION = np.zeros(design.N_DESIGN, dtype=np.float32)
@@ -51,6 +52,14 @@ class WristEnv(gym.Env):
         return OBSERVATION.copy(), float(evaluation.reward), True, False, evaluation.info
 
 
+def _row_design(row: int, action: np.ndarray) -> design.Design:
+    """The design of one row of a batch of actions; `DesignError` naming the row."""
+    try:
+        return design.from_action(action)
+    except DesignError as e:
+        raise DesignError(f"row {row} of the actions: {e}") from None
+
+
 class WristVectorEnv(VectorEnv):
     """`num_envs` designs per `step`, simulated in one batched call (same numbers as `WristEnv`)."""
 
@@ -75,7 +84,7 @@ class WristVectorEnv(VectorEnv):
         actions = np.asarray(actions)
         if actions.shape != (self.num_envs, design.N_DESIGN):
             raise ValueError(f"actions must have shape ({self.num_envs}, {design.N_DESIGN}), but got {actions.shape}")
-        evaluations = self.task.evaluate_batch(design.from_action(a) for a in actions)
+        evaluations = self.task.evaluate_batch([_row_design(i, a) for i, a in enumerate(actions)])
         infos = {}
         for i, e in enumerate(evaluations):
             infos = self._add_info(infos, e.info, i)

@@ -149,9 +149,9 @@ def load_participant_folder(path: str | Path) -> ParticipantSource:
             raise ParticipantError(f"{toml_path}: {where} role must be one of {ROLES}, but got {entry['role']!r}.")
         file = _listed_file(folder, entry["file"], f"{where} file", toml_path)
         trials[trial_name] = read_trial_csv(file, trial_name, entry["role"], n_frames=meta.get("frames"))
-    if not any(t.role == "calibrate" for t in trials.values()):
-        roles = {k: t.role for k, t in trials.items()}
-        raise ParticipantError(f'{toml_path}: at least one trial must have role "calibrate", but got {roles}.')
+    roles = {k: t.role for k, t in trials.items()}
+    if list(roles.values()).count("calibrate") != 1:
+        raise ParticipantError(f'{toml_path}: exactly one trial must have role "calibrate", but got {roles}.')
 
     if config["side"] == "left":
         bones = {b: mirror_mesh(*vf) for b, vf in bones.items()}
