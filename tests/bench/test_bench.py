@@ -281,11 +281,30 @@ def test_a_damaged_part_of_an_unfinished_cell_drops_it_and_what_follows(p1, tmp_
     sorted((tmp_path / "runs" / "evals").glob("part-*b00002*.parquet"))[0].write_bytes(b"")
     with pytest.warns(UserWarning, match="b00002"):
         assert log.repair() == 4  # the damaged batch and the three after it
-    assert log.logged_range(key) == 2 and len(list((tmp_path / "runs" / "damaged").iterdir())) == 4
+    assert log.logged_range(key) == 2 and len(list((tmp_path / "runs" / "damaged").glob("*.parquet"))) == 4
     report = benchmark([p1], ["nelder-mead"], [0], 12, tmp_path / "runs", workers=1, progress=False)
     assert report.ran == [key] and log.summary(key)["replayed"] == 2
     reference = benchmark([p1], ["nelder-mead"], [0], 12, tmp_path / "reference", workers=1, progress=False)
     assert not reference.failed
+    assert log.read_cell(key).cost.tolist() == RunLog(tmp_path / "reference").read_cell(key).cost.tolist()
+
+
+def test_a_deleted_middle_part_of_an_unfinished_cell_is_repaired_by_the_rerun(p1, tmp_path):
+    class Stop(Exception):
+        pass
+
+    def stop_after_six(n_new, nfev):
+        if nfev == 6:
+            raise Stop
+
+    key, log = RunKey(p1, "nelder-mead", 0, 12), RunLog(tmp_path / "runs")
+    with pytest.raises(Stop):  # one evaluation per batch: batches 0 … 5 logged
+        calibrate(p1, "nelder-mead", 12, 0, log=log, callback=stop_after_six)
+    sorted((tmp_path / "runs" / "evals").glob("part-*b00002*.parquet"))[0].unlink()
+    with pytest.warns(UserWarning, match=r"b00003.*evaluations 2…2 of its cell are missing"):
+        report = benchmark([p1], ["nelder-mead"], [0], 12, tmp_path / "runs", workers=1, progress=False)
+    assert report.ran == [key] and not report.failed and log.summary(key)["replayed"] == 2
+    reference = benchmark([p1], ["nelder-mead"], [0], 12, tmp_path / "reference", workers=1, progress=False)
     assert log.read_cell(key).cost.tolist() == RunLog(tmp_path / "reference").read_cell(key).cost.tolist()
 
 
