@@ -305,6 +305,7 @@ def test_a_deleted_middle_part_of_an_unfinished_cell_is_repaired_by_the_rerun(p1
         report = benchmark([p1], ["nelder-mead"], [0], 12, tmp_path / "runs", workers=1, progress=False)
     assert report.ran == [key] and not report.failed and log.summary(key)["replayed"] == 2
     reference = benchmark([p1], ["nelder-mead"], [0], 12, tmp_path / "reference", workers=1, progress=False)
+    assert not reference.failed
     assert log.read_cell(key).cost.tolist() == RunLog(tmp_path / "reference").read_cell(key).cost.tolist()
 
 
