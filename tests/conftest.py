@@ -31,3 +31,18 @@ def built(model_cache):
         return cache[name]
 
     return get
+
+
+@pytest.fixture(autouse=True)
+def participant_registry():
+    """Folders a test registers are forgotten after it (those of wider-scoped fixtures, set up
+    before it, are kept): a name is one folder within a process (`registry.add_folder` refuses a
+    second), and tests reuse names such as U1."""
+    from wrist_env.participants import registry
+
+    folders, sources = dict(registry._FOLDERS), dict(registry._SOURCES)
+    yield
+    registry._FOLDERS.clear()
+    registry._FOLDERS.update(folders)
+    registry._SOURCES.clear()
+    registry._SOURCES.update(sources)
