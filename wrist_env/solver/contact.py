@@ -149,6 +149,18 @@ def law_pressure(law, e):
 
 
 @njit(cache=True, error_model="numpy")
+def law_slope(law, e):
+    """dp/de (MPa per unit strain) of the tri-linear law at strain e (0 out of contact)."""
+    if e <= 0.0:
+        return 0.0
+    if e <= law[0]:
+        return law[2]
+    if e <= law[1]:
+        return law[3]
+    return law[4]
+
+
+@njit(cache=True, error_model="numpy")
 def law_energy(law, e):
     """Strain energy density ∫ p de (MPa) of the law from 0 to strain e."""
     if e <= 0.0:

@@ -17,7 +17,7 @@ import numpy as np
 from numba import njit
 from scipy.optimize import least_squares
 
-from wrist_env.design import ALL_LIGAMENT_NAMES, Design
+from wrist_env.design import Design
 from wrist_env.model import Model
 from wrist_env.solver import arrays, kernel
 from wrist_env.solver.kernel import CAPITATE, LEVER_MM, LUNATE, SCAPHOID
@@ -60,16 +60,7 @@ def _residual(q, R0, x0, nodes0, free_nodes, bod, grids, law, fib, stiffness, me
     R, x, nodes = moved_state(q, R0, x0, nodes0, free_nodes, loaded)
     n_bones = R.shape[0]
     state = kernel.State(R, x, np.zeros((n_bones, 3)), np.zeros((n_bones, 3)), nodes, np.zeros_like(nodes))
-    work = kernel.Work(
-        np.zeros(grids.points.shape[0], np.int64),
-        np.zeros(grids.pair_bones.shape[0], np.int64),
-        np.full((grids.pair_bones.shape[0], 12), np.nan),
-        np.zeros((n_bones, 3)),
-        np.zeros((n_bones, 3)),
-        np.zeros_like(nodes),
-        np.zeros((grids.pair_bones.shape[0], 3)),
-        np.zeros(len(ALL_LIGAMENT_NAMES)),
-    )
+    work = kernel.new_work(grids, nodes)
     kernel._forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, True)
     F, T, node_force = work.F, work.T, work.node_force
     k = 0
@@ -256,3 +247,56 @@ def tangent_stiffness(
         mass[12:, 12:] = p.bodies.mass[CAPITATE] * np.eye(3)
     asymmetry = float(np.linalg.norm(condensed - condensed.T) / np.linalg.norm(condensed))
     return Tangent(0.5 * (condensed + condensed.T), mass, asymmetry)
+
+
+@dataclass(frozen=True)
+class BlockMass:
+    """The explicit solver's block mass at one frame of a run (`preconditioner`), in `Tangent`'s coordinates.
+
+    stiffness (n, n): the Gauss–Newton tangent the mass is built from (N/mm, N/rad, N·mm/rad); mass (n, n):
+    the block-diagonal mass (t, t·mm, t·mm²) at settings.dt_s."""
+
+    stiffness: np.ndarray
+    mass: np.ndarray
+
+
+def block_mass(
+    model: Model, design: Design, driver, result, frame: int, settings: arrays.SolverSettings | None = None
+) -> BlockMass:
+    """The `BlockMass` the explicit solver would build at `frame` of `result` (a successful `simulate`)
+    under `settings` (their block_* fields; the block mass need not be on)."""
+    from wrist_env.solver import preconditioner
+
+    if not result.ok:
+        raise ValueError(f"the run failed ({result.message}); there is no state to linearize")
+    p = prepare(model, settings, driver.mode)
+    free_nodes, n_unknown = _unknowns(model, driver)
+    st = stiffness(p, design)
+    R0, x0, nodes0 = _frame_args(p, st, free_nodes, driver, result, frame)[:3]
+    n_bones = n_unknown - 3 * len(free_nodes)
+    g = p.grids
+    state = kernel.State(
+        R0.copy(), x0.copy(), np.zeros_like(x0), np.zeros_like(x0), nodes0.copy(), np.zeros_like(nodes0)
+    )
+    work = kernel.new_work(g, nodes0)
+    kernel._forces(
+        state, work, p.bodies, g, p.law, p.fibres, st, p.membrane, p.settings, float(driver.load_n[frame]), True
+    )
+    m = preconditioner.metric()
+    preconditioner.tangent(
+        state.R,
+        state.x,
+        state.nodes,
+        p.bodies.com0,
+        g,
+        p.law,
+        p.fibres,
+        st,
+        p.membrane,
+        p.settings,
+        work.active,
+        work.n_active,
+        m,
+    )
+    preconditioner.block_mass(state.R, p.bodies, p.settings, m)
+    return BlockMass(m.stiffness[:n_bones, :n_bones].copy(), m.mass[:n_bones, :n_bones].copy())

@@ -5,6 +5,9 @@ quasi-static answer. The radius and ulna are fixed, the scaphoid and lunate
 free in 6 DOF, the capitate driven (all 6 DOF prescribed, or, for the
 idealized driver, rotations prescribed and translations free under a
 compressive load), the RSC membrane's interior nodes free point masses.
+The free bones' masses are their (scaled) physical ones or, with
+`Settings.block_mass`, one block each from the tangent stiffness
+(`preconditioner`): the answer is the same equilibrium, reached in fewer steps.
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ from wrist_env.solver.forces import (
     membrane_forces,
     place_nodes,
 )
+from wrist_env.solver.preconditioner import block_mass, dof, metric, tangent
 from wrist_env.solver.rigid import interpolate_pose, matrix_to_rotvec, orthonormalize, rotate_in_place, smoothstep
 
 N_BONES, N_PAIRS = len(BONES), len(PAIRS)
@@ -58,11 +62,48 @@ def _mix(vel, force, a):
                 vel[i, k] = (1.0 - a) * vel[i, k] + c * force[i, k]
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _force_of(F, T, b, i):
+    """Generalized force of body b's unknown i (`preconditioner.dof`): F (N) then T (N·mm)."""
+    return F[b, i] if i < 3 else T[b, i - 3]
+
+
 @njit(cache=True, error_model="numpy")
-def _fire(v, w, nv, F, T, node_force, mem, st, fire):
+def _mix_metric(v, w, F, T, st, m, a):
+    """FIRE mixing of each free body's velocity (v; w) towards M⁻¹(F; T) in the block mass's metric
+    (preconditioned FIRE): u ← (1 − a)·u + a·|u|_M·M⁻¹g / |M⁻¹g|_M."""
+    M, Minv = m.mass, m.inverse
+    for b in (SCAPHOID, LUNATE, CAPITATE):
+        i0, nb = dof(st, b)
+        if i0 < 0:
+            continue
+        vn = 0.0
+        fn = 0.0
+        for i in range(nb):
+            ui = v[b, i] if i < 3 else w[b, i - 3]
+            gi = _force_of(F, T, b, i)
+            for j in range(nb):
+                uj = v[b, j] if j < 3 else w[b, j - 3]
+                vn += ui * M[i0 + i, i0 + j] * uj
+                fn += gi * Minv[i0 + i, i0 + j] * _force_of(F, T, b, j)
+        if fn <= 0.0:
+            continue
+        c = a * np.sqrt(max(vn, 0.0) / fn)
+        for i in range(nb):
+            di = 0.0
+            for j in range(nb):
+                di += Minv[i0 + i, i0 + j] * _force_of(F, T, b, j)
+            if i < 3:
+                v[b, i] = (1.0 - a) * v[b, i] + c * di
+            else:
+                w[b, i - 3] = (1.0 - a) * w[b, i - 3] + c * di
+
+
+@njit(cache=True, error_model="numpy")
+def _fire(v, w, nv, F, T, node_force, mem, st, fire, m):
     """FIRE relaxation (Bitzek et al. 2006) at a fixed step: mix velocities towards the
     forces while the power is positive, stop everything when it turns negative.
-    fire = [alpha, steps with positive power]."""
+    fire = [alpha, steps with positive power, 1 after a restart (the caller clears it)]."""
     power = 0.0
     for k in range(3):
         for b in (SCAPHOID, LUNATE):
@@ -73,11 +114,14 @@ def _fire(v, w, nv, F, T, node_force, mem, st, fire):
             power += node_force[i, k] * nv[i, k]
     if power > 0.0:
         a = fire[0]
-        for b in (SCAPHOID, LUNATE):
-            _mix(v[b : b + 1], F[b : b + 1], a)
-            _mix(w[b : b + 1], T[b : b + 1], a)
-        if st.driver == LOADED:
-            _mix(v[CAPITATE : CAPITATE + 1], F[CAPITATE : CAPITATE + 1], a)
+        if st.block_mass:
+            _mix_metric(v, w, F, T, st, m, a)
+        else:
+            for b in (SCAPHOID, LUNATE):
+                _mix(v[b : b + 1], F[b : b + 1], a)
+                _mix(w[b : b + 1], T[b : b + 1], a)
+            if st.driver == LOADED:
+                _mix(v[CAPITATE : CAPITATE + 1], F[CAPITATE : CAPITATE + 1], a)
         _mix(nv, node_force, a)
         fire[1] += 1.0
         if fire[1] > FIRE_N_MIN:
@@ -88,6 +132,7 @@ def _fire(v, w, nv, F, T, node_force, mem, st, fire):
         nv[:] = 0.0
         fire[0] = st.fire_alpha0
         fire[1] = 0.0
+        fire[2] = 1.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -135,19 +180,44 @@ def _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, rebuild
 
 
 @njit(cache=True, error_model="numpy")
-def _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step_index, fire):
+def _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step_index, fire, m, refresh):
     """One explicit step with the capitate at target (capR, capx), or, for the loaded
-    driver, at rotation capR under a compressive `load` (N, along +y)."""
+    driver, at rotation capR under a compressive `load` (N, along +y); with st.block_mass and
+    `refresh`, the block mass m (`preconditioner.Metric`) is rebuilt at this state first."""
     R, x, v, w, nodes, nv = state
-    _, _, _, F, T, node_force, _, _ = work
+    active, n_active, _, F, T, node_force, _, _ = work
     R[CAPITATE] = capR
     if st.driver == EXPERIMENTAL:
         x[CAPITATE, 0], x[CAPITATE, 1], x[CAPITATE, 2] = capx
         v[CAPITATE] = 0.0
     w[CAPITATE] = 0.0
     _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, False, False)
+    if st.block_mass and refresh:
+        tangent(R, x, nodes, bod.com0, grids, law, fib, stiffness, mem, st, active, n_active, m)
+        block_mass(R, bod, st, m)
     if st.fire_alpha0 > 0.0:
-        _fire(v, w, nv, F, T, node_force, mem, st, fire)
+        _fire(v, w, nv, F, T, node_force, mem, st, fire, m)
+    dt = st.dt
+    lin = 1.0 / (1.0 + st.damping * dt)
+    if st.block_mass:
+        _move_blocks(R, x, v, w, F, T, st, m)
+    else:
+        _move_diagonal(R, x, v, w, F, T, bod, st)
+    if stiffness.node_mass > 0.0:
+        for i in range(nodes.shape[0]):
+            if mem.bone[i] < 0:
+                for k in range(3):
+                    nv[i, k] = (nv[i, k] + dt / stiffness.node_mass * node_force[i, k]) * lin
+                    nodes[i, k] += dt * nv[i, k]
+    if step_index % 100 == 0:
+        for b in (SCAPHOID, LUNATE):
+            R[b] = orthonormalize(R[b])
+
+
+@njit(cache=True, error_model="numpy")
+def _move_diagonal(R, x, v, w, F, T, bod, st):
+    """Semi-implicit Euler of the free bodies under their (scaled) mass and inertia, with
+    mass-proportional damping."""
     dt = st.dt
     lin = 1.0 / (1.0 + st.damping * dt)
     rot = 1.0 / (1.0 + st.rot_damping * dt)
@@ -170,15 +240,41 @@ def _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, loa
         for k in range(3):
             v[CAPITATE, k] = (v[CAPITATE, k] + dt * bod.inv_mass[CAPITATE] * F[CAPITATE, k]) * lin
             x[CAPITATE, k] += dt * v[CAPITATE, k]
-    if stiffness.node_mass > 0.0:
-        for i in range(nodes.shape[0]):
-            if mem.bone[i] < 0:
-                for k in range(3):
-                    nv[i, k] = (nv[i, k] + dt / stiffness.node_mass * node_force[i, k]) * lin
-                    nodes[i, k] += dt * nv[i, k]
-    if step_index % 100 == 0:
-        for b in (SCAPHOID, LUNATE):
-            R[b] = orthonormalize(R[b])
+
+
+@njit(cache=True, error_model="numpy")
+def _move_blocks(R, x, v, w, F, T, st, m):
+    """Semi-implicit Euler of the free bodies under the block mass: u ← (u + dt·M⁻¹g)/(1 + block_damping),
+    the velocity cut where a body's step would move it more than st.block_max_move_mm (its shift
+    plus its rotation × LEVER_MM): the mass is a linearization, and a contact that closes between
+    refreshes is stiffer than it says."""
+    dt = st.dt
+    keep = 1.0 / (1.0 + st.block_damping)
+    Minv = m.inverse
+    for b in (SCAPHOID, LUNATE, CAPITATE):
+        i0, nb = dof(st, b)
+        if i0 < 0:
+            continue
+        for i in range(nb):
+            acc = 0.0
+            for j in range(nb):
+                acc += Minv[i0 + i, i0 + j] * _force_of(F, T, b, j)
+            if i < 3:
+                v[b, i] = (v[b, i] + dt * acc) * keep
+            else:
+                w[b, i - 3] = (w[b, i - 3] + dt * acc) * keep
+        move = dt * np.sqrt(v[b, 0] ** 2 + v[b, 1] ** 2 + v[b, 2] ** 2)
+        if nb == 6:
+            move += dt * LEVER_MM * np.sqrt(w[b, 0] ** 2 + w[b, 1] ** 2 + w[b, 2] ** 2)
+        if move > st.block_max_move_mm:
+            cut = st.block_max_move_mm / move
+            for k in range(3):
+                v[b, k] *= cut
+                w[b, k] *= cut
+        for k in range(3):
+            x[b, k] += dt * v[b, k]
+        if nb == 6:
+            rotate_in_place(R[b], w[b, 0] * dt, w[b, 1] * dt, w[b, 2] * dt)
 
 
 @njit(cache=True, error_model="numpy")
@@ -204,23 +300,32 @@ def _converged(F, T, bundle, st):
 
 
 @njit(cache=True, error_model="numpy")
-def _kinetic(R, v, w, nv, bod, st, node_mass):
-    """Kinetic energy (N·mm) of the free bodies and membrane nodes of mass `node_mass` (t) (mass-scaled)."""
+def _kinetic(R, v, w, nv, bod, st, node_mass, m):
+    """Kinetic energy (N·mm) of the free bodies and membrane nodes of mass `node_mass` (t) (mass-scaled;
+    with st.block_mass, in the block mass m)."""
     ke = 0.0
-    for b in (SCAPHOID, LUNATE):
-        # body-frame angular velocity Rᵀw against the neutral-pose inertia
-        u0 = R[b, 0, 0] * w[b, 0] + R[b, 1, 0] * w[b, 1] + R[b, 2, 0] * w[b, 2]
-        u1 = R[b, 0, 1] * w[b, 0] + R[b, 1, 1] * w[b, 1] + R[b, 2, 1] * w[b, 2]
-        u2 = R[b, 0, 2] * w[b, 0] + R[b, 1, 2] * w[b, 1] + R[b, 2, 2] * w[b, 2]
-        I = bod.inertia[b]
-        rot = (
-            u0 * (I[0, 0] * u0 + I[0, 1] * u1 + I[0, 2] * u2)
-            + u1 * (I[1, 0] * u0 + I[1, 1] * u1 + I[1, 2] * u2)
-            + u2 * (I[2, 0] * u0 + I[2, 1] * u1 + I[2, 2] * u2)
-        )
-        ke += 0.5 * bod.mass[b] * (v[b, 0] ** 2 + v[b, 1] ** 2 + v[b, 2] ** 2) + 0.5 * rot
-    if st.driver == LOADED:
-        ke += 0.5 * bod.mass[CAPITATE] * (v[CAPITATE, 0] ** 2 + v[CAPITATE, 1] ** 2 + v[CAPITATE, 2] ** 2)
+    if st.block_mass:
+        for b in (SCAPHOID, LUNATE, CAPITATE):
+            i0, nb = dof(st, b)
+            for i in range(nb if i0 >= 0 else 0):
+                ui = v[b, i] if i < 3 else w[b, i - 3]
+                for j in range(nb):
+                    ke += 0.5 * ui * m.mass[i0 + i, i0 + j] * (v[b, j] if j < 3 else w[b, j - 3])
+    if not st.block_mass:
+        for b in (SCAPHOID, LUNATE):
+            # body-frame angular velocity Rᵀw against the neutral-pose inertia
+            u0 = R[b, 0, 0] * w[b, 0] + R[b, 1, 0] * w[b, 1] + R[b, 2, 0] * w[b, 2]
+            u1 = R[b, 0, 1] * w[b, 0] + R[b, 1, 1] * w[b, 1] + R[b, 2, 1] * w[b, 2]
+            u2 = R[b, 0, 2] * w[b, 0] + R[b, 1, 2] * w[b, 1] + R[b, 2, 2] * w[b, 2]
+            I = bod.inertia[b]
+            rot = (
+                u0 * (I[0, 0] * u0 + I[0, 1] * u1 + I[0, 2] * u2)
+                + u1 * (I[1, 0] * u0 + I[1, 1] * u1 + I[1, 2] * u2)
+                + u2 * (I[2, 0] * u0 + I[2, 1] * u1 + I[2, 2] * u2)
+            )
+            ke += 0.5 * bod.mass[b] * (v[b, 0] ** 2 + v[b, 1] ** 2 + v[b, 2] ** 2) + 0.5 * rot
+        if st.driver == LOADED:
+            ke += 0.5 * bod.mass[CAPITATE] * (v[CAPITATE, 0] ** 2 + v[CAPITATE, 1] ** 2 + v[CAPITATE, 2] ** 2)
     for i in range(nv.shape[0]):
         ke += 0.5 * node_mass * (nv[i, 0] ** 2 + nv[i, 1] ** 2 + nv[i, 2] ** 2)
     return ke
@@ -233,6 +338,24 @@ Work = namedtuple("Work", ["active", "n_active", "ref", "F", "T", "node_force", 
 """A run's scratch: active contact samples, their count per pair and the pair transforms when they
 were filled (n_pairs, 12; NaN to refill), forces (5, 3) N and torques
 (5, 3) N·mm on the bodies, membrane node forces (M, 3) N, per-pair contact stats, bundle forces (N)."""
+
+
+@njit(cache=True)
+def new_work(grids, nodes):
+    """A zeroed `Work` for the contact grids and a membrane of nodes (M, 3)."""
+    n_pairs = grids.pair_bones.shape[0]
+    return Work(
+        np.zeros(grids.points.shape[0], np.int64),
+        np.zeros(n_pairs, np.int64),
+        np.full((n_pairs, 12), np.nan),
+        np.zeros((N_BONES, 3)),
+        np.zeros((N_BONES, 3)),
+        np.zeros_like(nodes),
+        np.zeros((n_pairs, 3)),
+        np.zeros(N_LIGAMENTS),
+    )
+
+
 Stiffness = namedtuple("Stiffness", ["f_l0", "f_K", "m_l0", "m_K", "node_mass"])
 """A design's zero-load lengths (mm) and stiffnesses of the fibres and the membrane connectors, and the
 membrane's free-node mass (t) its connectors need (`arrays.node_mass`)."""
@@ -286,22 +409,16 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
     w = np.zeros((N_BONES, 3))
     nodes = mem.rest.copy()
     nv = np.zeros_like(nodes)
-    node_force = np.zeros_like(nodes)
-    active = np.zeros(grids.points.shape[0], np.int64)
-    n_active = np.zeros(grids.pair_bones.shape[0], np.int64)
-    ref = np.full((grids.pair_bones.shape[0], 12), np.nan)
-    F = np.zeros((N_BONES, 3))
-    T = np.zeros((N_BONES, 3))
-    stats = np.zeros((grids.pair_bones.shape[0], 3))
-    bundle = np.zeros(N_LIGAMENTS)
     state = State(R, x, v, w, nodes, nv)
-    work = Work(active, n_active, ref, F, T, node_force, stats, bundle)
+    work = new_work(grids, nodes)
+    F, T, stats, bundle = work.F, work.T, work.stats, work.bundle
     status[0] = OK
     step = 0
     R0 = np.eye(3)
     x0 = com0[CAPITATE].copy()
-    fire = np.array([st.fire_alpha0, 0.0])
+    fire = np.array([st.fire_alpha0, 0.0, 0.0])
     capR = np.eye(3)
+    m = metric()
     taken = 0
     for f in range(SETTLE, n_frames):
         Ra, xa, la, Rb, xb, lb, ramp, most = _stage(f, R0, x0, frame_R, frame_x, frame_load, st)
@@ -313,7 +430,9 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
             s = smoothstep((k + 1) / ramp) if ramp > 0 else 1.0
             capx = interpolate_pose(Ra, xa, axis, capR, shift, s)
             load = la + s * (lb - la)
-            _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step, fire)
+            refresh = k % st.block_refresh_steps == 0 or fire[2] > 0.0
+            fire[2] = 0.0
+            _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step, fire, m, refresh)
             step += 1
             k += 1
             if k >= ramp + st.min_hold_steps and _converged(F, T, bundle, st):
@@ -352,7 +471,7 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
             contact[f, p, R_AREA] = area
             contact[f, p, R_FORCE] = stats[p, C_FORCE]
         bundle_out[f] = bundle
-        energy_out[f, 0] = _kinetic(R, v, w, nv, bod, st, stiffness.node_mass)
+        energy_out[f, 0] = _kinetic(R, v, w, nv, bod, st, stiffness.node_mass, m)
         energy_out[f, 1] = energy
         residual_out[f, 0] = max(np.linalg.norm(F[SCAPHOID]), np.linalg.norm(F[LUNATE]))
         residual_out[f, 1] = max(np.linalg.norm(T[SCAPHOID]), np.linalg.norm(T[LUNATE]))

@@ -23,6 +23,16 @@ def blankevoort_force(K, strain):
 
 
 @njit(cache=True, error_model="numpy")
+def blankevoort_slope(K, strain):
+    """dT/dε (N per unit strain) of a fibre of scale K at `strain` (0 when slack)."""
+    if strain <= 0.0:
+        return 0.0
+    if strain <= 2.0 * EPSILON_L:
+        return K * strain / (2.0 * EPSILON_L)
+    return K
+
+
+@njit(cache=True, error_model="numpy")
 def blankevoort_energy(K, l0, strain):
     """Strain energy (N·mm) of a fibre of scale K, zero-load length l0 (mm), at `strain`."""
     if strain <= 0.0:

@@ -1,0 +1,367 @@
+"""The block mass of the free bones: the explicit solver's preconditioner (Numba).
+
+A quasi-static answer does not depend on the masses; only the path to it and its
+speed do. The explicit step is bounded by the stiffest mode and a hold lasts as
+long as the softest mode needs, so the steps follow the spread √(λmax/λmin) of
+M⁻¹K. With diagonal, isotropic masses that spread is large, because a carpal
+bone's stiff and soft directions lie off its axes (contact normals, the coupling
+of translation and rotation). Here each free bone gets one 6×6 mass block (the
+loaded capitate's translations a 3×3 one) proportional to its own block of the
+tangent stiffness K, so each bone's directions relax at about one rate; the
+update stays explicit (a = M⁻¹F, one small inverse per bone).
+
+K is the Gauss–Newton tangent of the force kernels: each overclosed contact
+sample κ·JJᵀ with J = [n; r×n] and κ = p′(ε)·A/h; each taut fibre, and each RSC
+connector at its attached ends, dT/dl·uuᵀ + T/L·(I − uuᵀ) between its ends; the
+membrane's free nodes' contact with the scaphoid k·nnᵀ. No geometric terms of
+the moments. Coordinates per bone: shift (mm, world) then rotation (rad, world),
+as `equilibrium.tangent_stiffness`.
+
+Each block's eigenvalues, in the metric of the bone's physical (scaled) mass and
+inertia, are floored at `block_floor` × the largest of any bone (a torn ligament
+or an open contact leaves a direction with no stiffness), and the blocks are
+scaled together so that the stiffest mode of the whole tangent, the couplings
+between bones included, runs at dt·ω = `block_courant`.
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+
+import numpy as np
+from numba import njit
+
+from wrist_env.model import CAPITATE, LUNATE, SCAPHOID
+from wrist_env.solver.arrays import LOADED
+from wrist_env.solver.contact import law_slope, sdf_lookup_scalar
+from wrist_env.solver.forces import pair_transform, sample_lookup, sample_lookup_smooth, to_local, to_world
+from wrist_env.solver.ligaments import blankevoort_force, blankevoort_slope
+
+N_DOF = 15
+"""Unknowns of the tangent: scaphoid 0–5, lunate 6–11 (shift, rotation), the loaded capitate's shift 12–14."""
+POWER_ITERATIONS = 30
+"""Power iterations for the whole tangent's stiffest mode (a Rayleigh quotient: converged to < 1 %)."""
+
+Metric = namedtuple("Metric", ["stiffness", "mass", "inverse", "block", "coupling"])
+"""The block mass: the free bones' tangent stiffness (15, 15) (N/mm, N/rad, N·mm/rad); the mass
+(t, t·mm, t·mm²) and its inverse (15, 15), block diagonal; scratch: a 6×6 block, a 3×3 coupling (N/mm)."""
+
+
+@njit(cache=True)
+def metric():
+    """A zeroed `Metric`."""
+    return Metric(
+        np.zeros((N_DOF, N_DOF)), np.zeros((N_DOF, N_DOF)), np.zeros((N_DOF, N_DOF)), np.zeros((6, 6)), np.zeros((3, 3))
+    )
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def dof(st, b):
+    """(first unknown, number of unknowns) of body b; (-1, 0) if it is not free."""
+    if b == SCAPHOID:
+        return 0, 6
+    if b == LUNATE:
+        return 6, 6
+    if b == CAPITATE and st.driver == LOADED:
+        return 12, 3
+    return -1, 0
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _cross(r, p, q):
+    """[r]× entry (p, q)."""
+    if p == q:
+        return 0.0
+    if p == 0:
+        return -r[2] if q == 1 else r[1]
+    if p == 1:
+        return r[2] if q == 0 else -r[0]
+    return -r[1] if q == 0 else r[0]
+
+
+@njit(cache=True, error_model="numpy")
+def _add_levered(K, st, a, ra, b, rb, k, sign):
+    """K[a, b] += sign · [I; [ra]×] k [I; [rb]×]ᵀ for bodies a, b (skipped unless both are free): a 3×3
+    point stiffness k (N/mm) seen through the levers ra, rb (mm, world) of its ends."""
+    ia, na = dof(st, a)
+    ib, nb = dof(st, b)
+    if ia < 0 or ib < 0:
+        return
+    for i in range(na):
+        for j in range(nb):
+            acc = 0.0
+            for p in range(3):
+                gi = (1.0 if i == p else 0.0) if i < 3 else _cross(ra, i - 3, p)
+                if gi == 0.0:
+                    continue
+                for q in range(3):
+                    gj = (1.0 if j == q else 0.0) if j < 3 else _cross(rb, j - 3, q)
+                    acc += gi * k[p, q] * gj
+            K[ia + i, ib + j] += sign * acc
+
+
+@njit(cache=True, error_model="numpy")
+def add_point(K, st, a, ra, b, rb, k):
+    """A point coupling k (3×3, N/mm) between body a at lever ra and body b at lever rb (mm, world, from
+    each centre of mass): GₐᵀkGₐ and G_bᵀkG_b on the diagonal, −GₐᵀkG_b and its transpose off it."""
+    _add_levered(K, st, a, ra, a, ra, k, 1.0)
+    _add_levered(K, st, b, rb, b, rb, k, 1.0)
+    _add_levered(K, st, a, ra, b, rb, k, -1.0)
+    _add_levered(K, st, b, rb, a, ra, k, -1.0)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _axial(k, ux, uy, uz, along, across):
+    """k ← along·uuᵀ + across·(I − uuᵀ) (N/mm)."""
+    u = (ux, uy, uz)
+    for p in range(3):
+        for q in range(3):
+            k[p, q] = (along - across) * u[p] * u[q] + (across if p == q else 0.0)
+
+
+@njit(cache=True, error_model="numpy")
+def _add_pair(K, st, a, b, R, x, S):
+    """A contact pair's summed κJJᵀ S (6×6, body b's neutral frame about its centre) into K: rotated to
+    world for b, shifted by d = x_b − x_a for a (J_a = [n; (r_b + d)×n]), −J_aJ_bᵀ between them."""
+    ia, na = dof(st, a)
+    ib, nb = dof(st, b)
+    W = np.zeros((6, 6))  # T S Tᵀ, T = blockdiag(R_b, R_b)
+    for i in range(6):
+        for j in range(6):
+            acc = 0.0
+            for p in range(3):
+                rip = R[b, i % 3, p]
+                for q in range(3):
+                    acc += rip * S[3 * (i // 3) + p, 3 * (j // 3) + q] * R[b, j % 3, q]
+            W[i, j] = acc
+    d = (x[b, 0] - x[a, 0], x[b, 1] - x[a, 1], x[b, 2] - x[a, 2])
+    L = np.eye(6)  # J_a = L J_b
+    for p in range(3):
+        for q in range(3):
+            L[3 + p, q] = _cross(d, p, q)
+    LW = L @ W
+    if ib >= 0:
+        for i in range(nb):
+            for j in range(nb):
+                K[ib + i, ib + j] += W[i, j]
+    if ia >= 0:
+        LWL = LW @ L.T
+        for i in range(na):
+            for j in range(na):
+                K[ia + i, ia + j] += LWL[i, j]
+    if ia >= 0 and ib >= 0:
+        for i in range(na):
+            for j in range(nb):
+                K[ia + i, ib + j] -= LW[i, j]
+                K[ib + j, ia + i] -= LW[i, j]
+
+
+@njit(cache=True, error_model="numpy")
+def tangent(R, x, nodes, com0, grids, law, fib, stiffness, mem, st, active, n_active, m):
+    """Assemble m.stiffness, the Gauss–Newton tangent at the state (R, x, nodes) over the active contact
+    samples (as the last force evaluation left them)."""
+    K, S, k = m.stiffness, m.block, m.coupling
+    K[:] = 0.0
+    for p in range(grids.pair_bones.shape[0]):
+        a, b = grids.pair_bones[p, 0], grids.pair_bones[p, 1]
+        if dof(st, a)[0] < 0 and dof(st, b)[0] < 0:
+            continue
+        M = pair_transform(R, x, com0, a, b)
+        S[:] = 0.0
+        start = grids.sample_offsets[p]
+        for j in range(n_active[p]):
+            s = active[start + j]
+            if st.smooth_normals:
+                d, gx, gy, gz, qx, qy, qz = sample_lookup_smooth(grids, b, M, s)
+            else:
+                d, gx, gy, gz, qx, qy, qz = sample_lookup(grids, b, M, s)
+            gn = np.sqrt(gx * gx + gy * gy + gz * gz)
+            if d >= 0.0 or gn < 1e-12:
+                continue
+            h = grids.thickness[s]
+            kappa = law_slope(law, -d / h) * grids.area[s] / h
+            nx, ny, nz = gx / gn, gy / gn, gz / gn
+            cx, cy, cz = qx - com0[b, 0], qy - com0[b, 1], qz - com0[b, 2]
+            J = (nx, ny, nz, cy * nz - cz * ny, cz * nx - cx * nz, cx * ny - cy * nx)
+            for u in range(6):
+                ku = kappa * J[u]
+                for v in range(u, 6):
+                    S[u, v] += ku * J[v]
+        for u in range(6):
+            for v in range(u):
+                S[u, v] = S[v, u]
+        _add_pair(K, st, a, b, R, x, S)
+    ra = np.zeros(3)
+    rb = np.zeros(3)
+    o, ins = fib.origin, fib.insertion
+    for i in range(stiffness.f_l0.shape[0]):
+        if stiffness.f_K[i] == 0.0:
+            continue
+        a, b = fib.bones[i, 0], fib.bones[i, 1]
+        pa = to_world(R, x, com0, a, o[i, 0], o[i, 1], o[i, 2])
+        pb = to_world(R, x, com0, b, ins[i, 0], ins[i, 1], ins[i, 2])
+        _element(K, st, k, a, pa, b, pb, x, stiffness.f_K[i], stiffness.f_l0[i], ra, rb)
+    for c in range(stiffness.m_l0.shape[0]):
+        i, j = mem.connectors[c, 0], mem.connectors[c, 1]
+        a, b = mem.bone[i], mem.bone[j]
+        if stiffness.m_K[c] == 0.0 or (a < 0 and b < 0):
+            continue
+        pa = (nodes[i, 0], nodes[i, 1], nodes[i, 2])
+        pb = (nodes[j, 0], nodes[j, 1], nodes[j, 2])
+        _element(K, st, k, a, pa, b, pb, x, stiffness.m_K[c], stiffness.m_l0[c], ra, rb)
+    _membrane_contact(K, st, k, R, x, com0, mem, nodes, ra)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _element(K, st, k, a, pa, b, pb, x, scale, l0, ra, rb):
+    """A Blankevoort element of scale `scale` (N) and zero-load length l0 (mm) between world points pa on
+    body a and pb on body b (a body < 0: a membrane's free node, not an unknown); nothing if slack."""
+    dx, dy, dz = pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]
+    length = np.sqrt(dx * dx + dy * dy + dz * dz)
+    strain = length / l0 - 1.0
+    if strain <= 0.0:
+        return
+    along = blankevoort_slope(scale, strain) / l0
+    _axial(k, dx / length, dy / length, dz / length, along, blankevoort_force(scale, strain) / length)
+    for e in range(3):
+        ra[e] = pa[e] - x[a, e] if a >= 0 else 0.0
+        rb[e] = pb[e] - x[b, e] if b >= 0 else 0.0
+    add_point(K, st, max(a, -1), ra, max(b, -1), rb, k)
+
+
+@njit(cache=True, error_model="numpy")
+def _membrane_contact(K, st, k, R, x, com0, mem, nodes, r):
+    """The membrane's free nodes pressing on the scaphoid: membrane_contact_stiffness (N/mm) along the normal."""
+    s = mem.scaphoid
+    for i in range(nodes.shape[0]):
+        if mem.bone[i] >= 0:
+            continue
+        qx, qy, qz = to_local(R, x, com0, s, nodes[i, 0], nodes[i, 1], nodes[i, 2])
+        d, gx, gy, gz = sdf_lookup_scalar(
+            mem.grid_values, mem.grid_offset, mem.grid_shape, mem.grid_origin, mem.grid_spacing, qx, qy, qz
+        )
+        gn = np.sqrt(gx * gx + gy * gy + gz * gz)
+        if d >= 0.0 or gn < 1e-12:
+            continue
+        nx = (R[s, 0, 0] * gx + R[s, 0, 1] * gy + R[s, 0, 2] * gz) / gn
+        ny = (R[s, 1, 0] * gx + R[s, 1, 1] * gy + R[s, 1, 2] * gz) / gn
+        nz = (R[s, 2, 0] * gx + R[s, 2, 1] * gy + R[s, 2, 2] * gz) / gn
+        _axial(k, nx, ny, nz, st.membrane_contact_stiffness, 0.0)
+        for e in range(3):
+            r[e] = nodes[i, e] - x[s, e]
+        _add_levered(K, st, s, r, s, r, k, 1.0)
+
+
+@njit(cache=True, error_model="numpy")
+def _spd_inverse(A, i0, n, out):
+    """out[i0:i0+n, i0:i0+n] ← the inverse of A's symmetric positive-definite block there (Cholesky);
+    False if the block is not positive definite."""
+    L = np.zeros((6, 6))
+    for i in range(n):
+        for j in range(i + 1):
+            acc = A[i0 + i, i0 + j]
+            for k in range(j):
+                acc -= L[i, k] * L[j, k]
+            if i == j:
+                if not acc > 0.0:
+                    return False
+                L[i, i] = np.sqrt(acc)
+            else:
+                L[i, j] = acc / L[j, j]
+    Linv = np.zeros((6, 6))
+    for i in range(n):
+        Linv[i, i] = 1.0 / L[i, i]
+        for j in range(i):
+            acc = 0.0
+            for k in range(j, i):
+                acc -= L[i, k] * Linv[k, j]
+            Linv[i, j] = acc / L[i, i]
+    for i in range(n):
+        for j in range(n):
+            acc = 0.0
+            for k in range(max(i, j), n):
+                acc += Linv[k, i] * Linv[k, j]
+            out[i0 + i, i0 + j] = acc
+    return True
+
+
+@njit(cache=True, error_model="numpy")
+def _top(K, M, Minv, lo, hi):
+    """Largest λ of K v = λ M v over the unknowns lo:hi (K symmetric positive semi-definite, M symmetric
+    positive definite, Minv its inverse) by power iteration on Minv·K; the Rayleigh quotient vᵀKv / vᵀMv."""
+    Kb = np.ascontiguousarray(K[lo:hi, lo:hi])
+    Mb = np.ascontiguousarray(M[lo:hi, lo:hi])
+    Ib = np.ascontiguousarray(Minv[lo:hi, lo:hi])
+    v = np.ones(hi - lo)
+    top = 0.0
+    for _ in range(POWER_ITERATIONS):
+        Kv = Kb @ v
+        vMv = v @ (Mb @ v)
+        if not vMv > 0.0:
+            return 0.0
+        top = (v @ Kv) / vMv
+        u = Ib @ Kv
+        norm = np.sqrt(u @ u)
+        if norm == 0.0:
+            return 0.0
+        v = u / norm
+    return top
+
+
+@njit(cache=True, error_model="numpy")
+def block_mass(R, bod, st, m):
+    """Fill m.mass and m.inverse from m.stiffness (`tangent`): each free bone's block plus st.block_floor ×
+    λ_top × its physical mass (λ_top: the largest K v = λ M0 v of any bone's block, M0 its physical scaled
+    mass and inertia), all blocks scaled so that the whole tangent's stiffest mode runs at dt·ω =
+    st.block_courant. Without stiffness (nothing in contact, every fibre slack) the physical mass; a
+    state gone non-finite keeps the last mass."""
+    if not (np.all(np.isfinite(m.stiffness)) and np.all(np.isfinite(R))):
+        return
+    K = m.stiffness
+    M0 = np.zeros((N_DOF, N_DOF))
+    M0inv = np.zeros((N_DOF, N_DOF))
+    n = 0
+    for b in (SCAPHOID, LUNATE, CAPITATE):
+        i0, nb = dof(st, b)
+        if i0 < 0:
+            continue
+        n = i0 + nb
+        for k in range(3):
+            M0[i0 + k, i0 + k] = bod.mass[b]
+            M0inv[i0 + k, i0 + k] = bod.inv_mass[b]
+        if nb == 6:
+            Rb = np.ascontiguousarray(R[b])
+            M0[i0 + 3 : i0 + 6, i0 + 3 : i0 + 6] = Rb @ bod.inertia[b] @ Rb.T
+            M0inv[i0 + 3 : i0 + 6, i0 + 3 : i0 + 6] = Rb @ bod.inv_inertia[b] @ Rb.T
+    top = 0.0
+    for b in (SCAPHOID, LUNATE, CAPITATE):
+        i0, nb = dof(st, b)
+        if i0 >= 0:
+            top = max(top, _top(K, M0, M0inv, i0, i0 + nb))
+    D = m.mass
+    Dinv = m.inverse
+    D[:] = 0.0
+    Dinv[:] = 0.0
+    ok = top > 0.0
+    for b in (SCAPHOID, LUNATE, CAPITATE):
+        i0, nb = dof(st, b)
+        if i0 < 0:
+            continue
+        for i in range(nb):
+            for j in range(nb):
+                D[i0 + i, i0 + j] = (
+                    (0.5 * (K[i0 + i, i0 + j] + K[i0 + j, i0 + i]) + st.block_floor * top * M0[i0 + i, i0 + j])
+                    if ok
+                    else M0[i0 + i, i0 + j]
+                )
+        if not _spd_inverse(D, i0, nb, Dinv):
+            ok = False
+    if not ok:  # no stiffness (or a block not positive definite): the physical mass
+        D[:] = M0
+        Dinv[:] = M0inv
+        return
+    scale = _top(K, D, Dinv, 0, n) * (st.dt / st.block_courant) ** 2
+    if not scale > 0.0:
+        scale = 1.0
+    D *= scale
+    Dinv /= scale
