@@ -611,3 +611,17 @@ def test_two_folders_with_one_name_are_refused(folder, tmp_path, monkeypatch):
     assert registry.add_folder(folder) == "P7" and registry.add_folder(folder) == "P7"  # the same folder again
     with raises(ParticipantError, other / TOML, f"name 'P7' is taken by the folder {folder}"):
         registry.add_folder(other)
+
+
+@pytest.mark.parametrize(
+    "first, second, value",
+    [("scaphoid", "lunate", "ulnar of the lunate"), ("lunate", "capitate", "proximal of the lunate")],
+)
+def test_swapped_bones_are_named_before_the_build(folder, first, second, value):
+    """Two carpal files listed under each other's names: refused when the folder is read, naming both
+    entries (not, after a build, as implausible joint spaces with a hint about `side`)."""
+    edit_toml(folder, f'{first} = "bones/{first}.stl"', f'{first} = "bones/SWAP.stl"')
+    edit_toml(folder, f'{second} = "bones/{second}.stl"', f'{second} = "bones/{first}.stl"')
+    edit_toml(folder, f'{first} = "bones/SWAP.stl"', f'{first} = "bones/{second}.stl"')
+    with raises(ParticipantError, folder / "participant.toml", f"look swapped.*{value}"):
+        load_participant_folder(folder)

@@ -135,6 +135,7 @@ def load_participant_folder(path: str | Path) -> ParticipantSource:
     if absent or extra:
         raise ParticipantError(f"{toml_path}: [bones] must list exactly {BONES}, but {absent=} and {extra=}.")
     bones = {b: read_bone_mesh(_listed_file(folder, bone_table[b], f"bones.{b}", toml_path), b) for b in BONES}
+    _check_arrangement(bones, toml_path)
 
     trial_table = _check_table(config, "trials", toml_path)
     trials = {}
@@ -403,6 +404,29 @@ def _closed_part(mesh: trimesh.Trimesh, bone: str, source: str) -> trimesh.Trime
             f"(it has {edges}); close the radius (open parts such as a cut shaft may stay open)."
         )
     return part
+
+
+def _check_arrangement(bones: dict, toml_path: Path) -> None:
+    """ParticipantError naming both entries if two carpals look swapped: the scaphoid must lie radial
+    of the lunate (along the ulna → radius direction of the files' own centroids, so either side
+    passes) and the capitate distal of the lunate (RCS −y)."""
+    centre = {b: np.asarray(v, float).mean(axis=0) for b, (v, _) in bones.items()}
+    radial = centre["radius"] - centre["ulna"]
+    radial[1] = 0.0  # across the forearm: the shafts' lengths do not count
+    radial /= max(float(np.linalg.norm(radial)), 1e-12)
+    offset = float((centre["scaphoid"] - centre["lunate"]) @ radial)
+    if offset < 0.0:
+        raise ParticipantError(
+            f"{toml_path}: bones.scaphoid and bones.lunate look swapped: the scaphoid's centroid is "
+            f"{-offset:.1f} mm ulnar of the lunate's, and a scaphoid lies radial of it (from the radius and "
+            f"ulna as listed); check [bones]."
+        )
+    proximal = float(centre["capitate"][1] - centre["lunate"][1])
+    if proximal > 0.0:
+        raise ParticipantError(
+            f"{toml_path}: bones.capitate and bones.lunate look swapped: the capitate's centroid is "
+            f"{proximal:.1f} mm proximal of the lunate's (RCS +y), and a capitate lies distal of it; check [bones]."
+        )
 
 
 def _check_meta(config: dict, toml_path: Path) -> dict:
