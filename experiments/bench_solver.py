@@ -1,12 +1,16 @@
 """Benchmark: the explicit solver's speed on a built participant (after compilation).
 
-Prints, for P1 (or the participant named on the command line):
-- milliseconds per simulation on one core: the idealized flexion–extension
-  sweep (17 frames, ±40°) with the population design, and the participant's
-  15-frame calibration trial (the capitate's 6 DOF prescribed);
+Prints, for P1 (or the participant named on the command line), for two solvers
+side by side in one run — today's defaults and the block mass
+(`SolverSettings().preconditioned()`) — and their ratio:
+- steps, µs per step and ms per simulation on one core: the idealized
+  flexion–extension sweep (17 frames, ±40°) with the population design, and
+  the participant's 15-frame calibration trial (the capitate's 6 DOF prescribed);
 - simulations per second batched (`simulate_batch`, Numba prange) on all
   cores, for Monte Carlo designs (Table 2 normals truncated at ±3 SD, each
-  injurable ligament torn with probability 0.3);
+  injurable ligament torn with probability 0.3), their mean steps and share ok;
+- what that makes of the Monte Carlo study (2 × 12,500 sweeps) and the full
+  default benchmark's 49,500 trial evaluations (simulation time only);
 - efficiency: the time of a bare loop doing only the signed-distance
   look-ups of one step (the samples within the active band at the settled
   neutral pose) over the time of a full step (which also refills the active
@@ -29,10 +33,12 @@ from wrist_env import design
 from wrist_env.participants import registry
 from wrist_env.participants.registry import load_model
 from wrist_env.solver import arrays
+from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.forces import pair_transform, rebuild_active, sample_lookup, sample_lookup_smooth
 from wrist_env.solver.simulate import experimental, idealized, simulate, simulate_batch
 
-PREPRINT_SECONDS = 45.0
+PREPRINT_SECONDS = 45.0  # one Abaqus simulation
+PREPRINT_STUDY_DAYS = 13  # the preprint's Monte Carlo study
 
 
 def median_seconds(fn, repeats: int = 9) -> float:
@@ -104,48 +110,71 @@ def efficiency(model, steps_per_sim: float, seconds_per_sim: float) -> tuple[flo
     return per_step * 1e6, seconds_per_sim / steps_per_sim * 1e6, int(n_active.sum())
 
 
+SOLVERS = {"default": SolverSettings(), "block mass": SolverSettings().preconditioned()}
+"""The two solvers compared side by side: today's defaults and the block mass (`preconditioner`)."""
+MONTE_CARLO_RUNS = 2 * 12_500  # the preprint's study: 2 participants x 12,500 successful runs
+BENCHMARK_EVALUATIONS = 49_500  # the full default benchmark's calibration-trial simulations (leaderboards/runs.csv)
+
+
+def one_core(model, driver, settings) -> tuple[float, int]:
+    """(median seconds, steps) of the population design's run."""
+    pop = design.population()
+    result = simulate(model, pop, driver, settings)
+    if not result.ok:
+        raise SystemExit(f"the population design's run failed ({result.message}); nothing to time")
+    return median_seconds(lambda: simulate(model, pop, driver, settings)), int(result.steps.sum())
+
+
+def batched(model, driver, settings, designs) -> tuple[float, float, float]:
+    """(simulations per second on all cores, share ok, mean steps) of the Monte Carlo designs."""
+    simulate_batch(model, designs[:2], driver, settings)
+    start = time.perf_counter()
+    results = simulate_batch(model, designs, driver, settings)
+    rate = len(designs) / (time.perf_counter() - start)
+    ok = [r for r in results if r.ok]
+    return rate, len(ok) / len(results), float(np.mean([r.steps.sum() for r in ok]))
+
+
 def main(name: str, params=None, load_n=None) -> None:
     model = load_model(name, params)
-    pop = design.population()
-    sweep = idealized(model) if load_n is None else idealized(model, load_n=load_n)
-    trial = trial_driver(name, model)
-    rows = []
-    for label, driver in (("idealized sweep, 17 frames", sweep), ("15-frame trial", trial)):
-        seconds = median_seconds(lambda: simulate(model, pop, driver))
-        result = simulate(model, pop, driver)
-        steps = int(result.steps.sum())
-        if not result.ok:
-            raise SystemExit(f"{name}: the population design's {label} failed ({result.message}); nothing to time")
-        rows.append((label, seconds, steps))
-        print(
-            f"{label:<28} {seconds * 1e3:7.1f} ms on one core  ({steps} steps, {seconds / steps * 1e6:.1f} µs/step, "
-            f"{PREPRINT_SECONDS / seconds:,.0f}× faster than 45 s)"
-        )
+    motions = {
+        "idealized sweep, 17 frames": idealized(model) if load_n is None else idealized(model, load_n=load_n),
+        "15-frame trial": trial_driver(name, model),
+    }
     designs = monte_carlo_designs(64)
-    for label, driver in (("idealized sweep, 17 frames", sweep), ("15-frame trial", trial)):
-        simulate_batch(model, designs[:2], driver)
-        start = time.perf_counter()
-        results = simulate_batch(model, designs, driver)
-        rate = len(designs) / (time.perf_counter() - start)
-        ok = sum(r.ok for r in results)
+    rows = {}
+    for motion, driver in motions.items():
+        for solver, settings in SOLVERS.items():  # one after the other, each motion: the same machine state
+            seconds, steps = one_core(model, driver, settings)
+            rate, ok, mean_steps = batched(model, driver, settings, designs)
+            rows[motion, solver] = (seconds, steps, rate, ok, mean_steps)
+    print(f"| {name}, population design, one core | " + " | ".join(SOLVERS) + " | ratio |")
+    print("|---|" + "---|" * (len(SOLVERS) + 1))
+    for motion in motions:
+        (s0, n0, r0, ok0, m0), (s1, n1, r1, ok1, m1) = (rows[motion, solver] for solver in SOLVERS)
+        print(f"| {motion}: steps | {n0:,} | {n1:,} | {n0 / n1:.2f}× fewer |")
+        print(f"| {motion}: µs per step | {s0 / n0 * 1e6:.1f} | {s1 / n1 * 1e6:.1f} | {s1 / n1 / (s0 / n0):.2f}× |")
+        print(f"| {motion}: ms per simulation | {s0 * 1e3:.1f} | {s1 * 1e3:.1f} | {s0 / s1:.2f}× faster |")
         print(
-            f"{label:<28} {rate:7.1f} simulations/s batched on {get_num_threads()} threads "
-            f"({ok}/{len(results)} Monte Carlo designs ok)"
+            f"| {motion}: 64 Monte Carlo designs batched on {get_num_threads()} cores, simulations/s "
+            f"(mean steps, share ok) | {r0:.1f} ({m0:,.0f}, {ok0:.0%}) | {r1:.1f} ({m1:,.0f}, {ok1:.0%}) | {r1 / r0:.2f}× |"
         )
-        rows.append((label + " batched", rate, ok))
-    bare, full, n_active = efficiency(model, rows[0][2], rows[0][1])
+    sweep, trial = motions
+    for solver in SOLVERS:
+        mc = MONTE_CARLO_RUNS / rows[sweep, solver][3] / rows[sweep, solver][2] / 60
+        bench = BENCHMARK_EVALUATIONS / rows[trial, solver][2] / 60
+        print(
+            f"{solver}: the Monte Carlo study's {MONTE_CARLO_RUNS:,} sweeps simulate in ~{mc:.1f} min "
+            f"({PREPRINT_STUDY_DAYS * 24 * 60 / mc:,.0f}× faster than its {PREPRINT_STUDY_DAYS} days); the benchmark's "
+            f"{BENCHMARK_EVALUATIONS:,} trial evaluations in ~{bench:.1f} min (simulation only, at these rates)"
+        )
+    bare, full, n_active = efficiency(model, rows[sweep, "default"][1], rows[sweep, "default"][0])
     print(
-        f"efficiency: bare look-ups {bare:.1f} µs of a {full:.1f} µs step ({n_active} active samples) = {bare / full:.0%}"
+        f"efficiency (default): bare look-ups {bare:.1f} µs of a {full:.1f} µs step ({n_active} active samples) = {bare / full:.0%}"
     )
-    print()
-    print("| measure | P1 |")
-    print("|---|---|")
-    print(f"| idealized sweep (17 frames), one core | {rows[0][1] * 1e3:.0f} ms |")
-    print(f"| 15-frame trial, one core | {rows[1][1] * 1e3:.0f} ms |")
-    print(f"| Monte Carlo sweeps batched, {get_num_threads()} cores | {rows[2][1]:.0f} simulations/s |")
-    print(f"| 15-frame trials batched, {get_num_threads()} cores | {rows[3][1]:.0f} simulations/s |")
-    print(f"| look-ups / full step | {bare:.1f} / {full:.1f} µs ({bare / full:.0%}) |")
-    print(f"| vs the preprint's 45 s per simulation | {PREPRINT_SECONDS / rows[1][1]:,.0f}× faster |")
+    print(
+        f"vs the preprint's 45 s per simulation: {PREPRINT_SECONDS / rows[trial, 'block mass'][0]:,.0f}× faster (trial, block mass)"
+    )
 
 
 if __name__ == "__main__":

@@ -18,7 +18,7 @@ are also polished by the quasi-static Newton reference
 (`wrist_env.solver.equilibrium.nearest`): the distance from each explicit
 answer to the equilibrium nearest it, and the net force left there.
 
-Run: `python experiments/solver_accuracy.py [P1 P2 P3] [--designs 100] [--newton 3] [--set dt_s=9e-5 ...]`
+Run: `python experiments/solver_accuracy.py [P1 P2 P3] [--designs 100] [--newton 3] [--preconditioned] [--set dt_s=9e-5 ...]`
 (--set changes the settings under test; the reference stays the default's, with the same
 `smooth_normals`, which changes the answer, not only the path to it).
 References are cached in runs/solver_accuracy/ under a hash of their settings.
@@ -112,7 +112,18 @@ def within(a: np.ndarray, b: np.ndarray, com: np.ndarray) -> bool:
     return d[0] <= TOLERANCE[0] and d[1] <= TOLERANCE[1]
 
 
-def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int) -> None:
+def mcnemar(a: list[bool], b: list[bool]) -> str:
+    """The paired comparison of two solvers' hits on the same designs: the discordant counts and the
+    exact McNemar p (two-sided binomial test of the discordant pairs)."""
+    from scipy.stats import binomtest
+
+    only_a = sum(x and not y for x, y in zip(a, b))
+    only_b = sum(y and not x for x, y in zip(a, b))
+    p = binomtest(only_a, only_a + only_b).pvalue if only_a + only_b else 1.0
+    return f"within for the defaults only {only_a}, for the settings under test only {only_b} (McNemar p = {p:.2g})"
+
+
+def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int, paired: bool = False) -> None:
     model = load_model(name)
     designs = [design.population()] + monte_carlo_designs(n_designs)
     ref = reference(name, model, designs, replace(SolverSettings(), smooth_normals=settings.smooth_normals))
@@ -144,6 +155,19 @@ def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int) -
             f"  path-independent designs (reference, quarter step and slow ramps agree): {independent.sum()} of "
             f"{len(independent)}; of them within 0.1 mm and 0.5°: {100 * np.mean(matched):.0f} %"
         )
+        if paired:  # the defaults on the same designs
+            defaults = simulate_batch(
+                model, designs, driver, replace(SolverSettings(), smooth_normals=settings.smooth_normals)
+            )
+            hits = [
+                defaults[i].ok and within(defaults[i].poses, ref[motion][i], model.com)
+                for i in np.flatnonzero(independent)
+            ]
+            d_steps = np.mean([r.steps.sum() for r in defaults])
+            print(
+                f"  the defaults: {d_steps:.0f} mean steps ({d_steps / steps.mean():.2f}× the settings under test); "
+                f"path-independent within {100 * np.mean(hits):.0f} %; {mcnemar(hits, matched)}"
+            )
         for i in tqdm(range(min(n_newton, len(runs))), desc=f"{name} {motion} Newton", leave=False):
             if not runs[i].ok:
                 continue
@@ -162,12 +186,17 @@ def main(argv=None) -> None:
     parser.add_argument("--designs", type=int, default=100, help="Monte Carlo designs besides the population's")
     parser.add_argument("--newton", type=int, default=3, help="designs polished by the Newton reference")
     parser.add_argument("--set", nargs="*", default=[], metavar="FIELD=VALUE", help="settings under test")
+    parser.add_argument(
+        "--preconditioned", action="store_true", help="test SolverSettings().preconditioned() (the block mass)"
+    )
     args = parser.parse_args(argv)
     changes = {k: ast.literal_eval(v) for k, v in (item.split("=", 1) for item in args.set)}
-    settings = replace(SolverSettings(), **changes)
-    print(f"settings under test: {changes or 'the defaults'}; reference: {reference_settings(SolverSettings())}")
+    base = SolverSettings().preconditioned() if args.preconditioned else SolverSettings()
+    settings = replace(base, **changes)
+    under = ("the block mass" if args.preconditioned else "the defaults") + (f" with {changes}" if changes else "")
+    print(f"settings under test: {under}; reference: {reference_settings(SolverSettings())}")
     for name in args.participants:
-        report(name, args.designs, settings, args.newton)
+        report(name, args.designs, settings, args.newton, paired=args.preconditioned or bool(changes))
 
 
 if __name__ == "__main__":

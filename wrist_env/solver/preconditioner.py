@@ -42,16 +42,23 @@ N_DOF = 15
 POWER_ITERATIONS = 30
 """Power iterations for the whole tangent's stiffest mode (a Rayleigh quotient: converged to < 1 %)."""
 
-Metric = namedtuple("Metric", ["stiffness", "mass", "inverse", "block", "coupling"])
+Metric = namedtuple("Metric", ["stiffness", "mass", "inverse", "block", "coupling", "lever", "product"])
 """The block mass: the free bones' tangent stiffness (15, 15) (N/mm, N/rad, N·mm/rad); the mass
-(t, t·mm, t·mm²) and its inverse (15, 15), block diagonal; scratch: a 6×6 block, a 3×3 coupling (N/mm)."""
+(t, t·mm, t·mm²) and its inverse (15, 15), block diagonal; scratch: a 6×6 block, a 3×3 coupling (N/mm),
+two levers [I; [r]×] (2, 6, 3) and a product (6, 3)."""
 
 
 @njit(cache=True)
 def metric():
     """A zeroed `Metric`."""
     return Metric(
-        np.zeros((N_DOF, N_DOF)), np.zeros((N_DOF, N_DOF)), np.zeros((N_DOF, N_DOF)), np.zeros((6, 6)), np.zeros((3, 3))
+        np.zeros((N_DOF, N_DOF)),
+        np.zeros((N_DOF, N_DOF)),
+        np.zeros((N_DOF, N_DOF)),
+        np.zeros((6, 6)),
+        np.zeros((3, 3)),
+        np.zeros((2, 6, 3)),
+        np.zeros((6, 3)),
     )
 
 
@@ -79,35 +86,44 @@ def _cross(r, p, q):
     return -r[1] if q == 0 else r[0]
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _lever(G, r):
+    """G (6, 3) ← [I; [r]×]: a force at lever r (mm) as the force and moment on a body."""
+    G[:] = 0.0
+    G[0, 0] = G[1, 1] = G[2, 2] = 1.0
+    G[3, 1], G[3, 2] = -r[2], r[1]
+    G[4, 0], G[4, 2] = r[2], -r[0]
+    G[5, 0], G[5, 1] = -r[1], r[0]
+
+
 @njit(cache=True, error_model="numpy")
-def _add_levered(K, st, a, ra, b, rb, k, sign):
-    """K[a, b] += sign · [I; [ra]×] k [I; [rb]×]ᵀ for bodies a, b (skipped unless both are free): a 3×3
-    point stiffness k (N/mm) seen through the levers ra, rb (mm, world) of its ends."""
+def _add_block(K, i0, ni, Ga, k, j0, nj, Gb, H, sign):
+    """K[i0:i0+ni, j0:j0+nj] += sign · Ga k Gbᵀ (levers (6, 3), k (3, 3)); H (6, 3) scratch."""
+    for i in range(ni):
+        for q in range(3):
+            H[i, q] = Ga[i, 0] * k[0, q] + Ga[i, 1] * k[1, q] + Ga[i, 2] * k[2, q]
+    for i in range(ni):
+        for j in range(nj):
+            K[i0 + i, j0 + j] += sign * (H[i, 0] * Gb[j, 0] + H[i, 1] * Gb[j, 1] + H[i, 2] * Gb[j, 2])
+
+
+@njit(cache=True, error_model="numpy")
+def add_point(K, st, a, ra, b, rb, m):
+    """A point coupling m.coupling (3×3, N/mm) between body a at lever ra and body b at lever rb (mm,
+    world, from each centre of mass): GₐᵀkGₐ and G_bᵀkG_b on the diagonal, −GₐᵀkG_b and its transpose
+    off it (G = [I, −[r]×]: a body's move at the point)."""
     ia, na = dof(st, a)
     ib, nb = dof(st, b)
-    if ia < 0 or ib < 0:
-        return
-    for i in range(na):
-        for j in range(nb):
-            acc = 0.0
-            for p in range(3):
-                gi = (1.0 if i == p else 0.0) if i < 3 else _cross(ra, i - 3, p)
-                if gi == 0.0:
-                    continue
-                for q in range(3):
-                    gj = (1.0 if j == q else 0.0) if j < 3 else _cross(rb, j - 3, q)
-                    acc += gi * k[p, q] * gj
-            K[ia + i, ib + j] += sign * acc
-
-
-@njit(cache=True, error_model="numpy")
-def add_point(K, st, a, ra, b, rb, k):
-    """A point coupling k (3×3, N/mm) between body a at lever ra and body b at lever rb (mm, world, from
-    each centre of mass): GₐᵀkGₐ and G_bᵀkG_b on the diagonal, −GₐᵀkG_b and its transpose off it."""
-    _add_levered(K, st, a, ra, a, ra, k, 1.0)
-    _add_levered(K, st, b, rb, b, rb, k, 1.0)
-    _add_levered(K, st, a, ra, b, rb, k, -1.0)
-    _add_levered(K, st, b, rb, a, ra, k, -1.0)
+    G, H, k = m.lever, m.product, m.coupling
+    _lever(G[0], ra)
+    _lever(G[1], rb)
+    if ia >= 0:
+        _add_block(K, ia, na, G[0], k, ia, na, G[0], H, 1.0)
+    if ib >= 0:
+        _add_block(K, ib, nb, G[1], k, ib, nb, G[1], H, 1.0)
+    if ia >= 0 and ib >= 0:
+        _add_block(K, ia, na, G[0], k, ib, nb, G[1], H, -1.0)
+        _add_block(K, ib, nb, G[1], k, ia, na, G[0], H, -1.0)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -139,13 +155,25 @@ def _add_pair(K, st, a, b, R, x, S):
     for p in range(3):
         for q in range(3):
             L[3 + p, q] = _cross(d, p, q)
-    LW = L @ W
+    LW = np.zeros((6, 6))
+    LWL = np.zeros((6, 6))
+    for i in range(6):
+        for j in range(6):
+            acc = 0.0
+            for q in range(6):
+                acc += L[i, q] * W[q, j]
+            LW[i, j] = acc
+    for i in range(6):
+        for j in range(6):
+            acc = 0.0
+            for q in range(6):
+                acc += LW[i, q] * L[j, q]
+            LWL[i, j] = acc
     if ib >= 0:
         for i in range(nb):
             for j in range(nb):
                 K[ib + i, ib + j] += W[i, j]
     if ia >= 0:
-        LWL = LW @ L.T
         for i in range(na):
             for j in range(na):
                 K[ia + i, ia + j] += LWL[i, j]
@@ -157,36 +185,47 @@ def _add_pair(K, st, a, b, R, x, S):
 
 
 @njit(cache=True, error_model="numpy")
+def _pair_sums(grids, b, M, samples, law, com0, S, J, smooth):
+    """S (6×6) ← Σ κ J Jᵀ over a pair's overclosed samples, J = [n; c×n] in the grid bone b's neutral
+    frame about its centre (κ = p′(ε)·A/h, N/mm); J (6,) scratch."""
+    S[:] = 0.0
+    for s in samples:
+        if smooth:
+            d, gx, gy, gz, qx, qy, qz = sample_lookup_smooth(grids, b, M, s)
+        else:
+            d, gx, gy, gz, qx, qy, qz = sample_lookup(grids, b, M, s)
+        gn = np.sqrt(gx * gx + gy * gy + gz * gz)
+        if d >= 0.0 or gn < 1e-12:
+            continue
+        h = grids.thickness[s]
+        kappa = law_slope(law, -d / h) * grids.area[s] / h
+        nx, ny, nz = gx / gn, gy / gn, gz / gn
+        cx, cy, cz = qx - com0[b, 0], qy - com0[b, 1], qz - com0[b, 2]
+        J[0], J[1], J[2] = nx, ny, nz
+        J[3], J[4], J[5] = cy * nz - cz * ny, cz * nx - cx * nz, cx * ny - cy * nx
+        for u in range(6):
+            ku = kappa * J[u]
+            for v in range(u, 6):
+                S[u, v] += ku * J[v]
+
+
+@njit(cache=True, error_model="numpy")
 def tangent(R, x, nodes, com0, grids, law, fib, stiffness, mem, st, active, n_active, m):
     """Assemble m.stiffness, the Gauss–Newton tangent at the state (R, x, nodes) over the active contact
     samples (as the last force evaluation left them)."""
-    K, S, k = m.stiffness, m.block, m.coupling
+    K, S = m.stiffness, m.block
     K[:] = 0.0
+    J = np.empty(6)
     for p in range(grids.pair_bones.shape[0]):
         a, b = grids.pair_bones[p, 0], grids.pair_bones[p, 1]
         if dof(st, a)[0] < 0 and dof(st, b)[0] < 0:
             continue
         M = pair_transform(R, x, com0, a, b)
-        S[:] = 0.0
         start = grids.sample_offsets[p]
-        for j in range(n_active[p]):
-            s = active[start + j]
-            if st.smooth_normals:
-                d, gx, gy, gz, qx, qy, qz = sample_lookup_smooth(grids, b, M, s)
-            else:
-                d, gx, gy, gz, qx, qy, qz = sample_lookup(grids, b, M, s)
-            gn = np.sqrt(gx * gx + gy * gy + gz * gz)
-            if d >= 0.0 or gn < 1e-12:
-                continue
-            h = grids.thickness[s]
-            kappa = law_slope(law, -d / h) * grids.area[s] / h
-            nx, ny, nz = gx / gn, gy / gn, gz / gn
-            cx, cy, cz = qx - com0[b, 0], qy - com0[b, 1], qz - com0[b, 2]
-            J = (nx, ny, nz, cy * nz - cz * ny, cz * nx - cx * nz, cx * ny - cy * nx)
-            for u in range(6):
-                ku = kappa * J[u]
-                for v in range(u, 6):
-                    S[u, v] += ku * J[v]
+        if st.smooth_normals:  # the flag as a constant: one compiled loop each (see `kernel._contact`)
+            _pair_sums(grids, b, M, active[start : start + n_active[p]], law, com0, S, J, True)
+        else:
+            _pair_sums(grids, b, M, active[start : start + n_active[p]], law, com0, S, J, False)
         for u in range(6):
             for v in range(u):
                 S[u, v] = S[v, u]
@@ -200,7 +239,7 @@ def tangent(R, x, nodes, com0, grids, law, fib, stiffness, mem, st, active, n_ac
         a, b = fib.bones[i, 0], fib.bones[i, 1]
         pa = to_world(R, x, com0, a, o[i, 0], o[i, 1], o[i, 2])
         pb = to_world(R, x, com0, b, ins[i, 0], ins[i, 1], ins[i, 2])
-        _element(K, st, k, a, pa, b, pb, x, stiffness.f_K[i], stiffness.f_l0[i], ra, rb)
+        _element(K, st, m, a, pa, b, pb, x, stiffness.f_K[i], stiffness.f_l0[i], ra, rb)
     for c in range(stiffness.m_l0.shape[0]):
         i, j = mem.connectors[c, 0], mem.connectors[c, 1]
         a, b = mem.bone[i], mem.bone[j]
@@ -208,29 +247,31 @@ def tangent(R, x, nodes, com0, grids, law, fib, stiffness, mem, st, active, n_ac
             continue
         pa = (nodes[i, 0], nodes[i, 1], nodes[i, 2])
         pb = (nodes[j, 0], nodes[j, 1], nodes[j, 2])
-        _element(K, st, k, a, pa, b, pb, x, stiffness.m_K[c], stiffness.m_l0[c], ra, rb)
-    _membrane_contact(K, st, k, R, x, com0, mem, nodes, ra)
+        _element(K, st, m, a, pa, b, pb, x, stiffness.m_K[c], stiffness.m_l0[c], ra, rb)
+    _membrane_contact(K, st, m, R, x, com0, mem, nodes, ra, rb)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _element(K, st, k, a, pa, b, pb, x, scale, l0, ra, rb):
+def _element(K, st, m, a, pa, b, pb, x, scale, l0, ra, rb):
     """A Blankevoort element of scale `scale` (N) and zero-load length l0 (mm) between world points pa on
     body a and pb on body b (a body < 0: a membrane's free node, not an unknown); nothing if slack."""
+    if dof(st, a)[0] < 0 and dof(st, b)[0] < 0:
+        return
     dx, dy, dz = pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]
     length = np.sqrt(dx * dx + dy * dy + dz * dz)
     strain = length / l0 - 1.0
     if strain <= 0.0:
         return
     along = blankevoort_slope(scale, strain) / l0
-    _axial(k, dx / length, dy / length, dz / length, along, blankevoort_force(scale, strain) / length)
+    _axial(m.coupling, dx / length, dy / length, dz / length, along, blankevoort_force(scale, strain) / length)
     for e in range(3):
         ra[e] = pa[e] - x[a, e] if a >= 0 else 0.0
         rb[e] = pb[e] - x[b, e] if b >= 0 else 0.0
-    add_point(K, st, max(a, -1), ra, max(b, -1), rb, k)
+    add_point(K, st, max(a, -1), ra, max(b, -1), rb, m)
 
 
 @njit(cache=True, error_model="numpy")
-def _membrane_contact(K, st, k, R, x, com0, mem, nodes, r):
+def _membrane_contact(K, st, m, R, x, com0, mem, nodes, r, unused):
     """The membrane's free nodes pressing on the scaphoid: membrane_contact_stiffness (N/mm) along the normal."""
     s = mem.scaphoid
     for i in range(nodes.shape[0]):
@@ -246,10 +287,10 @@ def _membrane_contact(K, st, k, R, x, com0, mem, nodes, r):
         nx = (R[s, 0, 0] * gx + R[s, 0, 1] * gy + R[s, 0, 2] * gz) / gn
         ny = (R[s, 1, 0] * gx + R[s, 1, 1] * gy + R[s, 1, 2] * gz) / gn
         nz = (R[s, 2, 0] * gx + R[s, 2, 1] * gy + R[s, 2, 2] * gz) / gn
-        _axial(k, nx, ny, nz, st.membrane_contact_stiffness, 0.0)
+        _axial(m.coupling, nx, ny, nz, st.membrane_contact_stiffness, 0.0)
         for e in range(3):
             r[e] = nodes[i, e] - x[s, e]
-        _add_levered(K, st, s, r, s, r, k, 1.0)
+        add_point(K, st, s, r, -1, unused, m)
 
 
 @njit(cache=True, error_model="numpy")
@@ -285,26 +326,37 @@ def _spd_inverse(A, i0, n, out):
     return True
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _matvec(A, lo, hi, v, out):
+    """out ← A[lo:hi, lo:hi] v."""
+    for i in range(hi - lo):
+        acc = 0.0
+        for j in range(hi - lo):
+            acc += A[lo + i, lo + j] * v[j]
+        out[i] = acc
+
+
 @njit(cache=True, error_model="numpy")
 def _top(K, M, Minv, lo, hi):
     """Largest λ of K v = λ M v over the unknowns lo:hi (K symmetric positive semi-definite, M symmetric
     positive definite, Minv its inverse) by power iteration on Minv·K; the Rayleigh quotient vᵀKv / vᵀMv."""
-    Kb = np.ascontiguousarray(K[lo:hi, lo:hi])
-    Mb = np.ascontiguousarray(M[lo:hi, lo:hi])
-    Ib = np.ascontiguousarray(Minv[lo:hi, lo:hi])
-    v = np.ones(hi - lo)
+    n = hi - lo
+    v = np.ones(n)
+    Kv = np.empty(n)
+    Mv = np.empty(n)
     top = 0.0
     for _ in range(POWER_ITERATIONS):
-        Kv = Kb @ v
-        vMv = v @ (Mb @ v)
+        _matvec(K, lo, hi, v, Kv)
+        _matvec(M, lo, hi, v, Mv)
+        vMv = v @ Mv
         if not vMv > 0.0:
             return 0.0
         top = (v @ Kv) / vMv
-        u = Ib @ Kv
-        norm = np.sqrt(u @ u)
+        _matvec(Minv, lo, hi, Kv, v)
+        norm = np.sqrt(v @ v)
         if norm == 0.0:
             return 0.0
-        v = u / norm
+        v /= norm
     return top
 
 
@@ -330,9 +382,16 @@ def block_mass(R, bod, st, m):
             M0[i0 + k, i0 + k] = bod.mass[b]
             M0inv[i0 + k, i0 + k] = bod.inv_mass[b]
         if nb == 6:
-            Rb = np.ascontiguousarray(R[b])
-            M0[i0 + 3 : i0 + 6, i0 + 3 : i0 + 6] = Rb @ bod.inertia[b] @ Rb.T
-            M0inv[i0 + 3 : i0 + 6, i0 + 3 : i0 + 6] = Rb @ bod.inv_inertia[b] @ Rb.T
+            for p in range(3):
+                for q in range(3):
+                    acc = 0.0
+                    inv = 0.0
+                    for r in range(3):
+                        for t in range(3):
+                            acc += R[b, p, r] * bod.inertia[b, r, t] * R[b, q, t]
+                            inv += R[b, p, r] * bod.inv_inertia[b, r, t] * R[b, q, t]
+                    M0[i0 + 3 + p, i0 + 3 + q] = acc
+                    M0inv[i0 + 3 + p, i0 + 3 + q] = inv
     top = 0.0
     for b in (SCAPHOID, LUNATE, CAPITATE):
         i0, nb = dof(st, b)
