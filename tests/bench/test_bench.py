@@ -266,7 +266,9 @@ def test_a_damaged_evaluation_file_is_named_then_resimulated(p1, finished, tmp_p
     assert _csvs(tmp_path / "lb") == _csvs(finished / "lb")
 
 
-def test_a_damaged_part_of_an_unfinished_cell_drops_it_and_what_follows(p1, tmp_path):
+def six_batches_of_an_unfinished_cell(p1, tmp_path):
+    """(key, log) of a 12-evaluation Nelder–Mead cell stopped after 6 evaluations, one per batch."""
+
     class Stop(Exception):
         pass
 
@@ -277,6 +279,11 @@ def test_a_damaged_part_of_an_unfinished_cell_drops_it_and_what_follows(p1, tmp_
     key, log = RunKey(p1, "nelder-mead", 0, 12), RunLog(tmp_path / "runs")
     with pytest.raises(Stop):  # one evaluation per batch: batches 0 … 5 logged
         calibrate(p1, "nelder-mead", 12, 0, log=log, callback=stop_after_six)
+    return key, log
+
+
+def test_a_damaged_part_of_an_unfinished_cell_drops_it_and_what_follows(p1, tmp_path):
+    key, log = six_batches_of_an_unfinished_cell(p1, tmp_path)
     assert log.logged_range(key) == 6
     sorted((tmp_path / "runs" / "evals").glob("part-*b00002*.parquet"))[0].write_bytes(b"")
     with pytest.warns(UserWarning, match="b00002"):
@@ -290,16 +297,7 @@ def test_a_damaged_part_of_an_unfinished_cell_drops_it_and_what_follows(p1, tmp_
 
 
 def test_a_deleted_middle_part_of_an_unfinished_cell_is_repaired_by_the_rerun(p1, tmp_path):
-    class Stop(Exception):
-        pass
-
-    def stop_after_six(n_new, nfev):
-        if nfev == 6:
-            raise Stop
-
-    key, log = RunKey(p1, "nelder-mead", 0, 12), RunLog(tmp_path / "runs")
-    with pytest.raises(Stop):  # one evaluation per batch: batches 0 … 5 logged
-        calibrate(p1, "nelder-mead", 12, 0, log=log, callback=stop_after_six)
+    key, log = six_batches_of_an_unfinished_cell(p1, tmp_path)
     sorted((tmp_path / "runs" / "evals").glob("part-*b00002*.parquet"))[0].unlink()
     with pytest.warns(UserWarning, match=r"b00003.*evaluations 2…2 of its cell are missing"):
         report = benchmark([p1], ["nelder-mead"], [0], 12, tmp_path / "runs", workers=1, progress=False)

@@ -135,6 +135,19 @@ def _axial(k, ux, uy, uz, along, across):
             k[p, q] = (along - across) * u[p] * u[q] + (across if p == q else 0.0)
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _product6(A, B, transposed):
+    """A B (6×6), or A Bᵀ if `transposed` (explicit loops: a BLAS call costs more than the work)."""
+    out = np.zeros((6, 6))
+    for i in range(6):
+        for j in range(6):
+            acc = 0.0
+            for q in range(6):
+                acc += A[i, q] * (B[j, q] if transposed else B[q, j])
+            out[i, j] = acc
+    return out
+
+
 @njit(cache=True, error_model="numpy")
 def _add_pair(K, st, a, b, R, x, S):
     """A contact pair's summed κJJᵀ S (6×6, body b's neutral frame about its centre) into K: rotated to
@@ -155,20 +168,8 @@ def _add_pair(K, st, a, b, R, x, S):
     for p in range(3):
         for q in range(3):
             L[3 + p, q] = _cross(d, p, q)
-    LW = np.zeros((6, 6))
-    LWL = np.zeros((6, 6))
-    for i in range(6):
-        for j in range(6):
-            acc = 0.0
-            for q in range(6):
-                acc += L[i, q] * W[q, j]
-            LW[i, j] = acc
-    for i in range(6):
-        for j in range(6):
-            acc = 0.0
-            for q in range(6):
-                acc += LW[i, q] * L[j, q]
-            LWL[i, j] = acc
+    LW = _product6(L, W, False)
+    LWL = _product6(LW, L, True)
     if ib >= 0:
         for i in range(nb):
             for j in range(nb):
