@@ -77,6 +77,20 @@ def test_a_stiff_rsc_settles_every_frame(p1):
     assert run.steps.sum() < 3000  # the population design takes ~2,200
 
 
+def test_every_stiffness_at_the_top_of_the_box_settles_with_the_block_mass(p1):
+    """All eleven stiffnesses at +3 SD at once, and the RSC alone: with the block mass
+    (`SolverSettings.preconditioned`) every frame of P1's calibration trial settles."""
+    from wrist_env.design import N_LIGAMENTS
+
+    driver = experimental(p1, registry.trial("P1", "calibrate").pose("capitate"))
+    everything = design.population().vector.copy()
+    everything[:N_LIGAMENTS] = design.from_action(np.r_[np.ones(N_LIGAMENTS), np.zeros(16)]).vector[:N_LIGAMENTS]
+    for dsg in (stiff_rsc(), design.Design.from_vector(everything)):
+        run = simulate(p1, dsg, driver, arrays.SolverSettings().preconditioned())
+        assert run.ok and run.settled.all(), (run.message, run.settled)
+        assert np.max(run.residual[:, 0]) < 0.5  # N
+
+
 def test_settled_says_which_frames_ran_out_of_hold_steps(p1):
     driver = experimental(p1, registry.trial("P1", "calibrate").pose("capitate"))
     run = simulate(p1, design.population(), driver)
