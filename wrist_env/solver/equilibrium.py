@@ -205,6 +205,8 @@ class Tangent:
     mass: np.ndarray
     asymmetry: float
     """‖K − Kᵀ‖ / ‖K‖ of the unsymmetrized condensed stiffness (a conservative system's is 0)."""
+    membrane: np.ndarray
+    """The membrane's free nodes' own stiffness (3F, 3F) N/mm, the bones held (symmetrized)."""
 
     def frequencies(self) -> np.ndarray:
         """Natural angular frequencies (rad/s) of the linearized free bones, ascending (NaN where ω² < 0)."""
@@ -246,7 +248,8 @@ def tangent_stiffness(
     if n_bones > 12:
         mass[12:, 12:] = p.bodies.mass[CAPITATE] * np.eye(3)
     asymmetry = float(np.linalg.norm(condensed - condensed.T) / np.linalg.norm(condensed))
-    return Tangent(0.5 * (condensed + condensed.T), mass, asymmetry)
+    membrane = K[nodes, nodes]
+    return Tangent(0.5 * (condensed + condensed.T), mass, asymmetry, 0.5 * (membrane + membrane.T))
 
 
 @dataclass(frozen=True)
