@@ -31,7 +31,7 @@ def test_the_tangent_of_two_opposed_bundles_is_the_closed_form():
     slope = np.where(strain <= 2 * EPSILON_L, K * strain / (2 * EPSILON_L), K)
     along = np.sum(slope / l0)
     across = np.sum([tension(Ki, e) / L for Ki, e, L in zip(K, strain, length)])
-    b = block_mass(model, dsg, driver, result, frame=1, settings=replace(settings, block_floor=0.1))
+    b = block_mass(model, dsg, driver, result, frame=1, settings=settings)
     normal = np.cross(AXIS, [1.0, 0.0, 0.0])
     normal /= np.linalg.norm(normal)
     shift = b.stiffness[:3, :3]

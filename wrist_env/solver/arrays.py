@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import weakref
 from collections import namedtuple
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -31,7 +31,7 @@ Settings = namedtuple(
     "Settings",
     "dt settle_steps move_steps ramp_steps min_hold_steps max_hold_steps tolerance force_floor damping rot_damping fibre_damping_s "
     "active_band_mm node_mass membrane_contact_stiffness driver max_disp_mm max_rot_rad fire_alpha0 smooth_normals "
-    "block_mass block_courant block_floor block_refresh_steps block_damping block_max_move_mm",
+    "block_mass block_courant block_floor block_refresh_steps block_max_move_mm",
 )
 
 RSC = RSC_INDEX
@@ -58,9 +58,8 @@ class SolverSettings:
     block_refresh_steps, at each stage and after each FIRE restart; its
     stiffest mode at dt·ω = block_courant, each bone's soft directions
     floored at block_floor of the stiffest; a bone's step is cut to
-    block_max_move_mm (its shift plus rotation × 10 mm); block_damping
-    divides the velocities by (1 + it) each step. `preconditioned()` turns it
-    on with the stages it needs.
+    block_max_move_mm (its shift plus rotation × 10 mm). `preconditioned()`
+    turns it on with the stages it needs.
     mass_scale, inertia_scale: mass scaling of the free bones (inertia_scale
     multiplies rotational inertia on top of mass_scale). node_mass_t: the mass
     of the RSC membrane's free nodes, raised per design where its connectors
@@ -91,11 +90,10 @@ class SolverSettings:
     fire_alpha0: float = 0.1
     smooth_normals: bool = True
     block_mass: bool = False
-    block_courant: float = 1.0
-    block_floor: float = 1e-2
+    block_courant: float = 0.8
+    block_floor: float = 0.1
     block_refresh_steps: int = 10
-    block_damping: float = 0.0
-    block_max_move_mm: float = 0.02
+    block_max_move_mm: float = 0.3
 
     def preconditioned(self) -> "SolverSettings":
         """These settings with the block mass (`preconditioner`) and the stages it needs: ramps of 10
@@ -103,15 +101,9 @@ class SolverSettings:
         damping (a viscous term in seconds that the block mass's light directions cannot carry:
         dt·c/m = fibre_damping_s / dt_s · block_courant² > 2 at block_courant 1). Measured in
         `experiments/bench_solver.py` and the README's solver section."""
-        from dataclasses import replace
-
         return replace(
             self,
             block_mass=True,
-            block_courant=0.8,
-            block_floor=0.1,
-            block_refresh_steps=10,
-            block_max_move_mm=0.3,
             fibre_damping_s=0.0,
             fire_alpha0=0.2,
             settle_steps=150,
@@ -121,8 +113,6 @@ class SolverSettings:
 
     def halved(self) -> "SolverSettings":
         """The same run with half the time step (twice the steps)."""
-        from dataclasses import replace
-
         return replace(
             self,
             dt_s=self.dt_s / 2,
@@ -317,6 +307,5 @@ def settings_tuple(s: SolverSettings, driver: int) -> Settings:
         float(s.block_courant),
         float(s.block_floor),
         max(int(s.block_refresh_steps), 1),
-        float(s.block_damping),
         float(s.block_max_move_mm),
     )

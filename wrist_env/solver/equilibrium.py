@@ -19,7 +19,7 @@ from scipy.optimize import least_squares
 
 from wrist_env.design import Design
 from wrist_env.model import Model
-from wrist_env.solver import arrays, kernel
+from wrist_env.solver import arrays, kernel, preconditioner
 from wrist_env.solver.kernel import CAPITATE, LEVER_MM, LUNATE, SCAPHOID
 from wrist_env.solver.rigid import rotate_in_place
 from wrist_env.solver.simulate import prepare, stiffness
@@ -268,8 +268,6 @@ def block_mass(
 ) -> BlockMass:
     """The `BlockMass` the explicit solver would build at `frame` of `result` (a successful `simulate`)
     under `settings` (their block_* fields; the block mass need not be on)."""
-    from wrist_env.solver import preconditioner
-
     if not result.ok:
         raise ValueError(f"the run failed ({result.message}); there is no state to linearize")
     p = prepare(model, settings, driver.mode)

@@ -244,12 +244,11 @@ def _move_diagonal(R, x, v, w, F, T, bod, st):
 
 @njit(cache=True, error_model="numpy")
 def _move_blocks(R, x, v, w, F, T, st, m):
-    """Semi-implicit Euler of the free bodies under the block mass: u ← (u + dt·M⁻¹g)/(1 + block_damping),
+    """Semi-implicit Euler of the free bodies under the block mass: u ← u + dt·M⁻¹g (FIRE damps it),
     the velocity cut where a body's step would move it more than st.block_max_move_mm (its shift
     plus its rotation × LEVER_MM): the mass is a linearization, and a contact that closes between
     refreshes is stiffer than it says."""
     dt = st.dt
-    keep = 1.0 / (1.0 + st.block_damping)
     Minv = m.inverse
     for b in (SCAPHOID, LUNATE, CAPITATE):
         i0, nb = dof(st, b)
@@ -260,9 +259,9 @@ def _move_blocks(R, x, v, w, F, T, st, m):
             for j in range(nb):
                 acc += Minv[i0 + i, i0 + j] * _force_of(F, T, b, j)
             if i < 3:
-                v[b, i] = (v[b, i] + dt * acc) * keep
+                v[b, i] += dt * acc
             else:
-                w[b, i - 3] = (w[b, i - 3] + dt * acc) * keep
+                w[b, i - 3] += dt * acc
         move = dt * np.sqrt(v[b, 0] ** 2 + v[b, 1] ** 2 + v[b, 2] ** 2)
         if nb == 6:
             move += dt * LEVER_MM * np.sqrt(w[b, 0] ** 2 + w[b, 1] ** 2 + w[b, 2] ** 2)
@@ -311,7 +310,7 @@ def _kinetic(R, v, w, nv, bod, st, node_mass, m):
                 ui = v[b, i] if i < 3 else w[b, i - 3]
                 for j in range(nb):
                     ke += 0.5 * ui * m.mass[i0 + i, i0 + j] * (v[b, j] if j < 3 else w[b, j - 3])
-    if not st.block_mass:
+    else:
         for b in (SCAPHOID, LUNATE):
             # body-frame angular velocity Rᵀw against the neutral-pose inertia
             u0 = R[b, 0, 0] * w[b, 0] + R[b, 1, 0] * w[b, 1] + R[b, 2, 0] * w[b, 2]

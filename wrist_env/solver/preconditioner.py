@@ -244,7 +244,7 @@ def tangent(R, x, nodes, com0, grids, law, fib, stiffness, mem, st, active, n_ac
     for c in range(stiffness.m_l0.shape[0]):
         i, j = mem.connectors[c, 0], mem.connectors[c, 1]
         a, b = mem.bone[i], mem.bone[j]
-        if stiffness.m_K[c] == 0.0 or (a < 0 and b < 0):
+        if stiffness.m_K[c] == 0.0:
             continue
         pa = (nodes[i, 0], nodes[i, 1], nodes[i, 2])
         pb = (nodes[j, 0], nodes[j, 1], nodes[j, 2])
@@ -272,7 +272,7 @@ def _element(K, st, m, a, pa, b, pb, x, scale, l0, ra, rb):
 
 
 @njit(cache=True, error_model="numpy")
-def _membrane_contact(K, st, m, R, x, com0, mem, nodes, r, unused):
+def _membrane_contact(K, st, m, R, x, com0, mem, nodes, r, node_lever):
     """The membrane's free nodes pressing on the scaphoid: membrane_contact_stiffness (N/mm) along the normal."""
     s = mem.scaphoid
     for i in range(nodes.shape[0]):
@@ -291,7 +291,7 @@ def _membrane_contact(K, st, m, R, x, com0, mem, nodes, r, unused):
         _axial(m.coupling, nx, ny, nz, st.membrane_contact_stiffness, 0.0)
         for e in range(3):
             r[e] = nodes[i, e] - x[s, e]
-        add_point(K, st, s, r, -1, unused, m)
+        add_point(K, st, s, r, -1, node_lever, m)  # the node is no unknown: its lever is unused
 
 
 @njit(cache=True, error_model="numpy")
