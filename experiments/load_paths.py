@@ -1,9 +1,10 @@
-"""Where the axial load goes at neutral (issue 10: the radiocarpal load share).
+"""Where the axial load goes at neutral (issues 10 and 33: the load path).
 
 For each participant (population design, capitate held at neutral under the validation's 100 N):
 the contact force on each bone of each contact pair's sample body (the distal row's parts, the
-triquetrum with the lunate) and the neutral gaps of those samples to the opposing surface, to see
-why the STT and triquetrohamate joints carry little. Run: `python experiments/load_paths.py P1`.
+triquetrum with the lunate) with the neutral gaps of those samples to the opposing surface, then
+the force and share of each articulation (`model.ARTICULATIONS`: the midcarpal shares against
+Viegas 1993, the ulnar share against Palmer & Werner 1984) as `wrist-bench validate` checks them. Run: `python experiments/load_paths.py P1`.
 """
 
 from __future__ import annotations
@@ -11,15 +12,14 @@ from __future__ import annotations
 import sys
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from wrist_env import design
 from wrist_env.model import BODY_PARTS, BONES, PAIR_BONES, PAIRS
 from wrist_env.participants.registry import load_model
 from wrist_env.solver import simulate as sim
 from wrist_env.solver.contact import OUTSIDE_MM, sdf_lookup
-from wrist_env.solver.outputs import pressure_map
-from wrist_env.validation import NEUTRAL_LOAD_N
+from wrist_env.solver.outputs import articulation_forces, pair_slice, pressure_map, sample_parts
+from wrist_env.validation import NEUTRAL_LOAD_N, load_shares_pct
 
 
 def signed_distance(model, b: int, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -35,26 +35,13 @@ def signed_distance(model, b: int, points: np.ndarray) -> tuple[np.ndarray, np.n
     return d, grad
 
 
-def sample_parts(model, k: int) -> tuple[np.ndarray, slice]:
-    """The part (index into `BODY_PARTS` of the pair's sample body) of each sample of pair k, and the pair's slice."""
-    body = PAIR_BONES[k][0]
-    s = slice(model.sample_offsets[k], model.sample_offsets[k + 1])
-    vertices = model.vertices[model.vertex_offsets[body] : model.vertex_offsets[body + 1]]
-    part = model.vertex_part[model.vertex_offsets[body] : model.vertex_offsets[body + 1]]
-    return part[cKDTree(vertices).query(model.sample_points[s])[1]], s
-
-
-def load_paths(name: str) -> list[dict]:
-    """Per pair and sample-body part: contact force (N, magnitude), sample area (mm²), neutral gap (mm)."""
-    model = load_model(name)
-    result = sim.simulate(model, design.population(), sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N))
-    poses = result.poses[0]
-    pressure = pressure_map(model, poses)
+def part_gaps(name: str, model, poses) -> list[dict]:
+    """Per pair and sample-body part: contact force (N, pressure × area), sample area (mm²), neutral gap (mm)."""
+    load = pressure_map(model, poses) * model.sample_area
     rows = []
     for k, pair in enumerate(PAIRS):
         body, grid_body = PAIR_BONES[k]
-        owner, s = sample_parts(model, k)
-        force = (pressure[s] * model.sample_area[s])[:, None] * (model.sample_normals[s] @ poses[body, :3, :3].T)
+        owner, s = sample_parts(model, pair), pair_slice(model, pair)
         gap = signed_distance(model, grid_body, model.sample_points[s])[0]
         for q, part_name in enumerate(BODY_PARTS[BONES[body]]):
             mine = owner == q
@@ -63,35 +50,35 @@ def load_paths(name: str) -> list[dict]:
                     {
                         "pair": pair,
                         "part": part_name,
-                        "force_n": float(np.linalg.norm(force[mine].sum(0))),
+                        "force_n": float(load[s][mine].sum()),
                         "area_mm2": float(model.sample_area[s][mine].sum()),
                         "gap_min_mm": float(np.nanmin(gap[mine])),
                         "gap_median_mm": float(np.nanmedian(gap[mine])),
                     }
                 )
-    rs, rl = PAIRS.index("radioscaphoid"), PAIRS.index("radiolunate")
-    rows.append(
-        {
-            "pair": "RS/RL force ratio",
-            "part": "",
-            "force_n": float(result.contact[0, rs, 3] / result.contact[0, rl, 3]),
-            "area_mm2": np.nan,
-            "gap_min_mm": np.nan,
-            "gap_median_mm": np.nan,
-        }
-    )
     return rows
 
 
 def main(names) -> None:
     for name in names:
+        model = load_model(name)
+        result = sim.simulate(model, design.population(), sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N))
         print(f"{name}, population design, neutral, {NEUTRAL_LOAD_N:g} N")
         print("| pair | part | force (N) | sample area (mm²) | neutral gap min / median (mm) |\n|---|---|---|---|---|")
-        for r in load_paths(name):
+        for r in part_gaps(name, model, result.poses[0]):
             print(
                 f"| {r['pair']} | {r['part']} | {r['force_n']:.2f} | {r['area_mm2']:.0f} | "
                 f"{r['gap_min_mm']:.2f} / {r['gap_median_mm']:.2f} |"
             )
+        forces, shares = articulation_forces(model, result.poses[0]), load_shares_pct(model, result)
+        print("\n| articulation | force (N) | share (%) |\n|---|---|---|")
+        for joint, force in forces.items():
+            share = f"{shares[joint]:.1f}" if joint in shares else ""
+            print(f"| {joint} | {force:.2f} | {share} |")
+        rs, rl = forces["radioscaphoid"], forces["radiolunate"]
+        print(
+            f"\nRS/RL force ratio {rs / rl:.2f}; midcarpal shares of the four midcarpal joints, ulnocarpal of RS + RL + ulnocarpal\n"
+        )
 
 
 if __name__ == "__main__":

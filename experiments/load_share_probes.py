@@ -20,14 +20,14 @@ import dataclasses
 import sys
 
 import numpy as np
-from load_paths import sample_parts, signed_distance  # this folder's script (on sys.path when run)
+from load_paths import signed_distance  # this folder's script (on sys.path when run)
 from scipy.spatial.transform import Rotation
 
 from wrist_env import design
 from wrist_env.model import BODY_PARTS, BONES, PAIR_BONES, PAIRS
 from wrist_env.participants.registry import load_model
 from wrist_env.solver import simulate as sim
-from wrist_env.solver.outputs import pressure_map
+from wrist_env.solver.outputs import pair_slice, pressure_map, sample_parts
 
 LADDER_N = (1.0, 10.0, 100.0, 200.0, 250.0, 300.0)
 PROBE_N = 100.0
@@ -48,7 +48,7 @@ def _ratio(result) -> float:
 def _joint_samples(model, joint):
     """Mask over the pair's samples on the joint's distal-row parts, and the pair's slice."""
     pair, names = joint
-    owner, s = sample_parts(model, pair)
+    owner, s = sample_parts(model, PAIRS[pair]), pair_slice(model, PAIRS[pair])
     parts = BODY_PARTS[BONES[PAIR_BONES[pair][0]]]
     return np.isin(owner, [parts.index(n) for n in names]), s
 

@@ -16,6 +16,11 @@ CHECK_IDS = (
     "lunate_slope",
     "scaphoid_above_lunate",
     "rs_rl_force_ratio",
+    "midcarpal_stt_share_pct",
+    "midcarpal_sc_share_pct",
+    "midcarpal_lc_share_pct",
+    "midcarpal_th_share_pct",
+    "ulnar_share_pct",
     "sl_gap_growth_mm",
     "rs_mean_pressure_mpa",
     "slil_force_30ext_n",
@@ -91,7 +96,7 @@ def test_report_json_is_strict_and_round_trips():
     assert "FAIL" in validation.format_table(report)
 
 
-def test_cli_validate_json_has_the_seven_checks(capsys, built, tmp_path):
+def test_cli_validate_json_has_the_twelve_checks(capsys, built, tmp_path):
     built("P1")
     code = main(["validate", "P1", "--json", "--out", str(tmp_path)])
     out = json.loads(capsys.readouterr().out)
@@ -116,7 +121,7 @@ def test_a_failed_run_fails_its_check_and_says_why():
 
 
 @pytest.mark.xfail(
-    reason="the radiocarpal load share (and P2's SLIL force) need cartilage and TFCC data we do not have: issue 10, blocked",
+    reason="the load path (RS/RL, the midcarpal and ulnar shares) needs a radial column and the TFCC: issue 33",
     strict=True,
     raises=AssertionError,
 )
@@ -136,4 +141,8 @@ def test_builtins_move_like_a_wrist(name, built):
     report = validation.validate(name, model=built(name))
     for check in ("scaphoid_slope", "lunate_slope", "scaphoid_above_lunate", "rs_mean_pressure_mpa"):
         assert report.row(check).passed, report.row(check)
-    assert report.row("rs_rl_force_ratio").value < 1.1  # the open item of issue 10: update when it passes
+    assert report.row("rs_rl_force_ratio").value < 1.1  # the open item of issue 33: update when it passes
+    shares = [report.row(f"midcarpal_{k}_share_pct").value for k in validation.VIEGAS_1993]
+    assert sum(shares) == pytest.approx(100.0)
+    # issue 33's open items: the STT carries ~1 % (Viegas 1993: 23 %), no ulnar path (Palmer 1984: 18.4 %)
+    assert shares[0] < 13.0 and report.row("ulnar_share_pct").value == 0.0

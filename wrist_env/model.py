@@ -36,6 +36,20 @@ PAIR_BONES = np.array(
     [[SCAPHOID, RADIUS], [LUNATE, RADIUS], [SCAPHOID, LUNATE], [CAPITATE, SCAPHOID], [CAPITATE, LUNATE]]
 )
 """(sample bone, grid bone) of each contact pair: samples of the first are looked up in the second's grid."""
+ARTICULATIONS = {
+    "radioscaphoid": ("radioscaphoid", ("scaphoid",)),
+    "radiolunate": ("radiolunate", ("lunate", "triquetrum")),
+    "scapholunate": ("scapholunate", ("scaphoid",)),
+    "scaphotrapeziotrapezoid": ("scaphocapitate", ("trapezium", "trapezoid")),
+    "scaphocapitate": ("scaphocapitate", ("capitate",)),
+    "lunocapitate": ("lunocapitate", ("capitate",)),
+    "triquetrohamate": ("lunocapitate", ("hamate",)),
+}
+"""Each articulation as (contact pair, the parts of the pair's sample body on its side): a pair whose
+sample body holds several bones (`BODY_PARTS`) spans several joints (the distal row's samples against
+the scaphoid are the STT joint on the trapezium and trapezoid, the scaphocapitate on the capitate)."""
+MIDCARPAL = ("scaphotrapeziotrapezoid", "scaphocapitate", "lunocapitate", "triquetrohamate")
+"""The midcarpal articulations whose load shares Viegas 1993 measured (STT, SC, LC, TH)."""
 
 
 @dataclass(frozen=True)

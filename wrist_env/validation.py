@@ -3,7 +3,7 @@
 `validate(name)` runs three simulations of the population-mean design — an
 intact idealized ±40° flexion–extension sweep and the same sweep with all
 three SLIL bundles torn (one batched call), and the capitate held at neutral
-under the idealized compressive load — and compares seven outputs with bands
+under the idealized compressive load — and compares twelve outputs with bands
 drawn from cadaveric and in-vivo studies. Each row says where its band comes
 from. A check whose simulation failed has value NaN (None in JSON), fails,
 and names the solver's status in its description.
@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from wrist_env import design as design_mod
-from wrist_env.model import BONES, PAIRS, Model
+from wrist_env.model import BONES, MIDCARPAL, PAIRS, Model
 from wrist_env.solver.simulate import IDEALIZED_LOAD_N
 
 if TYPE_CHECKING:
@@ -35,6 +35,10 @@ SL_DISSOCIATION_MM = 3.0  # clinical scapholunate dissociation: gap > 3 mm
 RAINBOW_SCAPHOID = 0.72  # Rainbow 2013: scaphoid 70 % (flexion), 74 % (extension) of the capitate
 RAINBOW_LUNATE = 0.44  # Rainbow 2013: lunate 46 % (flexion), 42 % (extension)
 NEUTRAL_LOAD_N = 100.0  # axial load of the load-share check: Hara 1992 loaded neutral wrists with up to 12 kg
+
+VIEGAS_1993 = {"stt": 23, "sc": 28, "lc": 29, "th": 20}
+"""Midcarpal load shares (%), Viegas 1993, in `model.MIDCARPAL` order."""
+ULNAR_SHARE_PCT = (10.0, 25.0)  # Palmer & Werner 1984 (18.4 %), Hara 1992 (15 %)
 
 RAINBOW = (
     "Rainbow et al. 2013, J Hand Surg Am 38:278-288 (in vivo CT, 12 wrists, extreme loaded flexion and "
@@ -58,6 +62,18 @@ SOURCES = {
         "Andreassen et al. preprint, Figure 3 / Table 5 scale (a no-regression band: Table 5's "
         "normalizer, mean RS pressure 0.65 MPa; cadaveric radiocarpal pressures of a few MPa, "
         "Hara 1992: peak 2.4 MPa on the scaphoid fossa under 10 kg)"
+    ),
+    **{
+        f"midcarpal_{key}_share_pct": (
+            f"Viegas, Patterson, Todd & McCarty 1993, J Hand Surg Am 18:14-18 (pressure-sensitive film, "
+            f"cadaver wrists loaded axially in neutral: STT 23 %, SC 28 %, LC 29 %, TH 20 % of the midcarpal "
+            f"load; {key.upper()} {pct} %, band +-10 points)"
+        )
+        for key, pct in VIEGAS_1993.items()
+    },
+    "ulnar_share_pct": (
+        "Palmer & Werner 1984, Clin Orthop 187:26-35 (neutral ulnar variance: 18.4 % of the axial load "
+        "through the ulna); Hara et al. 1992, J Hand Surg Am 17:339-347 (TFC 15 %)"
     ),
     "slil_force_30ext_n": (
         "Dimitris et al. 2015, J Hand Surg Am 40:1525-1533 (total SLIL force in active wrist "
@@ -213,6 +229,21 @@ def _row(check_id, description, value, band, unit, failed=None) -> Check:
     return Check(check_id, description, value, (float(band[0]), float(band[1])), unit, SOURCES[check_id], passed)
 
 
+def load_shares_pct(model: Model, result) -> dict[str, float]:
+    """Load shares (%) at a run's first frame: each midcarpal articulation's (`model.MIDCARPAL`) of their
+    sum, and "ulnocarpal": the ulnar path's of radiocarpal + ulnocarpal (NaN for a failed run)."""
+    from wrist_env.solver.outputs import articulation_forces
+
+    if not result.ok:
+        return {name: math.nan for name in (*MIDCARPAL, "ulnocarpal")}
+    f = articulation_forces(model, result.poses[0])
+    midcarpal = sum(f[name] for name in MIDCARPAL)
+    proximal = f["radioscaphoid"] + f["radiolunate"] + f["ulnocarpal"]
+    out = {name: 100.0 * f[name] / midcarpal if midcarpal > 0 else math.nan for name in MIDCARPAL}
+    out["ulnocarpal"] = 100.0 * f["ulnocarpal"] / proximal if proximal > 0 else math.nan
+    return out
+
+
 def _failure(label, result) -> str | None:
     return None if result.ok else f"{label} run {result.message}"
 
@@ -261,6 +292,7 @@ def validate(
     inf = float("inf")
     with np.errstate(divide="ignore", invalid="ignore"):
         rs_rl = float(neutral.contact[0, rs, 3] / neutral.contact[0, rl, 3])
+    shares = load_shares_pct(model, neutral)
     rows = (
         _row(
             "scaphoid_slope",
@@ -292,6 +324,25 @@ def validate(
             rs_rl,
             (1.1, 2.0),
             "ratio",
+            fail_n,
+        ),
+        *(
+            _row(
+                f"midcarpal_{key}_share_pct",
+                f"{name}'s share of the midcarpal contact force, neutral, {NEUTRAL_LOAD_N:g} N",
+                shares[name],
+                (pct - 10.0, pct + 10.0),
+                "%",
+                fail_n,
+            )
+            for (key, pct), name in zip(VIEGAS_1993.items(), MIDCARPAL)
+        ),
+        _row(
+            "ulnar_share_pct",
+            f"ulnocarpal share of the radiocarpal + ulnocarpal contact force, neutral, {NEUTRAL_LOAD_N:g} N",
+            shares["ulnocarpal"],
+            ULNAR_SHARE_PCT,
+            "%",
             fail_n,
         ),
         _row(
@@ -359,12 +410,12 @@ def format_table(report: Report) -> str:
             if c
             else ""
         ),
-        f"{'check':<22} {'value':>8}  {'band':<13} {'unit':<8} {'result':<6}  source",
+        f"{'check':<24} {'value':>8}  {'band':<13} {'unit':<8} {'result':<6}  source",
     ]
     for r in report.rows:
         band = f"{_fmt(r.band[0])}-{_fmt(r.band[1])}" if math.isfinite(r.band[1]) else f"> {_fmt(r.band[0])}"
         lines.append(
-            f"{r.id:<22} {_fmt(r.value):>8}  {band:<13} {r.unit:<8} {'pass' if r.passed else 'FAIL':<6}  "
+            f"{r.id:<24} {_fmt(r.value):>8}  {band:<13} {r.unit:<8} {'pass' if r.passed else 'FAIL':<6}  "
             f"{r.source.split(' (')[0]}"
         )
     for r in report.rows:

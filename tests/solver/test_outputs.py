@@ -139,3 +139,23 @@ def test_result_to_dict_of_a_failed_run_has_nulls(p1, sweep):
     frame = out["frames"][0]
     assert frame["capitate_angle_deg"] is None and frame["contact"]["radiolunate"]["force_n"] is None
     assert frame["poses"]["scaphoid"][0][0] is None and frame["rotation_deg"]["lunate"] == [None, None, None]
+
+
+def test_articulations_split_each_pair_by_the_bone_under_its_samples(p1, sweep):
+    """Each pair's articulations (`ARTICULATIONS`) partition its samples: their forces add up to the
+    pair's force at the same poses, and every sample lies on one of the named bones."""
+    from wrist_env.model import ARTICULATIONS, BODY_PARTS
+    from wrist_env.solver.outputs import articulation_forces, sample_parts
+
+    poses = sweep.poses[2]
+    split = articulation_forces(p1, poses)
+    load = pressure_map(p1, poses) * p1.sample_area
+    for pair in PAIRS:
+        joints = [name for name, (p, _) in ARTICULATIONS.items() if p == pair]
+        s = pair_slice(p1, pair)
+        np.testing.assert_allclose(sum(split[j] for j in joints), load[s].sum(), rtol=1e-12, err_msg=pair)
+        body = BONES[PAIR_BONES[PAIRS.index(pair)][0]]
+        named = {BODY_PARTS[body].index(q) for j in joints for q in ARTICULATIONS[j][1]}
+        assert set(np.unique(sample_parts(p1, pair))) <= named, pair
+    assert split["scaphocapitate"] > 0 and split["lunocapitate"] > 0
+    assert split["ulnocarpal"] == 0.0  # no pair touches the ulna (issue 33: the TFCC)

@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from wrist_env.design import ALL_LIGAMENT_NAMES
-from wrist_env.model import BONES, PAIRS, Model
+from wrist_env.model import ARTICULATIONS, BODY_PARTS, BONES, PAIR_BONES, PAIRS, ULNA, Model
 from wrist_env.solver import arrays, forces
 from wrist_env.solver.forces import CONTACT_FIELDS
 
@@ -57,6 +57,32 @@ def pair_slice(model: Model, pair: str) -> slice:
     """The samples of one articulation (a `PAIRS` name) in `model.sample_points` order."""
     p = PAIRS.index(pair)
     return slice(int(model.sample_offsets[p]), int(model.sample_offsets[p + 1]))
+
+
+def sample_parts(model: Model, pair: str) -> np.ndarray:
+    """Index into `BODY_PARTS` of the pair's sample body of the bone under each of the pair's samples (n,)."""
+    from scipy.spatial import cKDTree
+
+    p = PAIRS.index(pair)
+    body = PAIR_BONES[p][0]
+    v = slice(int(model.vertex_offsets[body]), int(model.vertex_offsets[body + 1]))
+    return model.vertex_part[v][cKDTree(model.vertices[v]).query(model.sample_points[pair_slice(model, pair)])[1]]
+
+
+def articulation_forces(model: Model, pose_frame: ArrayLike) -> dict[str, float]:
+    """Contact force (N: pressure integrated over area, as pressure-sensitive film measures it and
+    `Result.contact` reports it) through each articulation (`model.ARTICULATIONS`) at one frame's poses
+    (5, 4, 4), from `pressure_map`; "ulnocarpal" sums the pairs that touch the ulna (0 in a model
+    without an ulnar load path)."""
+    load = pressure_map(model, pose_frame) * model.sample_area
+    out = {}
+    for name, (pair, parts) in ARTICULATIONS.items():
+        body = BONES[PAIR_BONES[PAIRS.index(pair)][0]]
+        mine = np.isin(sample_parts(model, pair), [BODY_PARTS[body].index(q) for q in parts])
+        out[name] = float(load[pair_slice(model, pair)][mine].sum())
+    ulnar = [p for p, bones in zip(PAIRS, PAIR_BONES) if ULNA in bones]
+    out["ulnocarpal"] = float(sum(load[pair_slice(model, p)].sum() for p in ulnar))
+    return out
 
 
 def cardan_deg(poses: ArrayLike) -> np.ndarray:
