@@ -4,12 +4,14 @@ For each participant (population design, capitate held at neutral under the vali
 the contact force on each bone of each contact pair's sample body (the distal row's parts, the
 triquetrum with the lunate) with the neutral gaps of those samples to the opposing surface, then
 the force and share of each articulation (`model.ARTICULATIONS`: the midcarpal shares against
-Viegas 1993, the ulnar share against Palmer & Werner 1984) as `wrist-bench validate` checks them. Run: `python experiments/load_paths.py P1`.
+Viegas 1993, the ulnar share against Palmer & Werner 1984) as `wrist-bench validate` checks them.
+Run: `python experiments/load_paths.py P1 [P2 ...] [--load-direction erhart2020]` (the load along the
+radius by default, or the tendon rig's resultant: `validation.LOAD_DIRECTIONS`).
 """
 
 from __future__ import annotations
 
-import sys
+import argparse
 
 import numpy as np
 
@@ -19,7 +21,7 @@ from wrist_env.participants.registry import load_model
 from wrist_env.solver import simulate as sim
 from wrist_env.solver.contact import OUTSIDE_MM, sdf_lookup
 from wrist_env.solver.outputs import articulation_forces, pair_slice, pressure_map, sample_parts
-from wrist_env.validation import NEUTRAL_LOAD_N, load_shares_pct
+from wrist_env.validation import LOAD_DIRECTIONS, NEUTRAL_LOAD_N, load_direction_rcs, load_shares_pct
 
 
 def signed_distance(model, b: int, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -59,11 +61,13 @@ def part_gaps(name: str, model, poses) -> list[dict]:
     return rows
 
 
-def main(names) -> None:
+def main(names, load_direction: str = "axial") -> None:
+    direction = load_direction_rcs(load_direction)
     for name in names:
         model = load_model(name)
-        result = sim.simulate(model, design.population(), sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N))
-        print(f"{name}, population design, neutral, {NEUTRAL_LOAD_N:g} N")
+        driver = sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, load_direction=direction)
+        result = sim.simulate(model, design.population(), driver)
+        print(f"{name}, population design, neutral, {NEUTRAL_LOAD_N:g} N along {load_direction} {direction.round(3)}")
         print("| pair | part | force (N) | sample area (mm²) | neutral gap min / median (mm) |\n|---|---|---|---|---|")
         for r in part_gaps(name, model, result.poses[0]):
             print(
@@ -82,4 +86,8 @@ def main(names) -> None:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:] or ["P1"])
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("participants", nargs="*", default=["P1"])
+    parser.add_argument("--load-direction", choices=LOAD_DIRECTIONS, default="axial")
+    args = parser.parse_args()
+    main(args.participants, args.load_direction)

@@ -146,3 +146,19 @@ def test_builtins_move_like_a_wrist(name, built):
     assert sum(shares) == pytest.approx(100.0)
     # issue 33's open items: the STT carries ~1 % (Viegas 1993: 23 %), no ulnar path (Palmer 1984: 18.4 %)
     assert shares[0] < 13.0 and report.row("ulnar_share_pct").value == 0.0
+
+
+def test_load_directions_are_the_clis_choices_and_unit_vectors():
+    """`--load-direction` offers exactly `validation.LOAD_DIRECTIONS`; each is a unit vector pulling
+    proximally, the axial one the radius' axis, and another name is refused by name."""
+    from wrist_env.cli import parser
+
+    validate = parser()._subparsers._group_actions[0].choices["validate"]
+    option = next(a for a in validate._actions if "--load-direction" in a.option_strings)
+    assert tuple(option.choices) == validation.LOAD_DIRECTIONS and option.default == "axial"
+    for name in validation.LOAD_DIRECTIONS:
+        d = validation.load_direction_rcs(name)
+        assert np.isclose(np.linalg.norm(d), 1.0) and d[1] > 0.95, (name, d)
+    assert np.array_equal(validation.load_direction_rcs("axial"), [0.0, 1.0, 0.0])
+    with pytest.raises(ValueError, match="sideways"):
+        validation.load_direction_rcs("sideways")

@@ -244,6 +244,21 @@ def load_shares_pct(model: Model, result) -> dict[str, float]:
     return out
 
 
+LOAD_DIRECTIONS = ("axial", "erhart2020", "erhart2020_groups")
+"""The loads' directions: along the radius' axis (RCS +y, the default), or the resultant of a tendon rig
+(`anatomy.tendons.RIGS`) on the hand at neutral, where the tendons put it."""
+
+
+def load_direction_rcs(name: str) -> np.ndarray:
+    """The unit direction (3,) RCS of `LOAD_DIRECTIONS` entry `name`."""
+    from wrist_env.anatomy.tendons import resultant_direction
+    from wrist_env.solver.simulate import AXIAL
+
+    if name not in LOAD_DIRECTIONS:
+        raise ValueError(f"load direction must be one of {LOAD_DIRECTIONS}, but got {name!r}")
+    return np.array(AXIAL) if name == "axial" else resultant_direction(name)
+
+
 def _failure(label, result) -> str | None:
     return None if result.ok else f"{label} run {result.message}"
 
@@ -256,11 +271,13 @@ def validate(
     n_frames: int = 17,
     params: BuildParams | None = None,
     load_n: float = IDEALIZED_LOAD_N,
+    load_direction: str = "axial",
 ) -> Report:
     """Run the published-measurement checks on participant `name` (population design by default).
 
     params: build parameters (`BuildParams`; the anatomy variant), default the default build.
     load_n: the compressive load (N) of the sweeps; the neutral pose takes `NEUTRAL_LOAD_N`.
+    load_direction: one of `LOAD_DIRECTIONS`, the loads' direction in the sweeps and at neutral.
     """
     from wrist_env.builder.pipeline import BuildParams
     from wrist_env.participants.registry import load_model
@@ -272,9 +289,12 @@ def validate(
     model = model if model is not None else load_model(name, params)
     intact_design = d if d is not None else design_mod.population()
     torn_design = with_tears(intact_design, SLIL)
-    sweep = sim.idealized(model, n_frames=n_frames, load_n=load_n)
+    direction = load_direction_rcs(load_direction)
+    sweep = sim.idealized(model, n_frames=n_frames, load_n=load_n, load_direction=direction)
     intact, torn = sim.simulate_batch(model, [intact_design, torn_design], sweep)
-    neutral = sim.simulate(model, intact_design, sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N))
+    neutral = sim.simulate(
+        model, intact_design, sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, load_direction=direction)
+    )
 
     b = {bone: BONES.index(bone) for bone in ("capitate", "scaphoid", "lunate")}
     rs, rl = PAIRS.index("radioscaphoid"), PAIRS.index("radiolunate")
@@ -388,6 +408,7 @@ def validate(
         "distal_row": params.anatomy[1],
         "fixed_ligaments": bool(params.fixed_ligaments and params.distal_row),
         "load_n": float(load_n),
+        "load_direction": load_direction,
     }
     return Report(model.name, rows, series, time.perf_counter() - start, conditions)
 
@@ -406,7 +427,8 @@ def format_table(report: Report) -> str:
         f"{report.participant}, population design: the model against published measurements"
         + (
             f" (fossa sweep ±{c['fossa_sweep_deg']} deg, distal row {'on' if c['distal_row'] else 'off'}, "
-            f"TC/TH {'on' if c.get('fixed_ligaments') else 'off'}, sweep load {c['load_n']:g} N)"
+            f"TC/TH {'on' if c.get('fixed_ligaments') else 'off'}, sweep load {c['load_n']:g} N, "
+            f"load direction {c.get('load_direction', 'axial')})"
             if c
             else ""
         ),

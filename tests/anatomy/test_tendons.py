@@ -131,3 +131,14 @@ def test_missing_site_names_the_file_and_the_site(tmp_path):
 def test_unknown_tendon_is_refused():
     with pytest.raises(BuildError, match="EDC2"):
         td.load_tendons({"EDC2": 5.0})
+
+
+def test_resultant_direction_is_the_rigs_resultant_as_a_unit_vector(tendons):
+    """The loaded driver's tendon direction: the "all" resultant normalized, within 15° of the radius'
+    axis (the tendons run along the forearm), and an unknown rig is refused by name."""
+    d = td.resultant_direction("erhart2020")
+    force = td.carpal_loads(tendons, 100.0)["all"].force
+    assert np.allclose(d, force / np.linalg.norm(force)) and np.isclose(np.linalg.norm(d), 1.0)
+    assert np.degrees(np.arccos(d[1])) < 15.0, d
+    with pytest.raises(ValueError, match="no_such_rig"):
+        td.resultant_direction("no_such_rig")

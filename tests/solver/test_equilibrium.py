@@ -3,6 +3,7 @@
 from dataclasses import replace
 
 import numpy as np
+import pytest
 from scipy.optimize import brentq
 from test_verification import EPSILON_L, OSCILLATORS, oscillator, undamped
 
@@ -11,7 +12,9 @@ from wrist_env.design import LIGAMENT_NAMES
 from wrist_env.participants import registry
 from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.equilibrium import nearest, tangent_stiffness
-from wrist_env.solver.simulate import experimental, idealized, simulate
+from wrist_env.anatomy.tendons import resultant_direction
+from wrist_env.model import CAPITATE
+from wrist_env.solver.simulate import AXIAL, experimental, idealized, loaded, simulate
 
 SCAPHOID = 2
 AXIS = np.array([1.0, 2.0, 2.0]) / 3.0
@@ -118,3 +121,29 @@ def test_population_trial_sits_in_a_stable_equilibrium_the_step_resolves(p1):
     assert s.asymmetry < 0.1, s.asymmetry
     assert np.all(np.isfinite(omega)) and omega[0] > 0.0, omega
     assert SolverSettings().dt_s < 2.0 / omega[-1], (SolverSettings().dt_s, 2.0 / omega[-1])
+
+
+def test_a_load_along_the_tendons_moves_the_distal_row_its_way_and_balances(p1):
+    """At neutral under 100 N along the Erhart rig's tendon resultant (dorsal and radial of the radius'
+    axis) the distal row sits, against the axial load, further along the load's off-axis part; the
+    Newton reference, which applies the same force, finds the explicit answer within 0.1 mm."""
+    tilted = resultant_direction("erhart2020")
+    runs = {}
+    for name, direction in (("axial", AXIAL), ("tendons", tilted)):
+        driver = loaded(p1, [np.eye(3)], load_n=100.0, load_direction=direction)
+        result = simulate(p1, design.population(), driver)
+        assert result.ok, result.message
+        runs[name] = (driver, result)
+    shift = runs["tendons"][1].poses[0, CAPITATE, :3, 3] - runs["axial"][1].poses[0, CAPITATE, :3, 3]
+    off_axis = tilted - (tilted @ np.array(AXIAL)) * np.array(AXIAL)
+    assert shift @ off_axis / np.linalg.norm(off_axis) > 0.05, (shift, off_axis)
+    driver, result = runs["tendons"]
+    eq = nearest(p1, design.population(), driver, result)
+    assert eq.distance[0, 0] < 0.1 and eq.distance[0, 1] < 0.5, eq.distance
+
+
+def test_a_load_direction_must_be_a_finite_nonzero_vector(p1):
+    assert np.allclose(loaded(p1, [np.eye(3)], 5.0, load_direction=(0.0, 2.0, 0.0)).load(0), (0.0, 5.0, 0.0))
+    for bad in ((0.0, 0.0, 0.0), (np.nan, 1.0, 0.0), (1.0, 0.0)):
+        with pytest.raises(ValueError, match="load_direction"):
+            loaded(p1, [np.eye(3)], 5.0, load_direction=bad)

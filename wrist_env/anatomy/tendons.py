@@ -26,6 +26,7 @@ total: the rig states its load as tendon weights, and the sum does not change wi
 
 from __future__ import annotations
 
+import functools
 import importlib.resources
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
@@ -223,3 +224,17 @@ def carpal_loads(tendons: Tendons, total_n: float, about=None) -> dict:
 def crossing(point: np.ndarray, direction: np.ndarray, y: float) -> np.ndarray:
     """Where the line through `point` (mm) along `direction` crosses the transverse plane at `y` (mm, RCS)."""
     return point + direction * ((y - point[1]) / direction[1])
+
+
+@functools.cache
+def _resultant_direction(rig: str) -> tuple:
+    force = carpal_loads(load_tendons(rig), 1.0)["all"].force
+    return tuple(force / np.linalg.norm(force))
+
+
+def resultant_direction(rig: str = "erhart2020") -> np.ndarray:
+    """The unit direction (3,) of the `rig`'s (a `RIGS` name) tendon resultant on the hand at
+    neutral, RCS: the loaded driver's `load_direction` for loads where the tendons put them."""
+    if rig not in RIGS:
+        raise ValueError(f"unknown tendon rig {rig!r}; known: {sorted(RIGS)}")
+    return np.array(_resultant_direction(rig))

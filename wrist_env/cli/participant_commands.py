@@ -221,9 +221,13 @@ def _validate(args) -> int:
     registry.require(args.participant)
     params = anatomy_params(args)
     report = validation.validate(
-        args.participant, params=params, load_n=IDEALIZED_LOAD_N if args.load is None else args.load
+        args.participant,
+        params=params,
+        load_n=IDEALIZED_LOAD_N if args.load is None else args.load,
+        load_direction=args.load_direction,
     )
-    variant = "" if params == BuildParams() and args.load is None else "_variant"
+    default = params == BuildParams() and args.load is None and args.load_direction == "axial"
+    variant = "" if default else "_variant"
     from wrist_env.figures.draw import FIGURES as figures_dir
 
     out = Path(args.out or figures_dir) / f"validation_{report.participant}{variant}.png"
@@ -358,6 +362,13 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         type=float,
         help="compressive load on the capitate in the sweeps, N (default: the idealized "
         "driver's; the load-share check always takes 100 N)",
+    )
+    s.add_argument(
+        "--load-direction",
+        choices=("axial", "erhart2020", "erhart2020_groups"),
+        default="axial",
+        help="the loads' direction: along the radius (default), or the resultant at neutral of a tendon "
+        "rig's tensions along myo-sim's tendon paths (Erhart 2020; see anatomy/tendons.py)",
     )
     s.set_defaults(run=_validate)
 

@@ -150,7 +150,7 @@ def _frame_args(p, design_stiffness, free_nodes, driver, result, f: int) -> tupl
         design_stiffness,
         p.membrane,
         p.settings,
-        float(driver.load_n[f]),
+        driver.load(f),
     )
 
 
@@ -280,9 +280,7 @@ def block_mass(
         R0.copy(), x0.copy(), np.zeros_like(x0), np.zeros_like(x0), nodes0.copy(), np.zeros_like(nodes0)
     )
     work = kernel.new_work(g, nodes0)
-    kernel._forces(
-        state, work, p.bodies, g, p.law, p.fibres, st, p.membrane, p.settings, float(driver.load_n[frame]), True
-    )
+    kernel._forces(state, work, p.bodies, g, p.law, p.fibres, st, p.membrane, p.settings, driver.load(frame), True)
     m = preconditioner.metric()
     preconditioner.tangent(
         state.R,

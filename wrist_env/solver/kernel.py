@@ -175,14 +175,15 @@ def _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, rebuild
     energy += e_mem
     bundle[RSC] += rsc
     if st.driver == LOADED:
-        F[CAPITATE, 1] += load
+        for i in range(3):
+            F[CAPITATE, i] += load[i]
     return energy
 
 
 @njit(cache=True, error_model="numpy")
 def _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step_index, fire, m, refresh):
     """One explicit step with the capitate at target (capR, capx), or, for the loaded
-    driver, at rotation capR under a compressive `load` (N, along +y); with st.block_mass and
+    driver, at rotation capR under the force `load` (3,) N, RCS; with st.block_mass and
     `refresh`, the block mass m (`preconditioner.Metric`) is rebuilt at this state first."""
     R, x, v, w, nodes, nv = state
     active, n_active, _, F, T, node_force, _, _ = work
@@ -360,7 +361,8 @@ Stiffness = namedtuple("Stiffness", ["f_l0", "f_K", "m_l0", "m_K", "node_mass"])
 membrane's free-node mass (t) its connectors need (`arrays.node_mass`)."""
 Frames = namedtuple("Frames", ["rotation", "com", "load"])
 """The capitate's targets per frame: rotation (n_frames, 3, 3), centre of mass (n_frames, 3) mm (for the
-loaded driver only the start: the centre is free), compressive load (n_frames,) N along +y."""
+loaded driver only the start: the centre is free), load (n_frames, 3) N, the force on the distal row
+(RCS; the loaded driver's only)."""
 Outputs = namedtuple(
     "Outputs", ["poses", "contact", "bundle", "energy", "residual", "steps", "settled", "nodes", "status"]
 )
@@ -377,7 +379,7 @@ SETTLE, MOVE = -2, -1
 @njit(cache=True, error_model="numpy")
 def _stage(f, R0, x0, frame_R, frame_x, frame_load, st):
     """Capitate targets of stage f (`SETTLE`, `MOVE` or a frame): start and end rotation, centre (mm)
-    and load (N), ramp steps, most hold steps."""
+    and load (3,) N, ramp steps, most hold steps."""
     if f == SETTLE:
         return R0, x0, frame_load[0], R0, x0, frame_load[0], 0, st.settle_steps
     if f == MOVE:
@@ -417,6 +419,7 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
     x0 = com0[CAPITATE].copy()
     fire = np.array([st.fire_alpha0, 0.0, 0.0])
     capR = np.eye(3)
+    load = np.zeros(3)
     m = metric()
     taken = 0
     for f in range(SETTLE, n_frames):
@@ -428,7 +431,8 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
         while k < ramp + most:
             s = smoothstep((k + 1) / ramp) if ramp > 0 else 1.0
             capx = interpolate_pose(Ra, xa, axis, capR, shift, s)
-            load = la + s * (lb - la)
+            for i in range(3):
+                load[i] = la[i] + s * (lb[i] - la[i])
             refresh = k % st.block_refresh_steps == 0 or fire[2] > 0.0
             fire[2] = 0.0
             _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step, fire, m, refresh)

@@ -3,14 +3,15 @@
 Drivers: `experimental(model, transforms)` prescribes all 6 DOF of the
 capitate from a trial's 4×4 transforms; `loaded(model, rotations, load_n)`
 prescribes its rotations and leaves its translations free under a
-compressive load; `idealized(model)` is the loaded driver ramping from
+compressive load (along the radius' axis, `AXIAL`, or any direction: the tendons' resultant is
+`anatomy.tendons.resultant_direction`); `idealized(model)` is the loaded driver ramping from
 maximum flexion to maximum extension about the RCS z axis.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numba
 import numpy as np
@@ -22,6 +23,7 @@ from wrist_env.model import BONES, Model
 from wrist_env.solver import arrays, kernel
 
 IDEALIZED_LOAD_N = 10.0  # compressive load that keeps the joint in contact (N)
+AXIAL = (0.0, 1.0, 0.0)  # the load along the radius' long axis, proximal (RCS +y)
 STATUS = {
     kernel.OK: "ok",
     kernel.FAILED_NAN: "failed: NaN in the state",
@@ -35,7 +37,8 @@ class Driver:
 
     mode: arrays.EXPERIMENTAL (all 6 DOF prescribed) or arrays.LOADED
     (rotations prescribed, translations free under `load_n`); load_n
-    (n_frames,) compressive load on the capitate along +y (proximal), N;
+    (n_frames,) compressive load on the distal row, N, along load_direction (3,), a unit
+    vector in the RCS (the same in every frame: the tendons pull along the forearm);
     angle_deg (n_frames,) the wrist flexion angle of each frame (idealized) or NaN.
     """
 
@@ -44,10 +47,17 @@ class Driver:
     com: np.ndarray
     angle_deg: np.ndarray
     load_n: np.ndarray
+    load_direction: np.ndarray = field(default_factory=lambda: np.array(AXIAL))
 
     @property
     def n_frames(self) -> int:
         return len(self.rotation)
+
+    def load(self, frame: int | None = None) -> np.ndarray:
+        """The force on the distal row (N, RCS): (3,) at `frame`, or (n_frames, 3)."""
+        if frame is None:
+            return np.ascontiguousarray(self.load_n[:, None] * self.load_direction)
+        return self.load_n[frame] * self.load_direction
 
 
 def experimental(model: Model, transforms: ArrayLike) -> Driver:
@@ -60,16 +70,29 @@ def experimental(model: Model, transforms: ArrayLike) -> Driver:
 
 
 def loaded(
-    model: Model, rotations: ArrayLike, load_n: ArrayLike = IDEALIZED_LOAD_N, angle_deg: ArrayLike | None = None
+    model: Model,
+    rotations: ArrayLike,
+    load_n: ArrayLike = IDEALIZED_LOAD_N,
+    angle_deg: ArrayLike | None = None,
+    load_direction: ArrayLike = AXIAL,
 ) -> Driver:
     """Capitate rotations (n_frames, 3, 3) prescribed, its translations free under a
-    compressive load `load_n` (N along +y; a scalar or one per frame)."""
+    compressive load `load_n` (N; a scalar or one per frame) along `load_direction` (3,), RCS."""
     rotation = np.ascontiguousarray(np.asarray(rotations, dtype=np.float64))
     n = len(rotation)
     com = np.tile(model.com[BONES.index("capitate")], (n, 1))
     load = np.broadcast_to(np.asarray(load_n, dtype=np.float64), (n,)).copy()
     angle = np.full(n, np.nan) if angle_deg is None else np.asarray(angle_deg, dtype=np.float64)
-    return Driver(arrays.LOADED, rotation, com, angle, load)
+    return Driver(arrays.LOADED, rotation, com, angle, load, _unit(load_direction))
+
+
+def _unit(direction: ArrayLike) -> np.ndarray:
+    """`direction` as a unit (3,) vector; a wrong shape, a non-finite or a zero vector is refused."""
+    d = np.asarray(direction, dtype=np.float64)
+    norm = float(np.linalg.norm(d)) if d.shape == (3,) else np.nan
+    if not np.isfinite(norm) or norm < 1e-9:
+        raise ValueError(f"load_direction must be a finite, non-zero (3,) vector (RCS), but got {direction!r}")
+    return d / norm
 
 
 def static(model: Model, n_frames: int = 3) -> Driver:
@@ -87,13 +110,15 @@ def idealized(
     n_frames: int = 17,
     angles_deg: ArrayLike | None = None,
     load_n: float = IDEALIZED_LOAD_N,
+    load_direction: ArrayLike = AXIAL,
 ) -> Driver:
     """Idealized flexion–extension (preprint 2.2.3.2): the capitate from `flexion_deg` of
     flexion to `extension_deg` of extension about the RCS z axis in `n_frames` equal steps
     (or through `angles_deg`, flexion +), other rotations held, translations free under
-    a small compressive load `load_n` (N)."""
+    a small compressive load `load_n` (N) along `load_direction` (RCS)."""
     angle = np.linspace(flexion_deg, -extension_deg, n_frames) if angles_deg is None else np.asarray(angles_deg, float)
-    return loaded(model, Rotation.from_euler("z", angle[:, None], degrees=True).as_matrix(), load_n, angle)
+    rotations = Rotation.from_euler("z", angle[:, None], degrees=True).as_matrix()
+    return loaded(model, rotations, load_n, angle, load_direction)
 
 
 @dataclass(frozen=True)
@@ -228,7 +253,7 @@ def simulate_batch(
     """Simulate many designs in parallel (Numba prange); same results as one at a time."""
     p = _prepared(model, settings, driver, prepared)
     per = [stiffness(p, d) for d in designs]
-    stacked = kernel.Stiffness(*(np.ascontiguousarray(np.stack(field)) for field in zip(*per)))
+    stacked = kernel.Stiffness(*(np.ascontiguousarray(np.stack(a)) for a in zip(*per)))
     out = _outputs(len(per), len(driver.rotation), len(model.membrane_nodes))
     previous = numba.set_parallel_chunksize(1)  # designs differ in cost: hand them out one at a time
     try:
@@ -240,7 +265,7 @@ def simulate_batch(
 
 def _run(entry, p: Prepared, stiffness: kernel.Stiffness, driver: Driver, out: kernel.Outputs) -> None:
     """Call a kernel entry point (`kernel.run` or `kernel.run_batch`) on prepared arrays; fills `out`."""
-    frames = kernel.Frames(driver.rotation, driver.com, driver.load_n)
+    frames = kernel.Frames(driver.rotation, driver.com, driver.load())
     entry(p.bodies, p.grids, p.law, p.fibres, stiffness, p.membrane, p.settings, frames, out)
 
 
