@@ -6,7 +6,7 @@ triquetrum with the lunate) with the neutral gaps of those samples to the opposi
 the force and share of each articulation (`model.ARTICULATIONS`: the midcarpal shares against
 Viegas 1993, the ulnar share against Palmer & Werner 1984) as `wrist-bench validate` checks them.
 Run: `python experiments/load_paths.py P1 [P2 ...] [--load-direction erhart2020]` (the load along the
-radius by default, or the tendon rig's resultant: `validation.LOAD_DIRECTIONS`).
+radius by default, or the tendon rig's resultant: `simulate.LOAD_DIRECTIONS`).
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from wrist_env.participants.registry import load_model
 from wrist_env.solver import simulate as sim
 from wrist_env.solver.contact import OUTSIDE_MM, sdf_lookup
 from wrist_env.solver.outputs import articulation_forces, pair_slice, pressure_map, sample_parts
-from wrist_env.validation import LOAD_DIRECTIONS, NEUTRAL_LOAD_N, load_direction_rcs, load_shares_pct
+from wrist_env.validation import NEUTRAL_LOAD_N, load_shares_pct
 
 
 def signed_distance(model, b: int, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -62,10 +62,10 @@ def part_gaps(name: str, model, poses) -> list[dict]:
 
 
 def main(names, load_direction: str = "axial") -> None:
-    direction = load_direction_rcs(load_direction)
+    direction = sim.load_direction(load_direction)
     for name in names:
         model = load_model(name)
-        driver = sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, load_direction=direction)
+        driver = sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=direction)
         result = sim.simulate(model, design.population(), driver)
         print(f"{name}, population design, neutral, {NEUTRAL_LOAD_N:g} N along {load_direction} {direction.round(3)}")
         print("| pair | part | force (N) | sample area (mm²) | neutral gap min / median (mm) |\n|---|---|---|---|---|")
@@ -88,6 +88,6 @@ def main(names, load_direction: str = "axial") -> None:
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("participants", nargs="*", default=["P1"])
-    parser.add_argument("--load-direction", choices=LOAD_DIRECTIONS, default="axial")
+    parser.add_argument("--load-direction", choices=sim.LOAD_DIRECTIONS, default="axial")
     args = parser.parse_args()
     main(args.participants, args.load_direction)

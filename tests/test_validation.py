@@ -149,16 +149,17 @@ def test_builtins_move_like_a_wrist(name, built):
 
 
 def test_load_directions_are_the_clis_choices_and_unit_vectors():
-    """`--load-direction` offers exactly `validation.LOAD_DIRECTIONS`; each is a unit vector pulling
-    proximally, the axial one the radius' axis, and another name is refused by name."""
+    """`validate --load-direction` offers exactly `simulate.LOAD_DIRECTIONS`; each is a unit vector
+    pulling proximally, the axial one the radius' axis, and another name is refused by name."""
     from wrist_env.cli import parser
+    from wrist_env.solver import simulate
 
     validate = parser()._subparsers._group_actions[0].choices["validate"]
     option = next(a for a in validate._actions if "--load-direction" in a.option_strings)
-    assert tuple(option.choices) == validation.LOAD_DIRECTIONS and option.default == "axial"
-    for name in validation.LOAD_DIRECTIONS:
-        d = validation.load_direction_rcs(name)
+    assert tuple(option.choices) == simulate.LOAD_DIRECTIONS and option.default == "axial"
+    for name in simulate.LOAD_DIRECTIONS:
+        d = simulate.load_direction(name)
         assert np.isclose(np.linalg.norm(d), 1.0) and d[1] > 0.95, (name, d)
-    assert np.array_equal(validation.load_direction_rcs("axial"), [0.0, 1.0, 0.0])
+    assert np.array_equal(simulate.load_direction("axial"), [0.0, 1.0, 0.0])
     with pytest.raises(ValueError, match="sideways"):
-        validation.load_direction_rcs("sideways")
+        simulate.load_direction("sideways")

@@ -244,21 +244,6 @@ def load_shares_pct(model: Model, result) -> dict[str, float]:
     return out
 
 
-LOAD_DIRECTIONS = ("axial", "erhart2020", "erhart2020_groups")
-"""The loads' directions: along the radius' axis (RCS +y, the default), or the resultant of a tendon rig
-(`anatomy.tendons.RIGS`) on the hand at neutral, where the tendons put it."""
-
-
-def load_direction_rcs(name: str) -> np.ndarray:
-    """The unit direction (3,) RCS of `LOAD_DIRECTIONS` entry `name`."""
-    from wrist_env.anatomy.tendons import resultant_direction
-    from wrist_env.solver.simulate import AXIAL
-
-    if name not in LOAD_DIRECTIONS:
-        raise ValueError(f"load direction must be one of {LOAD_DIRECTIONS}, but got {name!r}")
-    return np.array(AXIAL) if name == "axial" else resultant_direction(name)
-
-
 def _failure(label, result) -> str | None:
     return None if result.ok else f"{label} run {result.message}"
 
@@ -277,7 +262,7 @@ def validate(
 
     params: build parameters (`BuildParams`; the anatomy variant), default the default build.
     load_n: the compressive load (N) of the sweeps; the neutral pose takes `NEUTRAL_LOAD_N`.
-    load_direction: one of `LOAD_DIRECTIONS`, the loads' direction in the sweeps and at neutral.
+    load_direction: the loads' direction in the sweeps and at neutral (`simulate.LOAD_DIRECTIONS`).
     """
     from wrist_env.builder.pipeline import BuildParams
     from wrist_env.participants.registry import load_model
@@ -289,11 +274,11 @@ def validate(
     model = model if model is not None else load_model(name, params)
     intact_design = d if d is not None else design_mod.population()
     torn_design = with_tears(intact_design, SLIL)
-    direction = load_direction_rcs(load_direction)
-    sweep = sim.idealized(model, n_frames=n_frames, load_n=load_n, load_direction=direction)
+    direction = sim.load_direction(load_direction)
+    sweep = sim.idealized(model, n_frames=n_frames, load_n=load_n, direction=direction)
     intact, torn = sim.simulate_batch(model, [intact_design, torn_design], sweep)
     neutral = sim.simulate(
-        model, intact_design, sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, load_direction=direction)
+        model, intact_design, sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=direction)
     )
 
     b = {bone: BONES.index(bone) for bone in ("capitate", "scaphoid", "lunate")}

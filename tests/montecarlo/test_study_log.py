@@ -15,7 +15,9 @@ from wrist_env.montecarlo.study import counts
 CONFIG = StudyConfig(("P1",), n=10, seed=0)
 
 
-def _fake_chunk(participant, sample_ids, blocks, actions, *, exclude_above_mpa=16.5, folders=()):
+def _fake_chunk(
+    participant, sample_ids, blocks, actions, *, exclude_above_mpa=16.5, folders=(), load_direction="axial"
+):
     """`sampler.run_chunk`'s rows without simulating: every run ok, its outputs a function of its action."""
     actions = np.asarray(actions, dtype=np.float64)
     k = len(actions)
@@ -119,3 +121,16 @@ def test_sizes_are_refused_before_anything_is_allocated(tmp_path, capsys):
         status, err = _cli(capsys, "montecarlo", "P1", argv, value, "--out", str(tmp_path / "x"), "--no-progress")
         assert status == 2 and err.count("\n") == 1 and value in err, (argv, err)
     assert not (tmp_path / "x" / "runs").exists()
+
+
+def test_a_resume_under_another_load_direction_is_refused(study):
+    """The load direction decides every run: a study logged under the axial load does not resume under
+    the tendons' (its key names the direction only when not the axial default, so older logs resume)."""
+    out, _ = study
+    assert "load_direction" not in CONFIG.key()
+    tendons = StudyConfig(("P1",), n=10, seed=0, load_direction="erhart2020")
+    assert tendons.key()["load_direction"] == "erhart2020"
+    with pytest.raises(StudyError, match="load_direction"):
+        run_study(tendons, out, batch=4)
+    with pytest.raises(StudyError, match="sideways"):
+        StudyConfig(("P1",), n=10, load_direction="sideways")

@@ -8,12 +8,12 @@ from scipy.optimize import brentq
 from test_verification import EPSILON_L, OSCILLATORS, oscillator, undamped
 
 from wrist_env import design
+from wrist_env.anatomy.tendons import resultant_direction
 from wrist_env.design import LIGAMENT_NAMES
+from wrist_env.model import CAPITATE
 from wrist_env.participants import registry
 from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.equilibrium import nearest, tangent_stiffness
-from wrist_env.anatomy.tendons import resultant_direction
-from wrist_env.model import CAPITATE
 from wrist_env.solver.simulate import AXIAL, experimental, idealized, loaded, simulate
 
 SCAPHOID = 2
@@ -130,7 +130,7 @@ def test_a_load_along_the_tendons_moves_the_distal_row_its_way_and_balances(p1):
     tilted = resultant_direction("erhart2020")
     runs = {}
     for name, direction in (("axial", AXIAL), ("tendons", tilted)):
-        driver = loaded(p1, [np.eye(3)], load_n=100.0, load_direction=direction)
+        driver = loaded(p1, [np.eye(3)], load_n=100.0, direction=direction)
         result = simulate(p1, design.population(), driver)
         assert result.ok, result.message
         runs[name] = (driver, result)
@@ -143,7 +143,7 @@ def test_a_load_along_the_tendons_moves_the_distal_row_its_way_and_balances(p1):
 
 
 def test_a_load_direction_must_be_a_finite_nonzero_vector(p1):
-    assert np.allclose(loaded(p1, [np.eye(3)], 5.0, load_direction=(0.0, 2.0, 0.0)).load(0), (0.0, 5.0, 0.0))
-    for bad in ((0.0, 0.0, 0.0), (np.nan, 1.0, 0.0), (1.0, 0.0)):
+    assert np.allclose(loaded(p1, [np.eye(3)], 5.0, direction=(0.0, 2.0, 0.0)).load(0), (0.0, 5.0, 0.0))
+    for bad in ((0.0, 0.0, 0.0), (np.nan, 1.0, 0.0), (1.0, 0.0), "sideways"):
         with pytest.raises(ValueError, match="load_direction"):
-            loaded(p1, [np.eye(3)], 5.0, load_direction=bad)
+            loaded(p1, [np.eye(3)], 5.0, direction=bad)

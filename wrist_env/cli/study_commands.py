@@ -138,7 +138,9 @@ def _montecarlo(args) -> int:
     from wrist_env.participants import registry
 
     registry.require(*args.participants)
-    config = StudyConfig(tuple(args.participants), args.n, args.seed, args.tear_probability)
+    config = StudyConfig(
+        tuple(args.participants), args.n, args.seed, args.tear_probability, load_direction=args.load_direction
+    )
     where = (
         f"the dask scheduler {args.scheduler}"
         if args.scheduler
@@ -148,6 +150,7 @@ def _montecarlo(args) -> int:
     )
     print(
         f"Monte Carlo: {', '.join(config.participants)}, {config.n:,} successful runs each, seed {config.seed}, "
+        f"load {config.load_direction}, "
         f"batch {args.batch}, on {where}; run log {args.out}",
         flush=True,
     )
@@ -286,6 +289,12 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         type=float,
         default=TEAR_PROBABILITY,
         help=f"chance of each tear (default {TEAR_PROBABILITY:g})",
+    )
+    s.add_argument(
+        "--load-direction",
+        choices=("axial", "erhart2020", "erhart2020_groups"),
+        default="axial",
+        help="the sweeps' load: along the radius (default), or a tendon rig's resultant (see validate)",
     )
     s.add_argument("--out", default="runs/montecarlo", help="run-log folder (default runs/montecarlo)")
     s.add_argument("--scheduler", help="dask.distributed scheduler address (e.g. tcp://host:8786); one task per batch")

@@ -21,7 +21,16 @@ from wrist_env.model import BONES, PAIRS, Model
 from wrist_env.participants import builtin, registry
 from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.forces import CONTACT_FIELDS
-from wrist_env.solver.simulate import Driver, Result, experimental, idealized, prepare, simulate, simulate_batch
+from wrist_env.solver.simulate import (
+    LOAD_DIRECTIONS,
+    Driver,
+    Result,
+    experimental,
+    idealized,
+    prepare,
+    simulate,
+    simulate_batch,
+)
 
 MOTIONS = ("calibrate", "validate", "idealized")
 
@@ -40,7 +49,9 @@ class Evaluation:
 class Task:
     """Participant × motion: "calibrate" (unresisted trial), "validate" (held-out resisted
     trial) or "idealized" (flexion–extension sweep; reference = the hidden truth's
-    sweep for built-in participants, none for user participants → reward 0)."""
+    sweep for built-in participants, none for user participants → reward 0).
+    load_direction: the idealized sweep's load direction (`simulate.LOAD_DIRECTIONS`); the
+    trials' capitate is prescribed, so the other motions take only "axial"."""
 
     def __init__(
         self,
@@ -49,10 +60,16 @@ class Task:
         *,
         settings: SolverSettings | None = None,
         weights: CostWeights | None = None,
+        load_direction: str = "axial",
     ):
         if motion not in MOTIONS:
             raise ValueError(f"motion must be one of {MOTIONS}, but got {motion!r}")
-        self.participant, self.motion = participant, motion
+        if load_direction not in LOAD_DIRECTIONS or (motion != "idealized" and load_direction != "axial"):
+            raise ValueError(
+                f"load_direction must be one of {LOAD_DIRECTIONS} (the idealized motion's; the trials take "
+                f"'axial'), but got {load_direction!r} for motion {motion!r}"
+            )
+        self.participant, self.motion, self.load_direction = participant, motion, load_direction
         self.settings, self.weights = settings, weights
         self.model: Model = registry.load_model(participant)
         self.driver, self.reference = self._driver_and_reference()
@@ -61,7 +78,7 @@ class Task:
 
     def _driver_and_reference(self) -> tuple[Driver, np.ndarray | None]:
         if self.motion == "idealized":
-            driver = idealized(self.model)
+            driver = idealized(self.model, direction=self.load_direction)
             if self.participant not in builtin.BUILTIN:
                 return driver, None
             truth = simulate(self.model, builtin.truth(self.participant), driver, self.settings)
@@ -136,6 +153,7 @@ def _zero_undefined(per_bone: dict) -> dict:
 
 
 @functools.lru_cache(maxsize=32)
-def task(participant: str, motion: str) -> Task:
-    """A shared Task per participant and motion with default settings (models are big; build once)."""
-    return Task(participant, motion)
+def task(participant: str, motion: str, load_direction: str = "axial") -> Task:
+    """A shared Task per participant, motion and load direction with default settings (models are big;
+    build once)."""
+    return Task(participant, motion, load_direction=load_direction)

@@ -31,16 +31,17 @@ class WristEnv(gym.Env):
     """Calibrate, validate or sweep one participant (see `wrist_env.envs.task.Task`).
 
     participant: a registered participant name; motion: "calibrate",
-    "validate" or "idealized". info: cost, per-DOF 75th-percentile errors and
+    "validate" or "idealized"; load_direction: the idealized sweep's load
+    (`simulate.LOAD_DIRECTIONS`, default "axial"). info: cost, per-DOF 75th-percentile errors and
     RMSE (mm, deg), per-frame contact (MPa, mm², N), bundle forces (N),
     energies (N·mm), poses, and `failed` — deterministic, NaN-free.
     """
 
     metadata = {"render_modes": []}
 
-    def __init__(self, participant: str = "P1", motion: str = "calibrate"):
+    def __init__(self, participant: str = "P1", motion: str = "calibrate", load_direction: str = "axial"):
         self.participant, self.motion = participant, motion
-        self.task = task(participant, motion)
+        self.task = task(participant, motion, load_direction)
         self.action_space, self.observation_space = _spaces()
 
     def reset(self, *, seed: int | None = None, options: dict | None = None) -> tuple[np.ndarray, dict]:
@@ -65,10 +66,12 @@ class WristVectorEnv(VectorEnv):
 
     metadata = {"autoreset_mode": AutoresetMode.SAME_STEP, "render_modes": []}
 
-    def __init__(self, num_envs: int = 1, participant: str = "P1", motion: str = "calibrate", **_):
+    def __init__(
+        self, num_envs: int = 1, participant: str = "P1", motion: str = "calibrate", load_direction: str = "axial", **_
+    ):
         self.num_envs = check_int("num_envs", num_envs, 1, MAX_BATCH)
         self.participant, self.motion = participant, motion
-        self.task = task(participant, motion)
+        self.task = task(participant, motion, load_direction)
         self.single_action_space, self.single_observation_space = _spaces()
         self.action_space = gym.vector.utils.batch_space(self.single_action_space, self.num_envs)
         self.observation_space = gym.vector.utils.batch_space(self.single_observation_space, self.num_envs)

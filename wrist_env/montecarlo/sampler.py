@@ -146,17 +146,21 @@ def block_actions(
 _ENVS: dict = {}
 
 
-def vector_env(participant: str, num_envs: int) -> VectorEnv:
-    """The participant's Idealized vector env with `num_envs` slots (one per process and size)."""
+def vector_env(participant: str, num_envs: int, load_direction: str = "axial") -> VectorEnv:
+    """The participant's Idealized vector env with `num_envs` slots under `load_direction`
+    (`simulate.LOAD_DIRECTIONS`; one per process, size and direction)."""
     import gymnasium as gym
 
     from wrist_env.envs import env_id, register_ids
 
-    key = (participant, int(num_envs))
+    key = (participant, int(num_envs), load_direction)
     if key not in _ENVS:
         register_ids(participant, ("idealized",))
         env = gym.make_vec(
-            env_id(participant, "idealized"), num_envs=int(num_envs), vectorization_mode="vector_entry_point"
+            env_id(participant, "idealized"),
+            num_envs=int(num_envs),
+            vectorization_mode="vector_entry_point",
+            load_direction=load_direction,
         )
         env.reset(seed=0)
         _ENVS[key] = env
@@ -181,11 +185,13 @@ def run_chunk(
     *,
     exclude_above_mpa: float = EXCLUDE_ABOVE_MPA,
     folders: Iterable[str | Path] = (),
+    load_direction: str = "axial",
 ) -> pa.Table:
     """Simulate k runs (actions of shape (k, 27)) in one vector-env step; their log rows (`SCHEMA`).
 
     Runs wherever it is called: in this process, a local worker process or a dask worker
-    (`folders`: user participant folders to register there first).
+    (`folders`: user participant folders to register there first). load_direction: the sweep's
+    load (`simulate.LOAD_DIRECTIONS`).
     """
     if folders:
         from wrist_env.participants import registry
@@ -194,7 +200,7 @@ def run_chunk(
             registry.ensure_folder(folder)
     actions = np.asarray(actions, dtype=np.float64)
     k = len(actions)
-    env = vector_env(participant, k)
+    env = vector_env(participant, k, load_direction)
     _, _, _, _, infos = env.step(actions)
     angle = np.asarray(env.unwrapped.task.driver.angle_deg, dtype=np.float64)
     n_frames = len(angle)

@@ -47,6 +47,7 @@ from wrist_env.limits import MAX_BATCH, MAX_RUNS, MAX_SEED, MAX_WORKERS, check_i
 from wrist_env.montecarlo import sampler
 from wrist_env.runs.executor import executor
 from wrist_env.runs.store import RunStore
+from wrist_env.solver.simulate import LOAD_DIRECTIONS
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -71,6 +72,8 @@ class StudyConfig:
     exclude_above_mpa: float = sampler.EXCLUDE_ABOVE_MPA
     max_attempts: int | None = None
     """Give up (StudyError) after this many runs of one participant; default 5 n + 100."""
+    load_direction: str = "axial"
+    """The sweeps' load direction (`simulate.LOAD_DIRECTIONS`): along the radius, or a tendon rig's."""
 
     def __post_init__(self):
         object.__setattr__(self, "participants", tuple(self.participants))
@@ -81,20 +84,23 @@ class StudyConfig:
         check_int("seed", self.seed, 0, MAX_SEED)
         if not 0.0 <= self.tear_probability <= 1.0:
             raise StudyError(f"tear_probability must be in [0, 1], but got {self.tear_probability}")
+        if self.load_direction not in LOAD_DIRECTIONS:
+            raise StudyError(f"load_direction must be one of {LOAD_DIRECTIONS}, but got {self.load_direction!r}")
 
     @property
     def attempt_limit(self) -> int:
         return int(self.max_attempts) if self.max_attempts is not None else 5 * int(self.n) + 100
 
     def key(self) -> dict:
-        """The fields that must match to resume a study in the same folder."""
+        """The fields that must match to resume a study in the same folder (the load direction only when
+        not the axial default, so that a study logged before it existed resumes)."""
         return {
             "version": VERSION,
             "n": int(self.n),
             "seed": int(self.seed),
             "tear_probability": float(self.tear_probability),
             "exclude_above_mpa": float(self.exclude_above_mpa),
-        }
+        } | ({} if self.load_direction == "axial" else {"load_direction": self.load_direction})
 
 
 @dataclass
@@ -438,6 +444,7 @@ def _run_locked(
                                 block[rows],
                                 exclude_above_mpa=config.exclude_above_mpa,
                                 folders=folders,
+                                load_direction=config.load_direction,
                             )
                         )
                 for _, table, error in ex.results(tasks):

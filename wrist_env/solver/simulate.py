@@ -74,20 +74,35 @@ def loaded(
     rotations: ArrayLike,
     load_n: ArrayLike = IDEALIZED_LOAD_N,
     angle_deg: ArrayLike | None = None,
-    load_direction: ArrayLike = AXIAL,
+    direction: str | ArrayLike = "axial",
 ) -> Driver:
     """Capitate rotations (n_frames, 3, 3) prescribed, its translations free under a
-    compressive load `load_n` (N; a scalar or one per frame) along `load_direction` (3,), RCS."""
+    compressive load `load_n` (N; a scalar or one per frame) along `direction` (a `LOAD_DIRECTIONS`
+    name or a (3,) vector, RCS)."""
     rotation = np.ascontiguousarray(np.asarray(rotations, dtype=np.float64))
     n = len(rotation)
     com = np.tile(model.com[BONES.index("capitate")], (n, 1))
     load = np.broadcast_to(np.asarray(load_n, dtype=np.float64), (n,)).copy()
     angle = np.full(n, np.nan) if angle_deg is None else np.asarray(angle_deg, dtype=np.float64)
-    return Driver(arrays.LOADED, rotation, com, angle, load, _unit(load_direction))
+    return Driver(arrays.LOADED, rotation, com, angle, load, load_direction(direction))
 
 
-def _unit(direction: ArrayLike) -> np.ndarray:
-    """`direction` as a unit (3,) vector; a wrong shape, a non-finite or a zero vector is refused."""
+LOAD_DIRECTIONS = ("axial", "erhart2020", "erhart2020_groups")
+"""Named load directions: "axial", along the radius' long axis (`AXIAL`), or the resultant on the hand
+at neutral of a tendon rig (`anatomy.tendons.RIGS`), the loads where the tendons put them."""
+
+
+def load_direction(direction: str | ArrayLike) -> np.ndarray:
+    """The unit load direction (3,) RCS of a `LOAD_DIRECTIONS` name or a (3,) vector; a wrong name or
+    shape, a non-finite or a zero vector is refused."""
+    if isinstance(direction, str):
+        if direction not in LOAD_DIRECTIONS:
+            raise ValueError(f"load_direction must be one of {LOAD_DIRECTIONS} or a (3,) vector, but got {direction!r}")
+        if direction == "axial":
+            return np.array(AXIAL)
+        from wrist_env.anatomy.tendons import resultant_direction
+
+        return resultant_direction(direction)
     d = np.asarray(direction, dtype=np.float64)
     norm = float(np.linalg.norm(d)) if d.shape == (3,) else np.nan
     if not np.isfinite(norm) or norm < 1e-9:
@@ -110,15 +125,15 @@ def idealized(
     n_frames: int = 17,
     angles_deg: ArrayLike | None = None,
     load_n: float = IDEALIZED_LOAD_N,
-    load_direction: ArrayLike = AXIAL,
+    direction: str | ArrayLike = "axial",
 ) -> Driver:
     """Idealized flexion–extension (preprint 2.2.3.2): the capitate from `flexion_deg` of
     flexion to `extension_deg` of extension about the RCS z axis in `n_frames` equal steps
     (or through `angles_deg`, flexion +), other rotations held, translations free under
-    a small compressive load `load_n` (N) along `load_direction` (RCS)."""
+    a small compressive load `load_n` (N) along `direction` (see `loaded`)."""
     angle = np.linspace(flexion_deg, -extension_deg, n_frames) if angles_deg is None else np.asarray(angles_deg, float)
     rotations = Rotation.from_euler("z", angle[:, None], degrees=True).as_matrix()
-    return loaded(model, rotations, load_n, angle, load_direction)
+    return loaded(model, rotations, load_n, angle, direction)
 
 
 @dataclass(frozen=True)
