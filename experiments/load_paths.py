@@ -4,7 +4,8 @@ For each participant (population design, capitate held at neutral under the vali
 the contact force on each bone of each contact pair's sample body (the distal row's parts, the
 triquetrum with the lunate) with the neutral gaps of those samples to the opposing surface, then
 the force and share of each articulation (`model.ARTICULATIONS`: the midcarpal shares against
-Viegas 1993, the ulnar share against Palmer & Werner 1984) as `wrist-bench validate` checks them.
+Viegas 1993, the ulnar share against Palmer & Werner 1984) as `wrist-bench validate` checks them,
+and the space a TFCC would fill (`ulnocarpal_space`).
 Run: `python experiments/load_paths.py P1 [P2 ...] [--load-direction erhart2020]` (the load along the
 radius by default, or the tendon rig's resultant: `simulate.LOAD_DIRECTIONS`).
 """
@@ -61,6 +62,32 @@ def part_gaps(name: str, model, poses) -> list[dict]:
     return rows
 
 
+HEAD_WIDTH_MM = 8.0  # the ulnar head beside the sigmoid notch: up to this far ulnar of the radius' ulnar corner
+
+
+def ulnocarpal_space(model) -> dict:
+    """Where a TFCC would sit, at neutral: the closest approach (mm) of the lunate and of the triquetrum
+    to the ulna's surface, and the ulnar variance (mm, + ulna plus): the radius' ulnar corner (its most
+    ulnar vertex within 6 mm of the RCS origin along y) minus the most distal point of the ulnar head
+    (ulna vertices up to `HEAD_WIDTH_MM` ulnar of that corner, which leaves out the styloid), along y."""
+    import trimesh
+
+    def body(b):
+        lo, hi = model.vertex_offsets[b], model.vertex_offsets[b + 1]
+        faces = model.faces[model.face_offsets[b] : model.face_offsets[b + 1]]
+        return model.vertices[lo:hi], faces, model.vertex_part[lo:hi]
+
+    radius_v, _, _ = body(BONES.index("radius"))
+    ulna_v, ulna_f, _ = body(BONES.index("ulna"))
+    lunate_v, _, part = body(BONES.index("lunate"))
+    _, distance, _ = trimesh.proximity.closest_point(trimesh.Trimesh(ulna_v, ulna_f, process=False), lunate_v)
+    rim = radius_v[radius_v[:, 1] < 6.0]
+    corner = rim[np.argmin(rim[:, 2])]
+    head = ulna_v[(ulna_v[:, 2] <= corner[2]) & (ulna_v[:, 2] >= corner[2] - HEAD_WIDTH_MM)]
+    out = {f"{p}_to_ulna_mm": float(distance[part == q].min()) for q, p in enumerate(BODY_PARTS["lunate"])}
+    return out | {"ulnar_variance_mm": float(corner[1] - head[:, 1].min())}
+
+
 def main(names, load_direction: str = "axial") -> None:
     direction = sim.load_direction(load_direction)
     for name in names:
@@ -79,6 +106,11 @@ def main(names, load_direction: str = "axial") -> None:
         for joint, force in forces.items():
             share = f"{shares[joint]:.1f}" if joint in shares else ""
             print(f"| {joint} | {force:.2f} | {share} |")
+        space = ulnocarpal_space(model)
+        print(
+            f"\nulnocarpal space: lunate {space['lunate_to_ulna_mm']:.2f} mm and triquetrum "
+            f"{space['triquetrum_to_ulna_mm']:.2f} mm from the ulna; ulnar variance {space['ulnar_variance_mm']:+.2f} mm"
+        )
         rs, rl = forces["radioscaphoid"], forces["radiolunate"]
         print(
             f"\nRS/RL force ratio {rs / rl:.2f}; midcarpal shares of the four midcarpal joints, ulnocarpal of RS + RL + ulnocarpal\n"
