@@ -96,16 +96,18 @@ def test_batch_equals_one_at_a_time(p1):
         np.testing.assert_array_equal(one.contact, b.contact)
 
 
-@pytest.mark.parametrize("solver", ["default", "block mass"])
+@pytest.mark.parametrize("solver", ["default", "block mass", "tendons' load"])
 def test_random_designs_across_the_bounds_never_raise(p1, solver):
-    """Designs across the full bounds, tears included, with either solver: no exception, no NaN in a
-    run reported ok, every failure flagged with NaN outputs and a message."""
+    """Designs across the full bounds, tears included, with either solver or under the tendons' load
+    direction: no exception, no NaN in a run reported ok, every failure flagged with NaN outputs and a
+    message."""
     from wrist_env.solver.arrays import SolverSettings
 
     rng = np.random.default_rng(11)
     designs = [design.from_action(a) for a in rng.uniform(-1, 1, (1000, 27))]
     settings = SolverSettings().preconditioned() if solver == "block mass" else None
-    results = simulate_batch(p1, designs, idealized(p1, n_frames=9), settings)
+    direction = "erhart2020" if solver == "tendons' load" else "axial"
+    results = simulate_batch(p1, designs, idealized(p1, n_frames=9, direction=direction), settings)
     assert any(d.torn.any() for d in designs)
     for r in results:
         if r.ok:
