@@ -182,7 +182,8 @@ def part_settings(store: RunStore, name: str) -> dict | None:
 
 
 def _differences(old: dict, key: dict) -> str:
-    return ", ".join(f"{k} {old.get(k)!r} (asked {key[k]!r})" for k in key if old.get(k) != key[k])
+    old, key = _settings(old), _settings(key)
+    return ", ".join(f"{k} {old[k]!r} (asked {key[k]!r})" for k in sorted(key) if old[k] != key[k])
 
 
 def check_settings(out: str | Path, config: StudyConfig) -> None:
@@ -197,7 +198,7 @@ def check_settings(out: str | Path, config: StudyConfig) -> None:
             continue
         if settings is None:
             unrecorded.append(name)
-        elif settings != key:
+        elif _settings(settings) != _settings(key):
             raise StudyError(
                 f"{store.part_path(name)}: its runs were made with other settings ({_differences(settings, key)}); "
                 "use another --out or the same settings"
@@ -269,13 +270,19 @@ def read_runs(out: str | Path, columns: list[str] | None = None) -> pa.Table | N
     return table
 
 
+def _settings(key: dict) -> dict:
+    """A study key's fields with the load direction filled in (a key leaves out the axial default)."""
+    fields = set(StudyConfig(("-",), 1).key()) | {"load_direction"}
+    return {k: key.get(k, "axial" if k == "load_direction" else None) for k in fields}
+
+
 def _manifest(out: Path, config: StudyConfig) -> None:
     path = out / MANIFEST
     key = config.key()
     participants = list(config.participants)
     if path.is_file():
         old = read_json(path, "study manifest", "it records the study's settings: restore it, or use another --out")
-        if {k: old.get(k) for k in key} != key:
+        if _settings(old) != _settings(key):
             raise StudyError(
                 f"{out} holds another study ({_differences(old, key)}); use another --out or the same settings"
             )
@@ -477,7 +484,12 @@ def config_of(out: str | Path, participants: Sequence[str] | None = None) -> Stu
     """The StudyConfig recorded in a study folder (optionally for other participants)."""
     m = read_manifest(out)
     return StudyConfig(
-        tuple(participants or m["participants"]), m["n"], m["seed"], m["tear_probability"], m["exclude_above_mpa"]
+        tuple(participants or m["participants"]),
+        m["n"],
+        m["seed"],
+        m["tear_probability"],
+        m["exclude_above_mpa"],
+        load_direction=m.get("load_direction", "axial"),
     )
 
 
