@@ -210,3 +210,27 @@ def test_report_writes_tables_and_figures(reference, tmp_path):
     t5 = pd.read_csv(tmp_path / "table5.csv")
     assert list(t5["term"]) == ["Intercept", "s1", "s2", "SLIL_v", "SLIL_p", "SLIL_d", "RSC", "LRL"]
     assert "| Ligament injury | Volar SLIL |" in (tmp_path / "table5.md").read_text()
+
+
+def test_report_sets_the_preprints_tables_beside_ours_and_compares_signs(reference, tmp_path):
+    """report.md and summary.json carry the preprint's Tables 5-6 estimates beside ours: every injury
+    row has both, its sign verdict follows the two estimates' signs, and the spline's rows have none."""
+    import json
+
+    from wrist_env.montecarlo.report import PREPRINT_TABLE5, write_report
+
+    out, _ = reference
+    write_report(out, tmp_path)
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    rows = {r["term"]: r for r in summary["beside_preprint"]["table5"]}
+    assert set(rows) == set(PREPRINT_TABLE5)
+    for term, r in rows.items():
+        assert r["preprint_estimate"] == PREPRINT_TABLE5[term][0]
+        if term in ("Intercept", "s1", "s2"):
+            assert r["sign"] is None
+        else:
+            agree = (r["preprint_estimate"] > 0) == (r["estimate"] > 0)
+            assert r["sign"] == ("same" if agree else "differs"), r
+    text = (tmp_path / "report.md").read_text()
+    assert "## Beside the preprint" in text and "| RSC | 0.304 | 0.005 |" in text
+    assert summary["study"]["load_direction"] == "axial"

@@ -226,7 +226,7 @@ def _report_md(s: dict, t5: stats.Fit, t6: stats.Fit | None) -> str:
         "## Beside the preprint",
         "",
         "Its Tables 5–6 (GLME) and ours; the angle spline's basis need not be the preprint's, so the signs "
-        "of the injury and ligament rows are compared, not the spline's.",
+        "of the injury and ligament rows are compared (whatever their significance), not the spline's.",
         "",
         "Table 5, radioscaphoid mean pressure:",
         "",
@@ -235,8 +235,11 @@ def _report_md(s: dict, t5: stats.Fit, t6: stats.Fit | None) -> str:
     ]
     if beside["table6"] is not None:
         lines += ["Table 6, SLIL bundle forces (base: dorsal SLIL):", "", _beside_md(beside["table6"], "N"), ""]
-    differs = [r["parameter"] for t in beside.values() if t for r in t if r["sign"] == "differs"]
-    lines += [f"Signs that differ: {', '.join(differs) if differs else 'none'}.", ""]
+    for name, rows in beside.items():
+        if rows is not None:
+            differs = [r["parameter"] for r in rows if r["sign"] == "differs"]
+            lines.append(f"Signs that differ, {name}: {', '.join(differs) if differs else 'none'}.")
+    lines.append("")
     n = s["numbers"]
     lines += [
         f"## At {-n['angle_deg']:.0f}° extension",
