@@ -31,7 +31,7 @@ Settings = namedtuple(
     "Settings",
     "dt settle_steps move_steps ramp_steps min_hold_steps max_hold_steps tolerance force_floor damping rot_damping fibre_damping_s "
     "active_band_mm node_mass membrane_contact_stiffness driver max_disp_mm max_rot_rad fire_alpha0 smooth_normals "
-    "block_mass block_courant block_floor block_refresh_steps block_max_move_mm",
+    "block_mass block_courant block_floor block_refresh_steps block_max_move_mm membrane_substeps membrane_substep_damping block_refresh_restart predict predict_ramp_steps",
 )
 
 RSC = RSC_INDEX
@@ -55,11 +55,18 @@ class SolverSettings:
     exactly: `experiments/solver_accuracy.py`).
     block_mass: one 6×6 mass block per free bone (3×3 for the loaded capitate)
     from the force kernels' tangent (`preconditioner`), rebuilt every
-    block_refresh_steps, at each stage and after each FIRE restart; its
-    stiffest mode at dt·ω = block_courant, each bone's soft directions
-    floored at block_floor of the stiffest; a bone's step is cut to
-    block_max_move_mm (its shift plus rotation × 10 mm). `preconditioned()`
-    turns it on with the stages it needs.
+    block_refresh_steps, at each stage and (block_refresh_restart) after each
+    FIRE restart; its stiffest mode at dt·ω = block_courant, each bone's soft
+    directions floored at block_floor of the stiffest; a bone's step is cut to
+    block_max_move_mm (its shift plus rotation × 10 mm).
+    membrane_substeps: extra steps of the RSC membrane's free nodes per step,
+    the bones held, with mass-proportional damping
+    membrane_substep_damping_per_s (`membrane`). predict: start each frame of
+    the loaded driver from the secant through the last two frames' equilibria
+    (`predictor`), ramping the capitate over predict_ramp_steps instead of
+    ramp_steps, where that lowers the residual (the trials' measured poses
+    are too noisy to extrapolate: their holds then lock up, measured in the
+    README). `preconditioned()` turns these on with the stages they need.
     mass_scale, inertia_scale: mass scaling of the free bones (inertia_scale
     multiplies rotational inertia on top of mass_scale). node_mass_t: the mass
     of the RSC membrane's free nodes, raised per design where its connectors
@@ -94,13 +101,22 @@ class SolverSettings:
     block_floor: float = 0.1
     block_refresh_steps: int = 10
     block_max_move_mm: float = 0.3
+    membrane_substeps: int = 0
+    membrane_substep_damping_per_s: float = 2000.0
+    block_refresh_restart: bool = True
+    predict: bool = False
+    predict_ramp_steps: int = 0
 
     def preconditioned(self) -> "SolverSettings":
-        """These settings with the block mass (`preconditioner`) and the stages it needs: ramps of 10
-        steps, a 60-step move to the first pose (30 lands P1's and P3's 40° flexion on another equilibrium), at most 150 settling steps, FIRE's α₀ 0.2, no fibre
-        damping (a viscous term in seconds that the block mass's light directions cannot carry:
-        dt·c/m = fibre_damping_s / dt_s · block_courant² > 2 at block_courant 1). Measured in
-        `experiments/bench_solver.py` and the README's solver section."""
+        """These settings with the block mass (`preconditioner`), the membrane's nodes subcycled 7
+        steps a step (`membrane`) and the secant predictor (`predictor`), and the stages they need:
+        ramps of 10 steps, a 60-step move to the first pose (30 lands P1's and P3's 40° flexion on
+        another equilibrium), at most 150 settling steps, FIRE's α₀ 0.2, no fibre damping (a viscous
+        term in seconds that the block mass's light directions cannot carry: dt·c/m = fibre_damping_s
+        / dt_s · block_courant² > 2 at block_courant 1), the mass rebuilt every 20 steps and at each
+        stage but not after FIRE's restarts (a rebuild costs ~3 steps; every 10 steps and at each
+        restart cost 1.2× the time for the same steps). Measured in `experiments/bench_solver.py`
+        and the README's solver section."""
         return replace(
             self,
             block_mass=True,
@@ -109,6 +125,10 @@ class SolverSettings:
             settle_steps=150,
             move_steps=60,
             ramp_steps=10,
+            block_refresh_steps=20,
+            block_refresh_restart=False,
+            membrane_substeps=7,
+            predict=True,
         )
 
     def halved(self) -> "SolverSettings":
@@ -308,4 +328,9 @@ def settings_tuple(s: SolverSettings, driver: int) -> Settings:
         float(s.block_floor),
         max(int(s.block_refresh_steps), 1),
         float(s.block_max_move_mm),
+        int(s.membrane_substeps),
+        float(s.membrane_substep_damping_per_s),
+        bool(s.block_refresh_restart),
+        bool(s.predict),
+        int(s.predict_ramp_steps),
     )

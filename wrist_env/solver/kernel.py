@@ -33,7 +33,9 @@ from wrist_env.solver.forces import (
     membrane_forces,
     place_nodes,
 )
+from wrist_env.solver.membrane import new_scratch, substep
 from wrist_env.solver.preconditioner import block_mass, dof, metric, tangent
+from wrist_env.solver.predictor import capitate_move, history, predict, record
 from wrist_env.solver.rigid import interpolate_pose, matrix_to_rotvec, orthonormalize, rotate_in_place, smoothstep
 
 N_BONES, N_PAIRS = len(BONES), len(PAIRS)
@@ -181,10 +183,14 @@ def _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, rebuild
 
 
 @njit(cache=True, error_model="numpy")
-def _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step_index, fire, m, refresh):
+def _step(
+    state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step_index, fire, m, refresh, scratch
+):
     """One explicit step with the capitate at target (capR, capx), or, for the loaded
     driver, at rotation capR under the force `load` (3,) N, RCS; with st.block_mass and
-    `refresh`, the block mass m (`preconditioner.Metric`) is rebuilt at this state first."""
+    `refresh`, the block mass m (`preconditioner.Metric`) is rebuilt at this state first; with
+    st.membrane_substeps the membrane's free nodes then take that many more steps of their own
+    (`membrane.substep`; scratch its arrays)."""
     R, x, v, w, nodes, nv = state
     active, n_active, _, F, T, node_force, _, _ = work
     R[CAPITATE] = capR
@@ -210,6 +216,9 @@ def _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, loa
                 for k in range(3):
                     nv[i, k] = (nv[i, k] + dt / stiffness.node_mass * node_force[i, k]) * lin
                     nodes[i, k] += dt * nv[i, k]
+        if st.membrane_substeps > 0:
+            place_nodes(R, x, bod.com0, mem, nodes)
+            substep(R, x, bod.com0, mem, nodes, nv, stiffness.m_l0, stiffness.m_K, stiffness.node_mass, st, scratch)
     if step_index % 100 == 0:
         for b in (SCAPHOID, LUNATE):
             R[b] = orthonormalize(R[b])
@@ -297,6 +306,43 @@ def _converged(F, T, bundle, st):
             if not t2 <= (tol * LEVER_MM) ** 2:
                 return False
     return True
+
+
+@njit(cache=True, error_model="numpy")
+def _residual(F, T, st):
+    """The largest net force (N) on a free body, or net moment (N·mm) / LEVER_MM."""
+    worst = 0.0
+    for b in (SCAPHOID, LUNATE, CAPITATE):
+        if b == CAPITATE and st.driver == EXPERIMENTAL:
+            continue
+        worst = max(worst, np.sqrt(F[b, 0] ** 2 + F[b, 1] ** 2 + F[b, 2] ** 2))
+        if b != CAPITATE:
+            worst = max(worst, np.sqrt(T[b, 0] ** 2 + T[b, 1] ** 2 + T[b, 2] ** 2) / LEVER_MM)
+    return worst
+
+
+@njit(cache=True, error_model="numpy")
+def _predicted(state, work, bod, grids, law, fib, stiffness, mem, st, hist, capR, capx, load, move):
+    """Start the next stage, whose capitate pose is (capR, capx) under `load`, from the secant
+    predictor's state (`predictor.predict`) if the free bodies' residual there, with the capitate
+    already at that pose, is below their residual left where they are; True if so (the state is
+    the prediction), False if not (the positions are restored; the velocities, ~0 at the end of a
+    hold, stay zeroed)."""
+    R, x, v, w, nodes, nv = state
+    keep_R, keep_x, keep_nodes = R.copy(), x.copy(), nodes.copy()
+    R[CAPITATE] = capR
+    if st.driver == EXPERIMENTAL:
+        x[CAPITATE] = capx
+    _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, True, False)
+    before = _residual(work.F, work.T, st)
+    if not predict(hist, R, x, v, w, nodes, nv, mem, st, move):
+        R[:], x[:], nodes[:] = keep_R, keep_x, keep_nodes
+        return False
+    _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, True, False)
+    if _residual(work.F, work.T, st) < before:
+        return True
+    R[:], x[:], nodes[:] = keep_R, keep_x, keep_nodes
+    return False
 
 
 @njit(cache=True, error_model="numpy")
@@ -421,11 +467,22 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
     capR = np.eye(3)
     load = np.zeros(3)
     m = metric()
+    scratch = new_scratch(nodes)
+    hist = history(N_BONES, nodes)
     taken = 0
     for f in range(SETTLE, n_frames):
         Ra, xa, la, Rb, xb, lb, ramp, most = _stage(f, R0, x0, frame_R, frame_x, frame_load, st)
         axis = matrix_to_rotvec(Rb @ Ra.T)
         shift = xb - xa
+        move = capitate_move(axis, shift)
+        if (
+            st.predict
+            and st.driver == LOADED
+            and f > 0
+            and _predicted(state, work, bod, grids, law, fib, stiffness, mem, st, hist, Rb, xb, lb, move)
+        ):
+            ramp = st.predict_ramp_steps
+            fire[0], fire[1], fire[2] = st.fire_alpha0, 0.0, 1.0
         k = 0
         settled = False
         while k < ramp + most:
@@ -433,9 +490,11 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
             capx = interpolate_pose(Ra, xa, axis, capR, shift, s)
             for i in range(3):
                 load[i] = la[i] + s * (lb[i] - la[i])
-            refresh = k % st.block_refresh_steps == 0 or fire[2] > 0.0
+            refresh = k % st.block_refresh_steps == 0 or (st.block_refresh_restart and fire[2] > 0.0)
             fire[2] = 0.0
-            _step(state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step, fire, m, refresh)
+            _step(
+                state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step, fire, m, refresh, scratch
+            )
             step += 1
             k += 1
             if k >= ramp + st.min_hold_steps and _converged(F, T, bundle, st):
@@ -460,6 +519,8 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
             return
         if f < 0:  # SETTLE and MOVE have no output frame
             continue
+        if st.predict:
+            record(hist, R, x, nodes, move)
         # outputs at the state reached (the last step's forces were those before it)
         energy = _forces(state, work, bod, grids, law, fib, stiffness, mem, st, lb, True)
         for b in range(N_BONES):

@@ -1,0 +1,185 @@
+"""The subcycled membrane (`membrane`) and the secant predictor (`predictor`): their forces and moves
+against what they stand for, and the preconditioned solver's runs with them."""
+
+from collections import namedtuple
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from wrist_env import design
+from wrist_env.model import CAPITATE, LUNATE, SCAPHOID
+from wrist_env.solver.arrays import SolverSettings
+from wrist_env.solver.forces import membrane_forces, place_nodes
+from wrist_env.solver.membrane import _gaps, _substep_forces, new_scratch, substep
+from wrist_env.solver.predictor import MAX_RATIO, capitate_move, history, predict, record
+from wrist_env.solver.simulate import experimental, idealized, prepare, simulate, stiffness
+
+PRECONDITIONED = SolverSettings().preconditioned()
+
+
+def _state(model, result, frame, shake_mm=0.0, seed=0):
+    """(R, x, nodes) at a frame of a run, the free nodes shaken by up to `shake_mm`."""
+    pose = result.poses[frame]
+    R = np.ascontiguousarray(pose[:, :3, :3])
+    x = np.ascontiguousarray(np.einsum("bij,bj->bi", R, model.com) + pose[:, :3, 3])
+    nodes = np.ascontiguousarray(result.membrane_nodes[frame]).copy()
+    free = np.asarray(model.membrane_bone) < 0
+    nodes[free] += np.random.default_rng(seed).uniform(-shake_mm, shake_mm, (free.sum(), 3))
+    return R, x, nodes, free
+
+
+def test_a_substep_feels_the_force_kernels_membrane_forces(p1):
+    """On P1's settled neutral state with the free nodes shaken by up to 0.3 mm (some pressed into the
+    scaphoid, connectors taut and slack): the substep's forces on the free nodes equal
+    `forces.membrane_forces`' to rounding, so the subcycled nodes settle where the solver's own forces
+    balance."""
+    # the look-up rule's bound: a node with travel t since its gap d looked up is ≥ d − √3·t away
+    driver = experimental(p1, np.tile(np.eye(4), (2, 1, 1)))
+    result = simulate(p1, design.population(), driver)
+    p = prepare(p1, PRECONDITIONED, driver.mode)
+    s = stiffness(p, design.population())
+    R, x, nodes, free = _state(p1, result, -1, shake_mm=0.3)
+    F, T, exact = np.zeros((5, 3)), np.zeros((5, 3)), np.zeros_like(nodes)
+    membrane_forces(
+        R,
+        x,
+        p1.com,
+        p.membrane,
+        nodes,
+        s.m_l0,
+        s.m_K,
+        PRECONDITIONED.membrane_contact_stiffness,
+        F,
+        T,
+        exact,
+        False,
+        True,
+    )
+    gap, travel = np.zeros(len(nodes)), np.zeros(len(nodes))
+    _gaps(R, x, p1.com, p.membrane, nodes, gap, travel)
+    force = np.zeros_like(nodes)
+    _substep_forces(
+        R,
+        x,
+        p1.com,
+        p.membrane,
+        nodes,
+        s.m_l0,
+        s.m_K,
+        PRECONDITIONED.membrane_contact_stiffness,
+        gap,
+        travel,
+        force,
+        True,
+    )
+    assert (gap < 0).sum() > 0 and np.abs(exact[free]).max() > 0.1
+    np.testing.assert_allclose(force[free], exact[free], rtol=1e-12, atol=1e-12)
+
+
+def test_substeps_relax_the_nodes_to_their_equilibrium(p1):
+    """The bones held at P1's settled neutral state and the free nodes shaken by 0.2 mm: 300 steps of
+    substeps bring the nodes back to a balance of `forces.membrane_forces` (largest free-node force below
+    1e-3 N from over 1 N), and the shake's energy is gone, not pumped (the damping is mass-proportional)."""
+    driver = experimental(p1, np.tile(np.eye(4), (2, 1, 1)))
+    result = simulate(p1, design.population(), driver)
+    p = prepare(p1, PRECONDITIONED, driver.mode)
+    s = stiffness(p, design.population())
+    R, x, nodes, free = _state(p1, result, -1, shake_mm=0.2, seed=1)
+    place_nodes(R, x, p1.com, p.membrane, nodes)
+    F, T, force = np.zeros((5, 3)), np.zeros((5, 3)), np.zeros_like(nodes)
+
+    def largest():
+        membrane_forces(
+            R,
+            x,
+            p1.com,
+            p.membrane,
+            nodes,
+            s.m_l0,
+            s.m_K,
+            PRECONDITIONED.membrane_contact_stiffness,
+            F,
+            T,
+            force,
+            False,
+            True,
+        )
+        return np.abs(force[free]).max()
+
+    before = largest()
+    nv, scratch = np.zeros_like(nodes), new_scratch(nodes)
+    for _ in range(300):
+        substep(R, x, p1.com, p.membrane, nodes, nv, s.m_l0, s.m_K, s.node_mass, p.settings, scratch)
+    assert before > 1.0 and largest() < 1e-3, (before, largest())
+
+
+def _rigid_path(t):
+    """Rotations (5, 3, 3) and centres (5, 3) mm on a screw path: each body turns 0.05 rad per unit t
+    about its own axis and moves 0.3 mm per unit t."""
+    axes = np.array([[0, 0, 1.0], [1.0, 0, 0], [0, 1.0, 0], [1.0, 1.0, 0], [0, 1.0, 1.0]])
+    R = np.stack([Rotation.from_rotvec(0.05 * t * a / np.linalg.norm(a)).as_matrix() for a in axes])
+    x = np.arange(15.0).reshape(5, 3) + 0.3 * t * axes
+    return R, x
+
+
+_Membrane = namedtuple("Membrane", "bone")(np.array([0, -1, -1, 4]))
+_LOADED = namedtuple("Settings", "driver")(1)  # the loaded driver: the capitate's centre is free
+
+
+def test_the_secant_predictor_continues_a_screw_path_exactly():
+    """Two equilibria on a screw path (constant turn and shift per unit capitate move): the predictor
+    puts the free bodies and nodes where the path goes next, for a next move 1.5× the last (to rounding),
+    caps the extrapolation at MAX_RATIO, zeroes the velocities, and leaves the fixed and driven bodies and
+    the attached nodes alone."""
+    st = _LOADED
+    nodes0 = np.zeros((4, 3))
+    h = history(5, nodes0)
+    for t in (0.0, 1.0):
+        R, x = _rigid_path(t)
+        record(h, R, x, nodes0 + t * np.array([0.1, 0.2, 0.3]), move=2.0)
+    for move, t_next in ((3.0, 2.5), (100.0, 1.0 + MAX_RATIO)):
+        R, x = _rigid_path(1.0)
+        nodes = nodes0 + np.array([0.1, 0.2, 0.3])
+        v, w, nv = np.ones((5, 3)), np.ones((5, 3)), np.ones((4, 3))
+        assert predict(h, R, x, v, w, nodes, nv, _Membrane, st, move)
+        R_expect, x_expect = _rigid_path(t_next)
+        for b in (SCAPHOID, LUNATE):
+            np.testing.assert_allclose(R[b], R_expect[b], atol=1e-12)
+            np.testing.assert_allclose(x[b], x_expect[b], atol=1e-12)
+        np.testing.assert_allclose(x[CAPITATE], x_expect[CAPITATE], atol=1e-12)
+        np.testing.assert_allclose(R[CAPITATE], _rigid_path(1.0)[0][CAPITATE])  # driven: its rotation stays
+        np.testing.assert_allclose(x[:2], _rigid_path(1.0)[1][:2])  # radius and ulna: fixed
+        np.testing.assert_allclose(nodes[1:3], t_next * np.tile([0.1, 0.2, 0.3], (2, 1)), atol=1e-12)
+        np.testing.assert_allclose(nodes[[0, 3]], np.tile([0.1, 0.2, 0.3], (2, 1)))  # attached: not moved
+        assert not v.any() and not w.any() and not nv.any()
+
+
+def test_the_predictor_needs_two_equilibria_and_a_moving_capitate():
+    st = _LOADED
+    h = history(5, np.zeros((4, 3)))
+    R, x = _rigid_path(0.0)
+    args = (np.zeros((5, 3)), np.zeros((5, 3)), np.zeros((4, 3)), np.zeros((4, 3)), _Membrane, st, 1.0)
+    assert not predict(h, R, x, *args)
+    record(h, R, x, np.zeros((4, 3)), 1.0)
+    assert not predict(h, R, x, *args)
+    record(h, R, x, np.zeros((4, 3)), 0.0)  # the last stage held the capitate still: no direction
+    assert not predict(h, R, x, *args)
+    assert np.isclose(capitate_move(np.array([0.0, 0.1, 0.0]), np.array([3.0, 4.0, 0.0])), 1.0 + 5.0)
+
+
+def test_the_predicted_sweep_settles_every_frame_on_the_default_answer(p1):
+    """P1's population sweep under the preconditioned solver (predictor, subcycled membrane): every
+    frame settles within 0.02 mm and 0.15° of the default solver's answer, and frames 2 on (the ones
+    predicted) take fewer steps than without the predictor."""
+    from dataclasses import replace
+
+    from wrist_env.solver.equilibrium import distance
+
+    driver = idealized(p1)
+    default = simulate(p1, design.population(), driver)
+    predicted = simulate(p1, design.population(), driver, PRECONDITIONED)
+    plain = simulate(p1, design.population(), driver, replace(PRECONDITIONED, predict=False))
+    assert predicted.ok and predicted.settled.all(), predicted.message
+    d = distance(default.poses, predicted.poses, p1.com).max(axis=0)
+    assert d[0] < 0.02 and d[1] < 0.15, d
+    assert predicted.steps[2:].sum() < plain.steps[2:].sum(), (predicted.steps, plain.steps)

@@ -1,0 +1,93 @@
+"""A secant predictor for the next frame's equilibrium (Numba).
+
+A quasi-static motion is a path of equilibria: from one frame to the next the free bones move on
+from where the last two frames put them, in proportion to the capitate's move. So before a frame
+the free bodies (scaphoid, lunate, the loaded capitate's centre) and the membrane's free nodes are
+put where the line through the last two frames' equilibria says they will be (the secant predictor
+of numerical continuation), their velocities zeroed, and the hold starts from there. The predictor
+only chooses the starting point of the hold: the frame still ends at equilibrium
+(`kernel._converged`), so a poor prediction costs steps, not accuracy, unless the path has more
+than one equilibrium (a design whose answer depends on its path; `experiments/solver_accuracy.py`).
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+
+import numpy as np
+from numba import njit
+
+from wrist_env.model import CAPITATE, LUNATE, SCAPHOID
+from wrist_env.solver.arrays import LOADED
+from wrist_env.solver.rigid import matrix_to_rotvec, rotate_in_place
+
+LEVER_MM = 10.0
+"""A rotation's size as a move: radians × this lever (mm), added to a translation's."""
+MAX_RATIO = 2.0
+"""The most the last frame's change is extrapolated by (a frame whose capitate moves more than twice the
+last one's is predicted as twice)."""
+
+History = namedtuple("History", ["rotation", "centre", "nodes", "move", "count"])
+"""The last two equilibria: rotations (2, n_bodies, 3, 3), centres (2, n_bodies, 3) mm, membrane nodes
+(2, M, 3) mm, the capitate's move into each (2,) mm (`capitate_move`), and how many are stored (1,)."""
+
+
+@njit(cache=True)
+def history(n_bodies, nodes):
+    """An empty `History`."""
+    return History(
+        np.zeros((2, n_bodies, 3, 3)),
+        np.zeros((2, n_bodies, 3)),
+        np.zeros((2,) + nodes.shape),
+        np.zeros(2),
+        np.zeros(1, np.int64),
+    )
+
+
+@njit(cache=True, error_model="numpy")
+def capitate_move(axis, shift):
+    """The size (mm) of a capitate move of rotation vector `axis` (rad) and translation `shift` (mm)."""
+    return LEVER_MM * np.sqrt(axis[0] ** 2 + axis[1] ** 2 + axis[2] ** 2) + np.sqrt(
+        shift[0] ** 2 + shift[1] ** 2 + shift[2] ** 2
+    )
+
+
+@njit(cache=True, error_model="numpy")
+def record(h, R, x, nodes, move):
+    """Store the equilibrium (R, x, nodes) reached by a stage whose capitate moved `move` (mm)."""
+    h.rotation[0] = h.rotation[1]
+    h.centre[0] = h.centre[1]
+    h.nodes[0] = h.nodes[1]
+    h.move[0] = h.move[1]
+    h.rotation[1] = R
+    h.centre[1] = x
+    h.nodes[1] = nodes
+    h.move[1] = move
+    h.count[0] = min(h.count[0] + 1, 2)
+
+
+@njit(cache=True, error_model="numpy")
+def predict(h, R, x, v, w, nodes, nv, mem, st, move):
+    """Put the free bodies and nodes where the secant through the last two equilibria says the next
+    stage, whose capitate moves `move` (mm), ends; velocities zeroed. False (nothing changed) without
+    two equilibria or when the last stage's capitate did not move."""
+    if h.count[0] < 2 or not h.move[1] > 1e-9:
+        return False
+    ratio = min(move / h.move[1], MAX_RATIO)
+    for b in (SCAPHOID, LUNATE):
+        turn = matrix_to_rotvec(h.rotation[1, b] @ h.rotation[0, b].T)
+        R[b] = h.rotation[1, b]
+        rotate_in_place(R[b], ratio * turn[0], ratio * turn[1], ratio * turn[2])
+        for k in range(3):
+            x[b, k] = h.centre[1, b, k] + ratio * (h.centre[1, b, k] - h.centre[0, b, k])
+    if st.driver == LOADED:
+        for k in range(3):
+            x[CAPITATE, k] = h.centre[1, CAPITATE, k] + ratio * (h.centre[1, CAPITATE, k] - h.centre[0, CAPITATE, k])
+    for i in range(nodes.shape[0]):
+        if mem.bone[i] < 0:
+            for k in range(3):
+                nodes[i, k] = h.nodes[1, i, k] + ratio * (h.nodes[1, i, k] - h.nodes[0, i, k])
+    v[:] = 0.0
+    w[:] = 0.0
+    nv[:] = 0.0
+    return True
