@@ -18,7 +18,10 @@ are also polished by the quasi-static Newton reference
 (`wrist_env.solver.equilibrium.nearest`): the distance from each explicit
 answer to the equilibrium nearest it, and the net force left there.
 
-Run: `python experiments/solver_accuracy.py [P1 P2 P3] [--designs 100] [--newton 3] [--preconditioned] [--set dt_s=9e-5 ...]`
+With --frame-local, instead: each frame of each path-independent design run alone from the
+reference's previous frame, by the settings under test and by the defaults (`frame_local`).
+
+Run: `python experiments/solver_accuracy.py [P1 P2 P3] [--designs 100] [--newton 3] [--preconditioned] [--frame-local] [--set dt_s=9e-5 ...]`
 (--set changes the settings under test; the reference stays the default's, with the same
 `smooth_normals`, which changes the answer, not only the path to it).
 References are cached in runs/solver_accuracy/ under a hash of their settings.
@@ -42,7 +45,7 @@ from wrist_env.participants import registry
 from wrist_env.participants.registry import load_model
 from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.equilibrium import distance, nearest
-from wrist_env.solver.simulate import experimental, idealized, simulate_batch
+from wrist_env.solver.simulate import experimental, idealized, prepare, simulate_batch, simulate_frame
 
 CACHE = Path("runs/solver_accuracy")
 TOLERANCE = (0.1, 0.5)  # mm, degrees: issue 13's "answer unchanged"
@@ -83,7 +86,9 @@ def reference(name: str, model, designs, base: SolverSettings) -> dict[str, np.n
     key = hashlib.sha1(repr(settings).encode()).hexdigest()[:8]  # a new default gets a new reference
     path = CACHE / f"{name}_{len(designs) - 1}_{key}_paths.npz"
     if path.exists():
-        return dict(np.load(path))
+        cached = dict(np.load(path))
+        if all(f"{motion}_nodes" in cached for motion in ("sweep", "trial")):
+            return cached
     out = {}
     runs_of = {"": settings} | {f"_{k}": s for k, s in path_settings(settings).items()}
     for motion, driver in drivers(name, model).items():
@@ -91,6 +96,8 @@ def reference(name: str, model, designs, base: SolverSettings) -> dict[str, np.n
             runs = simulate_batch(model, designs, driver, s)
             out[motion + suffix] = np.stack([r.poses for r in runs])
             out[motion + suffix + "_ok"] = np.array([r.ok for r in runs])
+            if not suffix:  # the membrane's nodes too: a frame-local run starts from the reference's state
+                out[motion + "_nodes"] = np.stack([r.membrane_nodes for r in runs])
     path.parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(path, **out)
     return out
@@ -180,6 +187,48 @@ def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int, p
             )
 
 
+def frame_local(name: str, n_designs: int, settings: SolverSettings) -> None:
+    """Each frame of each path-independent design run alone from the reference's previous frame
+    (`simulate.simulate_frame`), by the settings under test and by the defaults: the share of frames
+    that land within `TOLERANCE` (and within 0.02 mm and 0.1°) of the reference's, the McNemar test on
+    the frames, and the mean steps per frame. A solver's error at a frame, apart from the path that led
+    there."""
+    model = load_model(name)
+    designs = [design.population()] + monte_carlo_designs(n_designs)
+    ref = reference(name, model, designs, replace(SolverSettings(), smooth_normals=settings.smooth_normals))
+    defaults = replace(SolverSettings(), smooth_normals=settings.smooth_normals)
+    for motion, driver in drivers(name, model).items():
+        chosen = np.flatnonzero(path_independent(ref, motion, model.com))
+        prepared = {k: prepare(model, s, driver.mode) for k, s in (("test", settings), ("defaults", defaults))}
+        hits = {k: [] for k in prepared}
+        close = {k: [] for k in prepared}
+        steps = {k: [] for k in prepared}
+        for i in tqdm(chosen, desc=f"{name} {motion} frame-local", leave=False):
+            for f in range(1, driver.n_frames):
+                target = ref[motion][i][f]
+                for k, p in prepared.items():
+                    r = simulate_frame(
+                        model,
+                        designs[i],
+                        driver,
+                        f,
+                        ref[motion][i][f - 1],
+                        ref[motion + "_nodes"][i][f - 1],
+                        prepared=p,
+                    )
+                    d = distance(r.poses[1:], target[None], model.com)[0] if r.ok else (np.inf, np.inf)
+                    hits[k].append(bool(d[0] <= TOLERANCE[0] and d[1] <= TOLERANCE[1]))
+                    close[k].append(bool(d[0] <= 0.02 and d[1] <= 0.1))
+                    steps[k].append(int(r.steps[1]))
+        print(
+            f"{name} {motion} frame-local ({len(hits['test'])} frames of {len(chosen)} path-independent designs): "
+            f"within 0.1 mm and 0.5° — settings under test {100 * np.mean(hits['test']):.1f} %, defaults "
+            f"{100 * np.mean(hits['defaults']):.1f} %; within 0.02 mm and 0.1° — {100 * np.mean(close['test']):.1f} % / "
+            f"{100 * np.mean(close['defaults']):.1f} %; steps per frame {np.mean(steps['test']):.0f} / "
+            f"{np.mean(steps['defaults']):.0f}\n  {mcnemar(hits['defaults'], hits['test'])}"
+        )
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("participants", nargs="*", default=["P1", "P2", "P3"])
@@ -189,6 +238,11 @@ def main(argv=None) -> None:
     parser.add_argument(
         "--preconditioned", action="store_true", help="test SolverSettings().preconditioned() (the block mass)"
     )
+    parser.add_argument(
+        "--frame-local",
+        action="store_true",
+        help="only the frame-local comparison (`frame_local`), against the defaults",
+    )
     args = parser.parse_args(argv)
     changes = {k: ast.literal_eval(v) for k, v in (item.split("=", 1) for item in args.set)}
     base = SolverSettings().preconditioned() if args.preconditioned else SolverSettings()
@@ -196,6 +250,9 @@ def main(argv=None) -> None:
     under = ("the block mass" if args.preconditioned else "the defaults") + (f" with {changes}" if changes else "")
     print(f"settings under test: {under}; reference: {reference_settings(SolverSettings())}")
     for name in args.participants:
+        if args.frame_local:
+            frame_local(name, args.designs, settings)
+            continue
         report(name, args.designs, settings, args.newton, paired=args.preconditioned or bool(changes))
 
 

@@ -183,3 +183,24 @@ def test_the_predicted_sweep_settles_every_frame_on_the_default_answer(p1):
     d = distance(default.poses, predicted.poses, p1.com).max(axis=0)
     assert d[0] < 0.02 and d[1] < 0.15, d
     assert predicted.steps[2:].sum() < plain.steps[2:].sum(), (predicted.steps, plain.steps)
+
+
+def test_a_frame_run_alone_from_the_previous_answer_lands_on_the_same_answer(p1):
+    """`simulate_frame`: P1's population trial, frame 6 run alone from the default run's frame 5 (its poses
+    and membrane nodes, at rest) lands within 0.01 mm and 0.1° of that run's frame 6, by either solver;
+    frame 0 (nothing before it) is refused."""
+    import pytest
+
+    from wrist_env.participants import registry
+    from wrist_env.solver.equilibrium import distance
+    from wrist_env.solver.simulate import simulate_frame
+
+    driver = experimental(p1, registry.trial("P1", "calibrate").pose("capitate"))
+    run = simulate(p1, design.population(), driver)
+    for settings in (None, PRECONDITIONED):
+        alone = simulate_frame(p1, design.population(), driver, 6, run.poses[5], run.membrane_nodes[5], settings)
+        assert alone.ok and alone.settled[1] and np.isnan(alone.poses[0]).all()
+        d = distance(alone.poses[1:], run.poses[6:7], p1.com)[0]
+        assert d[0] < 0.01 and d[1] < 0.1, d
+    with pytest.raises(ValueError, match="frame must be in 1..14"):
+        simulate_frame(p1, design.population(), driver, 0, run.poses[0], run.membrane_nodes[0])

@@ -444,17 +444,30 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
     `_converged` (at least min_hold_steps, at most max_hold_steps; settling
     at most settle_steps).
     """
+    R = np.zeros((N_BONES, 3, 3))
+    for b in range(N_BONES):
+        R[b] = np.eye(3)
+    _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R, bod.com0.copy(), mem.rest.copy(), SETTLE)
+
+
+@njit(cache=True, error_model="numpy")
+def run_from(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes):
+    """`run` from a given state at frame 0 instead of from rest: rotations R (5, 3, 3), centres of mass
+    x (5, 3) mm (the capitate at frame 0's pose) and membrane nodes (M, 3) mm, at rest; no settling or
+    move, frame 0's outputs left unfilled, each later frame as in `run` (for a frame-local comparison:
+    `experiments/solver_accuracy.py --frame-local`)."""
+    _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R.copy(), x.copy(), nodes.copy(), 1)
+
+
+@njit(cache=True, error_model="numpy")
+def _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes, first):
+    """`run` from the state (R, x, nodes), its stages from `first` (`SETTLE`, or 1 from a frame-0 state)."""
     frame_R, frame_x, frame_load = frames
     poses, contact, bundle_out, energy_out, residual_out, steps_out, settled_out, nodes_out, status = out
     com0 = bod.com0
     n_frames = frame_R.shape[0]
-    R = np.zeros((N_BONES, 3, 3))
-    for b in range(N_BONES):
-        R[b] = np.eye(3)
-    x = com0.copy()
     v = np.zeros((N_BONES, 3))
     w = np.zeros((N_BONES, 3))
-    nodes = mem.rest.copy()
     nv = np.zeros_like(nodes)
     state = State(R, x, v, w, nodes, nv)
     work = new_work(grids, nodes)
@@ -470,7 +483,7 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
     scratch = new_scratch(nodes)
     hist = history(N_BONES, nodes)
     taken = 0
-    for f in range(SETTLE, n_frames):
+    for f in range(first, n_frames):
         Ra, xa, la, Rb, xb, lb, ramp, most = _stage(f, R0, x0, frame_R, frame_x, frame_load, st)
         axis = matrix_to_rotvec(Rb @ Ra.T)
         shift = xb - xa

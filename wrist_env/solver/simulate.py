@@ -11,7 +11,7 @@ maximum flexion to maximum extension about the RCS z axis.
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numba
 import numpy as np
@@ -255,6 +255,52 @@ def simulate(
     out = _outputs(0, len(driver.rotation), len(model.membrane_nodes))
     _run(kernel.run, p, stiffness(p, design), driver, out)
     return _result(out, driver, int(out.status[0]))
+
+
+def simulate_frame(
+    model: Model,
+    design: Design,
+    driver: Driver,
+    frame: int,
+    poses: np.ndarray,
+    nodes: np.ndarray,
+    settings: arrays.SolverSettings | None = None,
+    *,
+    prepared: Prepared | None = None,
+) -> Result:
+    """Simulate one frame of `driver` (≥ 1) alone, from the state of frame − 1 given as the bones'
+    poses (5, 4, 4) and the membrane's nodes (M, 3) mm (another run's answer there): the capitate ramps
+    from frame − 1's pose to frame's and holds. A `Result` of two frames, the first left NaN."""
+    if not 1 <= frame < driver.n_frames:
+        raise ValueError(f"frame must be in 1..{driver.n_frames - 1}, but got {frame}")
+    p = _prepared(model, settings, driver, prepared)
+    pair = slice(frame - 1, frame + 1)
+    two = replace(
+        driver,
+        rotation=np.ascontiguousarray(driver.rotation[pair]),
+        com=np.ascontiguousarray(driver.com[pair]),
+        angle_deg=driver.angle_deg[pair],
+        load_n=driver.load_n[pair],
+    )
+    R = np.ascontiguousarray(poses[:, :3, :3], dtype=np.float64)
+    x = np.ascontiguousarray(np.einsum("bij,bj->bi", R, model.com) + poses[:, :3, 3])
+    out = _outputs(0, 2, len(model.membrane_nodes))
+    frames = kernel.Frames(two.rotation, two.com, two.load())
+    kernel.run_from(
+        p.bodies,
+        p.grids,
+        p.law,
+        p.fibres,
+        stiffness(p, design),
+        p.membrane,
+        p.settings,
+        frames,
+        out,
+        R,
+        x,
+        np.ascontiguousarray(nodes, dtype=np.float64),
+    )
+    return _result(out, two, int(out.status[0]))
 
 
 def simulate_batch(
