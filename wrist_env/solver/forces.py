@@ -314,6 +314,49 @@ def place_nodes(R, x, com0, mem, nodes):
             )
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def connector_pull(nodes, i, j, l0, K):
+    """A membrane connector from node i to node j of zero-load length l0 (mm) and scale K (N): its
+    tension per unit length (N/mm; 0 when slack), the vector from i to j (mm), its length (mm) and strain."""
+    dx, dy, dz = nodes[j, 0] - nodes[i, 0], nodes[j, 1] - nodes[i, 1], nodes[j, 2] - nodes[i, 2]
+    length = np.sqrt(dx * dx + dy * dy + dz * dz)
+    strain = length / l0 - 1.0
+    if strain <= 0.0:
+        return 0.0, dx, dy, dz, length, strain
+    return blankevoort_force(K, strain) / length, dx, dy, dz, length, strain
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def node_contact(R, x, com0, mem, px, py, pz, contact_stiffness, smooth):
+    """The scaphoid's push (N, world) on a membrane node at world point p, the node's signed distance (mm)
+    and whether it touches (a negative distance with a normal; else no push)."""
+    s = mem.scaphoid
+    qx, qy, qz = to_local(R, x, com0, s, px, py, pz)
+    if smooth:
+        d, gx, gy, gz = sdf_lookup_smooth(
+            mem.grid_values,
+            mem.grid_normals,
+            mem.grid_offset,
+            mem.grid_shape,
+            mem.grid_origin,
+            mem.grid_spacing,
+            qx,
+            qy,
+            qz,
+        )
+    else:
+        d, gx, gy, gz = sdf_lookup_scalar(
+            mem.grid_values, mem.grid_offset, mem.grid_shape, mem.grid_origin, mem.grid_spacing, qx, qy, qz
+        )
+    if d < 0.0:
+        gn = np.sqrt(gx * gx + gy * gy + gz * gz)
+        if gn > 1e-12:
+            scale = contact_stiffness * -d / gn
+            fx, fy, fz = rotate(R, s, gx * scale, gy * scale, gz * scale)
+            return fx, fy, fz, d, True
+    return 0.0, 0.0, 0.0, d, False
+
+
 @njit(cache=True, error_model="numpy")
 def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node_force, want_energy=True, smooth=False):
     """RSC membrane: connector tension and node–scaphoid contact.
@@ -330,12 +373,9 @@ def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node
         if K[c] == 0.0:
             continue
         i, j = mem.connectors[c, 0], mem.connectors[c, 1]
-        dx, dy, dz = nodes[j, 0] - nodes[i, 0], nodes[j, 1] - nodes[i, 1], nodes[j, 2] - nodes[i, 2]
-        length = np.sqrt(dx * dx + dy * dy + dz * dz)
-        strain = length / l0[c] - 1.0
+        tension, dx, dy, dz, length, strain = connector_pull(nodes, i, j, l0[c], K[c])
         if strain <= 0.0:
             continue
-        tension = blankevoort_force(K[c], strain) / length
         node_force[i, 0] += tension * dx
         node_force[i, 1] += tension * dy
         node_force[i, 2] += tension * dz
@@ -346,37 +386,18 @@ def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node
             energy += blankevoort_energy(K[c], l0[c], strain)
         if mem.first_row[c]:
             along += tension * length
-    s = mem.scaphoid
     for i in range(nodes.shape[0]):
         if mem.bone[i] >= 0:
             continue
-        qx, qy, qz = to_local(R, x, com0, s, nodes[i, 0], nodes[i, 1], nodes[i, 2])
-        if smooth:
-            d, gx, gy, gz = sdf_lookup_smooth(
-                mem.grid_values,
-                mem.grid_normals,
-                mem.grid_offset,
-                mem.grid_shape,
-                mem.grid_origin,
-                mem.grid_spacing,
-                qx,
-                qy,
-                qz,
-            )
-        else:
-            d, gx, gy, gz = sdf_lookup_scalar(
-                mem.grid_values, mem.grid_offset, mem.grid_shape, mem.grid_origin, mem.grid_spacing, qx, qy, qz
-            )
-        if d < 0.0:
-            gn = np.sqrt(gx * gx + gy * gy + gz * gz)
-            if gn > 1e-12:
-                scale = contact_stiffness * -d / gn
-                fx, fy, fz = rotate(R, s, gx * scale, gy * scale, gz * scale)
-                node_force[i, 0] += fx
-                node_force[i, 1] += fy
-                node_force[i, 2] += fz
-                apply_force(F, T, x, s, -fx, -fy, -fz, nodes[i, 0], nodes[i, 1], nodes[i, 2])
-                energy += 0.5 * contact_stiffness * d * d
+        fx, fy, fz, d, touching = node_contact(
+            R, x, com0, mem, nodes[i, 0], nodes[i, 1], nodes[i, 2], contact_stiffness, smooth
+        )
+        if touching:
+            node_force[i, 0] += fx
+            node_force[i, 1] += fy
+            node_force[i, 2] += fz
+            apply_force(F, T, x, mem.scaphoid, -fx, -fy, -fz, nodes[i, 0], nodes[i, 1], nodes[i, 2])
+            energy += 0.5 * contact_stiffness * d * d
     for i in range(nodes.shape[0]):
         b = mem.bone[i]
         if b >= 0:

@@ -21,9 +21,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from wrist_env.solver.contact import sdf_distance, sdf_lookup_scalar, sdf_lookup_smooth
-from wrist_env.solver.forces import rotate, to_local
-from wrist_env.solver.ligaments import blankevoort_force
+from wrist_env.solver.contact import sdf_distance
+from wrist_env.solver.forces import connector_pull, node_contact, to_local
 
 LIPSCHITZ = np.sqrt(3.0)
 """Bound on the trilinear signed distance's slope (each axis' difference of a distance field is at most
@@ -54,49 +53,25 @@ def _substep_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, gap, trave
         if K[c] == 0.0:
             continue
         i, j = mem.connectors[c, 0], mem.connectors[c, 1]
-        dx, dy, dz = nodes[j, 0] - nodes[i, 0], nodes[j, 1] - nodes[i, 1], nodes[j, 2] - nodes[i, 2]
-        length = np.sqrt(dx * dx + dy * dy + dz * dz)
-        strain = length / l0[c] - 1.0
+        tension, dx, dy, dz, _, strain = connector_pull(nodes, i, j, l0[c], K[c])
         if strain <= 0.0:
             continue
-        tension = blankevoort_force(K[c], strain) / length
         force[i, 0] += tension * dx
         force[i, 1] += tension * dy
         force[i, 2] += tension * dz
         force[j, 0] -= tension * dx
         force[j, 1] -= tension * dy
         force[j, 2] -= tension * dz
-    s = mem.scaphoid
     for i in range(nodes.shape[0]):
         if not gap[i] - LIPSCHITZ * travel[i] < 0.0:
             continue
-        qx, qy, qz = to_local(R, x, com0, s, nodes[i, 0], nodes[i, 1], nodes[i, 2])
-        if smooth:
-            d, gx, gy, gz = sdf_lookup_smooth(
-                mem.grid_values,
-                mem.grid_normals,
-                mem.grid_offset,
-                mem.grid_shape,
-                mem.grid_origin,
-                mem.grid_spacing,
-                qx,
-                qy,
-                qz,
-            )
-        else:
-            d, gx, gy, gz = sdf_lookup_scalar(
-                mem.grid_values, mem.grid_offset, mem.grid_shape, mem.grid_origin, mem.grid_spacing, qx, qy, qz
-            )
-        gap[i] = d
+        fx, fy, fz, gap[i], _ = node_contact(
+            R, x, com0, mem, nodes[i, 0], nodes[i, 1], nodes[i, 2], contact_stiffness, smooth
+        )
         travel[i] = 0.0
-        if d < 0.0:
-            gn = np.sqrt(gx * gx + gy * gy + gz * gz)
-            if gn > 1e-12:
-                scale = contact_stiffness * -d / gn
-                fx, fy, fz = rotate(R, s, gx * scale, gy * scale, gz * scale)
-                force[i, 0] += fx
-                force[i, 1] += fy
-                force[i, 2] += fz
+        force[i, 0] += fx
+        force[i, 1] += fy
+        force[i, 2] += fz
 
 
 @njit(cache=True, error_model="numpy")
