@@ -17,100 +17,58 @@ from wrist_env.solver.simulate import experimental, idealized, prepare, simulate
 PRECONDITIONED = SolverSettings().preconditioned()
 
 
-def _state(model, result, frame, shake_mm=0.0, seed=0):
-    """(R, x, nodes) at a frame of a run, the free nodes shaken by up to `shake_mm`."""
-    pose = result.poses[frame]
+def _shaken_neutral(model, shake_mm, seed):
+    """P1's settled neutral state under the preconditioned settings, the free nodes shaken by up to
+    `shake_mm`: (R, x, nodes, free-node mask, prepared arrays, design arrays, the membrane's forces)."""
+    driver = experimental(model, np.tile(np.eye(4), (2, 1, 1)))
+    result = simulate(model, design.population(), driver)
+    p = prepare(model, PRECONDITIONED, driver.mode)
+    s = stiffness(p, design.population())
+    pose = result.poses[-1]
     R = np.ascontiguousarray(pose[:, :3, :3])
     x = np.ascontiguousarray(np.einsum("bij,bj->bi", R, model.com) + pose[:, :3, 3])
-    nodes = np.ascontiguousarray(result.membrane_nodes[frame]).copy()
+    nodes = np.ascontiguousarray(result.membrane_nodes[-1]).copy()
     free = np.asarray(model.membrane_bone) < 0
     nodes[free] += np.random.default_rng(seed).uniform(-shake_mm, shake_mm, (free.sum(), 3))
-    return R, x, nodes, free
+    place_nodes(R, x, model.com, p.membrane, nodes)
+    k = PRECONDITIONED.membrane_contact_stiffness
+
+    def exact():
+        force = np.zeros_like(nodes)
+        membrane_forces(
+            R, x, model.com, p.membrane, nodes, s.m_l0, s.m_K, k, np.zeros((5, 3)), np.zeros((5, 3)), force, False, True
+        )
+        return force
+
+    return R, x, nodes, free, p, s, exact
 
 
 def test_a_substep_feels_the_force_kernels_membrane_forces(p1):
     """On P1's settled neutral state with the free nodes shaken by up to 0.3 mm (some pressed into the
     scaphoid, connectors taut and slack): the substep's forces on the free nodes equal
     `forces.membrane_forces`' to rounding, so the subcycled nodes settle where the solver's own forces
-    balance."""
-    # the look-up rule's bound: a node with travel t since its gap d looked up is ≥ d − √3·t away
-    driver = experimental(p1, np.tile(np.eye(4), (2, 1, 1)))
-    result = simulate(p1, design.population(), driver)
-    p = prepare(p1, PRECONDITIONED, driver.mode)
-    s = stiffness(p, design.population())
-    R, x, nodes, free = _state(p1, result, -1, shake_mm=0.3)
-    F, T, exact = np.zeros((5, 3)), np.zeros((5, 3)), np.zeros_like(nodes)
-    membrane_forces(
-        R,
-        x,
-        p1.com,
-        p.membrane,
-        nodes,
-        s.m_l0,
-        s.m_K,
-        PRECONDITIONED.membrane_contact_stiffness,
-        F,
-        T,
-        exact,
-        False,
-        True,
-    )
+    balance (a node is looked up where gap − √3·travel < 0: here every travel is 0)."""
+    R, x, nodes, free, p, s, exact = _shaken_neutral(p1, 0.3, 0)
     gap, travel = np.zeros(len(nodes)), np.zeros(len(nodes))
     _gaps(R, x, p1.com, p.membrane, nodes, gap, travel)
     force = np.zeros_like(nodes)
-    _substep_forces(
-        R,
-        x,
-        p1.com,
-        p.membrane,
-        nodes,
-        s.m_l0,
-        s.m_K,
-        PRECONDITIONED.membrane_contact_stiffness,
-        gap,
-        travel,
-        force,
-        True,
-    )
-    assert (gap < 0).sum() > 0 and np.abs(exact[free]).max() > 0.1
-    np.testing.assert_allclose(force[free], exact[free], rtol=1e-12, atol=1e-12)
+    k = PRECONDITIONED.membrane_contact_stiffness
+    _substep_forces(R, x, p1.com, p.membrane, nodes, s.m_l0, s.m_K, k, gap, travel, force, True)
+    assert (gap < 0).sum() > 0 and np.abs(exact()[free]).max() > 0.1
+    np.testing.assert_allclose(force[free], exact()[free], rtol=1e-12, atol=1e-12)
 
 
 def test_substeps_relax_the_nodes_to_their_equilibrium(p1):
     """The bones held at P1's settled neutral state and the free nodes shaken by 0.2 mm: 300 steps of
     substeps bring the nodes back to a balance of `forces.membrane_forces` (largest free-node force below
-    1e-3 N from over 1 N), and the shake's energy is gone, not pumped (the damping is mass-proportional)."""
-    driver = experimental(p1, np.tile(np.eye(4), (2, 1, 1)))
-    result = simulate(p1, design.population(), driver)
-    p = prepare(p1, PRECONDITIONED, driver.mode)
-    s = stiffness(p, design.population())
-    R, x, nodes, free = _state(p1, result, -1, shake_mm=0.2, seed=1)
-    place_nodes(R, x, p1.com, p.membrane, nodes)
-    F, T, force = np.zeros((5, 3)), np.zeros((5, 3)), np.zeros_like(nodes)
-
-    def largest():
-        membrane_forces(
-            R,
-            x,
-            p1.com,
-            p.membrane,
-            nodes,
-            s.m_l0,
-            s.m_K,
-            PRECONDITIONED.membrane_contact_stiffness,
-            F,
-            T,
-            force,
-            False,
-            True,
-        )
-        return np.abs(force[free]).max()
-
-    before = largest()
+    1e-3 N from over 1 N): the damping takes the shake's energy out, it does not pump it."""
+    R, x, nodes, free, p, s, exact = _shaken_neutral(p1, 0.2, 1)
+    before = np.abs(exact()[free]).max()
     nv, scratch = np.zeros_like(nodes), new_scratch(nodes)
     for _ in range(300):
         substep(R, x, p1.com, p.membrane, nodes, nv, s.m_l0, s.m_K, s.node_mass, p.settings, scratch)
-    assert before > 1.0 and largest() < 1e-3, (before, largest())
+    after = np.abs(exact()[free]).max()
+    assert before > 1.0 and after < 1e-3, (before, after)
 
 
 def _rigid_path(t):
