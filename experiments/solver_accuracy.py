@@ -47,7 +47,7 @@ from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.equilibrium import distance, nearest
 from wrist_env.solver.simulate import experimental, idealized, prepare, simulate_batch, simulate_frame
 
-CACHE = Path("runs/solver_accuracy")
+CACHE = Path(__file__).resolve().parent.parent / "runs" / "solver_accuracy"  # the repository root's runs/, git-ignored
 TOLERANCE = (0.1, 0.5)  # mm, degrees: issue 13's "answer unchanged"
 
 
