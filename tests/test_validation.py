@@ -163,3 +163,22 @@ def test_load_directions_are_the_clis_choices_and_unit_vectors():
     assert np.array_equal(simulate.load_direction("axial"), [0.0, 1.0, 0.0])
     with pytest.raises(ValueError, match="sideways"):
         simulate.load_direction("sideways")
+
+
+def test_the_preconditioned_solver_validates_like_the_default(built):
+    """Issue 32's bar: under `SolverSettings.preconditioned()` P1's slopes and ratios are within 0.01 of
+    the default solver's (measured < 0.001 on P1–P3; the load shares to 0.001 points)."""
+    from wrist_env.solver.arrays import solver_settings
+
+    model = built("P1")
+    reports = [
+        validation.validate("P1", model=model, settings=solver_settings(s)) for s in ("default", "preconditioned")
+    ]
+    for check in ("scaphoid_slope", "lunate_slope", "scaphoid_above_lunate", "rs_rl_force_ratio"):
+        a, b = (r.row(check).value for r in reports)
+        assert abs(a - b) < 0.01, (check, a, b)
+    for k in validation.VIEGAS_1993:
+        a, b = (r.row(f"midcarpal_{k}_share_pct").value for r in reports)
+        assert abs(a - b) < 0.1, (k, a, b)
+    with pytest.raises(ValueError, match="solver must be one of"):
+        solver_settings("implicit")

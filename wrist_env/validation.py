@@ -257,12 +257,14 @@ def validate(
     params: BuildParams | None = None,
     load_n: float = IDEALIZED_LOAD_N,
     load_direction: str = "axial",
+    settings=None,
 ) -> Report:
     """Run the published-measurement checks on participant `name` (population design by default).
 
     params: build parameters (`BuildParams`; the anatomy variant), default the default build.
     load_n: the compressive load (N) of the sweeps; the neutral pose takes `NEUTRAL_LOAD_N`.
     load_direction: the loads' direction in the sweeps and at neutral (`simulate.LOAD_DIRECTIONS`).
+    settings: the solver's (`arrays.SolverSettings`), default its defaults.
     """
     from wrist_env.builder.pipeline import BuildParams
     from wrist_env.participants.registry import load_model
@@ -276,9 +278,9 @@ def validate(
     torn_design = with_tears(intact_design, SLIL)
     direction = sim.load_direction(load_direction)
     sweep = sim.idealized(model, n_frames=n_frames, load_n=load_n, direction=direction)
-    intact, torn = sim.simulate_batch(model, [intact_design, torn_design], sweep)
+    intact, torn = sim.simulate_batch(model, [intact_design, torn_design], sweep, settings)
     neutral = sim.simulate(
-        model, intact_design, sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=direction)
+        model, intact_design, sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=direction), settings
     )
 
     b = {bone: BONES.index(bone) for bone in ("capitate", "scaphoid", "lunate")}

@@ -106,6 +106,19 @@ def load_design(spec: str, participant: str) -> Design:
     return design.read_json(spec)
 
 
+def add_solver_argument(parser) -> None:
+    """--solver: the named solver settings (`arrays.SOLVERS`)."""
+    from wrist_env.solver.arrays import SOLVERS
+
+    parser.add_argument(
+        "--solver",
+        choices=SOLVERS,
+        default="default",
+        help="the solver: its defaults, or the preconditioned one (block mass, subcycled membrane, predicted "
+        "sweep frames: 3-4x fewer steps, opt-in; README, 'The preconditioned solver')",
+    )
+
+
 def make_driver(model: Model, motion: str, frames: int | None, flexion: float, extension: float) -> Driver:
     """The capitate driver of `simulate`: an idealized sweep or the capitate held at neutral."""
     from wrist_env.solver import simulate
@@ -129,12 +142,15 @@ def _simulate(args) -> int:
     d = load_design(args.design, args.participant)
     driver = make_driver(model, args.motion, args.frames, args.flexion, args.extension)
     compile_seconds = None
+    from wrist_env.solver.arrays import solver_settings
+
+    settings = solver_settings(args.solver)
     if args.warm_up:
         start = time.perf_counter()
-        simulate.simulate(model, d, make_driver(model, args.motion, 1, 0.0, 0.0))
+        simulate.simulate(model, d, make_driver(model, args.motion, 1, 0.0, 0.0), settings)
         compile_seconds = time.perf_counter() - start
     start = time.perf_counter()
-    result = simulate.simulate(model, d, driver)
+    result = simulate.simulate(model, d, driver, settings)
     wall = time.perf_counter() - start
     if args.json:
         out = {
@@ -216,6 +232,7 @@ def _validate(args) -> int:
     from wrist_env import validation
     from wrist_env.builder.pipeline import BuildParams, anatomy_params
     from wrist_env.participants import registry
+    from wrist_env.solver.arrays import solver_settings
     from wrist_env.solver.simulate import IDEALIZED_LOAD_N
 
     registry.require(args.participant)
@@ -225,8 +242,11 @@ def _validate(args) -> int:
         params=params,
         load_n=IDEALIZED_LOAD_N if args.load is None else args.load,
         load_direction=args.load_direction,
+        settings=solver_settings(args.solver),
     )
-    default = params == BuildParams() and args.load is None and args.load_direction == "axial"
+    default = (
+        params == BuildParams() and args.load is None and args.load_direction == "axial" and args.solver == "default"
+    )
     variant = "" if default else "_variant"
     from wrist_env.figures.draw import FIGURES as figures_dir
 
@@ -321,6 +341,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     s.add_argument("--extension", type=float, default=40.0, help="idealized: last frame's extension, deg (default 40)")
     s.add_argument("--warm-up", action="store_true", help="run a one-frame simulation first (compile_seconds)")
     s.add_argument("--json", action="store_true", help="print all per-frame outputs as JSON")
+    add_solver_argument(s)
     s.set_defaults(run=_simulate)
 
     s = command(
@@ -370,6 +391,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         help="the loads' direction: along the radius (default), or the resultant at neutral of a tendon "
         "rig's tensions along myo-sim's tendon paths (Erhart 2020; see anatomy/tendons.py)",
     )
+    add_solver_argument(s)
     s.set_defaults(run=_validate)
 
     s = command(

@@ -144,6 +144,17 @@ class SolverSettings:
         )
 
 
+SOLVERS = ("default", "preconditioned")
+"""The named solver settings: today's defaults, and `SolverSettings.preconditioned` (opt-in, issue 32)."""
+
+
+def solver_settings(name: str) -> SolverSettings:
+    """The settings of a solver in `SOLVERS`."""
+    if name not in SOLVERS:
+        raise ValueError(f"solver must be one of {SOLVERS}, but got {name!r}")
+    return SolverSettings().preconditioned() if name == "preconditioned" else SolverSettings()
+
+
 def bodies(model: Model, s: SolverSettings) -> Bodies:
     mass = model.mass * s.mass_scale
     inertia = model.inertia * (s.mass_scale * s.inertia_scale)
