@@ -114,8 +114,8 @@ class SolverSettings:
         another equilibrium), at most 150 settling steps, FIRE's α₀ 0.2, no fibre damping (a viscous
         term in seconds that the block mass's light directions cannot carry: dt·c/m = fibre_damping_s
         / dt_s · block_courant² > 2 at block_courant 1), the mass rebuilt every 20 steps and at each
-        stage but not after FIRE's restarts (a rebuild costs ~3 steps; every 10 steps and at each
-        restart cost 1.2× the time for the same steps). Measured in `experiments/bench_solver.py`
+        stage but not after FIRE's restarts (a rebuild costs ~3 steps; rebuilding at the restarts too
+        cost 1.15–1.7× the time for about the same steps). Measured in `experiments/bench_solver.py`
         and the README's solver section."""
         return replace(
             self,
