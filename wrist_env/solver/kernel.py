@@ -36,7 +36,14 @@ from wrist_env.solver.forces import (
 from wrist_env.solver.membrane import new_scratch, substep
 from wrist_env.solver.preconditioner import block_mass, dof, metric, tangent
 from wrist_env.solver.predictor import capitate_move, history, predict, record
-from wrist_env.solver.rigid import interpolate_pose, matrix_to_rotvec, orthonormalize, rotate_in_place, smoothstep
+from wrist_env.solver.rigid import (
+    LEVER_MM,
+    interpolate_pose,
+    matrix_to_rotvec,
+    orthonormalize,
+    rotate_in_place,
+    smoothstep,
+)
 
 N_BONES, N_PAIRS = len(BONES), len(PAIRS)
 N_LIGAMENTS = len(ALL_LIGAMENT_NAMES)
@@ -45,7 +52,6 @@ OK, FAILED_NAN, FAILED_DIVERGED = 0, 1, 2
 
 
 FIRE_F_ALPHA, FIRE_N_MIN = 0.99, 5
-LEVER_MM = 10.0  # moment tolerance = force tolerance × this lever
 
 
 @njit(cache=True, error_model="numpy", inline="always")

@@ -19,10 +19,8 @@ from numba import njit
 
 from wrist_env.model import CAPITATE, LUNATE, SCAPHOID
 from wrist_env.solver.arrays import LOADED
-from wrist_env.solver.rigid import matrix_to_rotvec, rotate_in_place
+from wrist_env.solver.rigid import LEVER_MM, matrix_to_rotvec, rotate_in_place
 
-LEVER_MM = 10.0
-"""A rotation's size as a move: radians × this lever (mm), added to a translation's."""
 MAX_RATIO = 2.0
 """The most the last frame's change is extrapolated by (a frame whose capitate moves more than twice the
 last one's is predicted as twice)."""

@@ -5,6 +5,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+LEVER_MM = 10.0
+"""A rotation's size as a move (radians × this lever, mm): the moment tolerance is the force tolerance
+× this lever, and a bone's or the capitate's move counts its rotation so."""
+
 
 @njit(cache=True, error_model="numpy")
 def matrix_to_rotvec(R):
