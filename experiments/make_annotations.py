@@ -4,7 +4,8 @@ Each ligament site is placed on the template bones (RCS: x volar, y proximal,
 z radial) by an anatomical rule quoted from the descriptions the preprint
 cites (Table 2): Berger 2001 (SLIL regions, RSC, LRL), Nagao 2005 (SRL, DRC,
 UL), Mizuseki 1989 (DRC), Ringler 2013 (RCL), Apergis 2013 (SCL), Moritomo
-2013 (UCL); Berger 2001 and Garcia-Elias 2017 for the fixed TC and TH. A rule
+2013 (UCL); Berger 2001 and Garcia-Elias 2017 for the fixed TC and TH; Garcia-Elias 1989,
+Nanno 2006 and Bettinger 1999 for the radial column's TZC_p, TZC_d and STT. A rule
 picks the extreme vertex of a bone region along an anatomical direction; the patch is the bone surface within `radius_mm` of it.
 Cartilage coverage is the part of each bone facing its partner within a gap.
 
@@ -176,15 +177,50 @@ def main() -> None:
             "centre_mm": np.round(extreme(V["hamate"], (1, 0.3, 0.3), hamate_body), 3).tolist(),
         },
     }
-    # Articulations are between rigid bodies: the scaphocapitate one includes the scaphoid's
-    # distal pole against the trapezium and trapezoid (the STT joint), the lunocapitate one the
-    # triquetrum against the hamate (Moritomo 2013: the helicoid triquetrohamate joint).
+    # The radial column (trapezium + trapezoid, its own body): the trapezoid is bound to the
+    # capitate by dorsal and palmar trapezocapitate ligaments spanning the rims of their joint
+    # (Garcia-Elias 1989, J Hand Surg Am 14:277; Nanno 2006, J Hand Surg Am 31:1160), and the
+    # column to the scaphoid by the palmar STT ligament, from the scaphoid tubercle to the palmar
+    # trapezium proximal to its ridge (Bettinger 1999, J Hand Surg Am 24:786).
+    tz_c, c_tz = near("trapezoid", "capitate", 2.5), near("capitate", "trapezoid", 2.5)
+    for name, direction in (("TZC_p", (1, 0, 0)), ("TZC_d", (-1, 0, 0))):
+        ligaments[name] = {
+            "origin": {
+                "bone": "trapezium",
+                "part": "trapezoid",
+                "radius_mm": 2.0,
+                "centre_mm": np.round(extreme(V["trapezoid"], direction, tz_c), 3).tolist(),
+            },
+            "insertion": {
+                "bone": "capitate",
+                "radius_mm": 2.0,
+                "centre_mm": np.round(extreme(V["capitate"], direction, c_tz), 3).tolist(),
+            },
+        }
+    ligaments["STT"] = {
+        "origin": {
+            "bone": "scaphoid",
+            "radius_mm": 2.0,
+            "centre_mm": np.round(extreme(V["scaphoid"], (1, -1, 1)), 3).tolist(),
+        },
+        "insertion": {
+            "bone": "trapezium",
+            "radius_mm": 2.0,
+            "centre_mm": np.round(extreme(V["trapezium"], (1, 0.5, 0)), 3).tolist(),
+        },
+    }
+    # Articulations are between rigid bodies: the lunocapitate one includes the triquetrum
+    # against the hamate (Moritomo 2013: the helicoid triquetrohamate joint); the radial column
+    # meets the scaphoid's distal pole (the STT joint) and the capitate (the trapezoid–capitate
+    # joint) as articulations of its own.
     cartilage = {
         "radioscaphoid": {"bones": ["radius", "scaphoid"], "max_gap_mm": 2.5},
         "radiolunate": {"bones": ["radius", "lunate"], "max_gap_mm": 2.5},
         "scapholunate": {"bones": ["scaphoid", "lunate"], "max_gap_mm": 2.5},
         "scaphocapitate": {"bones": ["scaphoid", "capitate"], "max_gap_mm": 3.0},
         "lunocapitate": {"bones": ["lunate", "capitate"], "max_gap_mm": 2.5},
+        "scaphotrapezial": {"bones": ["scaphoid", "trapezium"], "max_gap_mm": 3.0},
+        "trapeziocapitate": {"bones": ["trapezium", "capitate"], "max_gap_mm": 2.5},
     }
     data = {
         "about": "wrist-env template annotations in the template RCS (mm); written by experiments/make_annotations.py",

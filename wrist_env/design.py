@@ -51,9 +51,14 @@ LIGAMENTS = (
     Ligament("UL", "ulnolunate ligament", 3, 40.0, 12.0, False, "Nagao 2005"),
 )
 LIGAMENT_NAMES = tuple(lig.name for lig in LIGAMENTS)
+STIFFNESS_TZC, SOURCE_TZC = 75.0, "PLACEHOLDER"
+STIFFNESS_STT, SOURCE_STT = 40.0, "PLACEHOLDER"
 FIXED_LIGAMENTS = (
     Ligament("TC", "palmar triquetrocapitate ligament", 3, 20.0, 6.0, False, "Garcia-Elias 2017; Weaver 1994"),
     Ligament("TH", "palmar triquetrohamate ligament", 3, 20.0, 6.0, False, "Garcia-Elias 2017; Weaver 1994"),
+    Ligament("TZC_p", "palmar trapezocapitate ligament", 3, STIFFNESS_TZC, 0.0, False, SOURCE_TZC),
+    Ligament("TZC_d", "dorsal trapezocapitate ligament", 3, STIFFNESS_TZC, 0.0, False, SOURCE_TZC),
+    Ligament("STT", "palmar scaphotrapeziotrapezoid ligament", 3, STIFFNESS_STT, 0.0, False, SOURCE_STT),
 )
 """Ligaments outside the design, built with the distal row: the two insertions (capitate,
 hamate) of the triquetrum–hamate–capitate ligament, the ulnar arm of the palmar arcuate
@@ -65,6 +70,8 @@ Apergis 2013), split equally between its two insertions, and `FIXED_REFERENCE_ST
 FIXED_REFERENCE_STRAIN = 1.0
 """Reference strain of the fixed ligaments: just taut at neutral (the palmar ligaments are in
 tension in the unloaded neutral wrist: Weaver 1994)."""
+COLUMN_LIGAMENTS = ("TZC_p", "TZC_d", "STT")
+"""The fixed ligaments that hold the radial column (`model.BODY_PARTS`): built in every variant."""
 ALL_LIGAMENTS = LIGAMENTS + FIXED_LIGAMENTS
 ALL_LIGAMENT_NAMES = tuple(lig.name for lig in ALL_LIGAMENTS)
 """The design's eleven ligaments, then the fixed ones: the order of every per-bundle output."""

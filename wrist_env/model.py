@@ -16,38 +16,69 @@ from numpy.typing import ArrayLike
 
 from wrist_env.io import load_dataclass, save_dataclass
 
-BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate")
-"""The five rigid bodies, each named after its principal bone."""
-RADIUS, ULNA, SCAPHOID, LUNATE, CAPITATE = range(5)
+BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate", "trapezium")
+"""The six rigid bodies, each named after its principal bone."""
+RADIUS, ULNA, SCAPHOID, LUNATE, CAPITATE, TRAPEZIUM = range(6)
+N_BODIES = len(BONES)
+FREE = (SCAPHOID, LUNATE, TRAPEZIUM)
+"""The bodies free in 6 DOF under every driver (the capitate is driven; the radius and ulna fixed)."""
 BODY_PARTS = {
     "radius": ("radius",),
     "ulna": ("ulna",),
     "scaphoid": ("scaphoid",),
     "lunate": ("lunate", "triquetrum"),
-    "capitate": ("capitate", "trapezium", "trapezoid", "hamate"),
+    "capitate": ("capitate", "hamate"),
+    "trapezium": ("trapezium", "trapezoid"),
 }
 """The bones of each rigid body, principal bone first: the triquetrum moves with the lunate
-(lunotriquetral motion is small beside scapholunate motion: Ruby 1988, Kobayashi 1997), the
-distal row with the capitate (within 3°: Akhbari 2019)."""
+(lunotriquetral motion is small beside scapholunate motion: Ruby 1988, Kobayashi 1997), the hamate
+with the capitate (the capitohamate joint is bound by its interosseous ligament and moves least of
+the distal row: Garcia-Elias 1989). The trapezium and trapezoid are the radial column, a body of its
+own: it loads the scaphoid's distal pole through the STT joint with the 1st and 2nd rays' loads
+(issue 33: with it on the driven capitate no load reached the STT joint), held to the capitate by
+the trapezocapitate ligaments and joint (`design.FIXED_LIGAMENTS`)."""
+SUPPLIED = ("radius", "ulna", "scaphoid", "lunate", "capitate")
+"""The bodies a participant folder supplies meshes of (the principal bones); the radial column and
+the other parts are carried from the template with the capitate (`anatomy.template.carry_parts`)."""
+CARRIED_WITH = {"trapezium": "capitate"}
+"""Bodies not in `SUPPLIED`, and the supplied body whose registration carries them."""
 PARTS = tuple(p for b in BONES for p in BODY_PARTS[b])
-"""All nine bones of the model: the five principal bones, then the triquetrum and the distal row."""
-PAIRS = ("radioscaphoid", "radiolunate", "scapholunate", "scaphocapitate", "lunocapitate")
-PAIR_BONES = np.array(
-    [[SCAPHOID, RADIUS], [LUNATE, RADIUS], [SCAPHOID, LUNATE], [CAPITATE, SCAPHOID], [CAPITATE, LUNATE]]
+"""All nine bones of the model, body by body (`BODY_PARTS`)."""
+PAIRS = (
+    "radioscaphoid",
+    "radiolunate",
+    "scapholunate",
+    "scaphocapitate",
+    "lunocapitate",
+    "scaphotrapezial",
+    "trapeziocapitate",
 )
-"""(sample bone, grid bone) of each contact pair: samples of the first are looked up in the second's grid."""
+PAIR_BONES = np.array(
+    [
+        [SCAPHOID, RADIUS],
+        [LUNATE, RADIUS],
+        [SCAPHOID, LUNATE],
+        [CAPITATE, SCAPHOID],
+        [CAPITATE, LUNATE],
+        [TRAPEZIUM, SCAPHOID],
+        [TRAPEZIUM, CAPITATE],
+    ]
+)
+"""(sample bone, grid bone) of each contact pair: samples of the first are looked up in the second's grid.
+"scaphotrapezial" is the STT joint (the trapezium's and trapezoid's facets on the scaphoid's distal
+pole), "trapeziocapitate" the radial column against the capitate (chiefly the trapezoid–capitate joint)."""
 ARTICULATIONS = {
     "radioscaphoid": ("radioscaphoid", ("scaphoid",)),
     "radiolunate": ("radiolunate", ("lunate", "triquetrum")),
     "scapholunate": ("scapholunate", ("scaphoid",)),
-    "scaphotrapeziotrapezoid": ("scaphocapitate", ("trapezium", "trapezoid")),
+    "scaphotrapeziotrapezoid": ("scaphotrapezial", ("trapezium", "trapezoid")),
     "scaphocapitate": ("scaphocapitate", ("capitate",)),
     "lunocapitate": ("lunocapitate", ("capitate",)),
     "triquetrohamate": ("lunocapitate", ("hamate",)),
 }
 """Each articulation as (contact pair, the parts of the pair's sample body on its side): a pair whose
-sample body holds several bones (`BODY_PARTS`) spans several joints (the distal row's samples against
-the scaphoid are the STT joint on the trapezium and trapezoid, the scaphocapitate on the capitate)."""
+sample body holds several bones (`BODY_PARTS`) spans several joints (the capitate body's samples
+against the lunate body are the lunocapitate joint on the capitate, the triquetrohamate on the hamate)."""
 MIDCARPAL = ("scaphotrapeziotrapezoid", "scaphocapitate", "lunocapitate", "triquetrohamate")
 """The midcarpal articulations whose load shares Viegas 1993 measured (STT, SC, LC, TH)."""
 
@@ -56,20 +87,20 @@ MIDCARPAL = ("scaphotrapeziotrapezoid", "scaphocapitate", "lunocapitate", "triqu
 class Model:
     """A participant model.
 
-    Bones (5, `BONES` order):
-        vertices (V, 3) mm, vertex_offsets (6,); faces (F, 3) local indices, face_offsets (6,);
+    Bones (6, `BONES` order):
+        vertices (V, 3) mm, vertex_offsets (7,); faces (F, 3) local indices, face_offsets (7,);
         vertex_part (V,) index into `BODY_PARTS[body]` of the bone each vertex belongs to;
         thickness (V,) mm, cartilage thickness per vertex (0 off cartilage);
-        mass (5,) t; com (5, 3) mm; inertia (5, 3, 3) t·mm² about the com, RCS axes;
-        centroid (5, 3) mm, volume centroid of each body's principal bone alone (the point
+        mass (6,) t; com (6, 3) mm; inertia (6, 3, 3) t·mm² about the com, RCS axes;
+        centroid (6, 3) mm, volume centroid of each body's principal bone alone (the point
         whose motion the kinematic cost tracks; the lunate's without the triquetrum).
-    Contact grids (one per bone; empty for the ulna):
-        grid_origin (5, 3) mm; grid_spacing (5,) mm; grid_shape (5, 3);
-        grid_values (G,) float32 mm, C-order per bone, grid_offsets (6,).
-    Contact samples (pair-sorted, 5 pairs in `PAIRS` order, bones in `PAIR_BONES`):
+    Contact grids (one per bone; empty for the ulna and the radial column):
+        grid_origin (6, 3) mm; grid_spacing (6,) mm; grid_shape (6, 3);
+        grid_values (G,) float32 mm, C-order per bone, grid_offsets (7,).
+    Contact samples (pair-sorted, 7 pairs in `PAIRS` order, bones in `PAIR_BONES`):
         sample_points (S, 3) mm on the sample bone's cartilage surface; sample_normals (S, 3);
         sample_area (S,) mm²; sample_thickness (S,) mm, total cartilage thickness of both layers;
-        sample_offsets (6,).
+        sample_offsets (8,).
     contact_law (5,): tri-linear pressure–strain law [e1, e2, k1, k2, k3] (strain, MPa).
     Ligament fibres (1D bundles, Table 2 order):
         fibre_ligament (N,) ligament index; fibre_bones (N, 2) origin, insertion bone;

@@ -23,7 +23,6 @@ from scipy.optimize import minimize
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
-from wrist_env.model import BODY_PARTS
 
 FACETS = (
     ("scaphoid", "capitate"),
@@ -33,7 +32,8 @@ FACETS = (
     ("triquetrum", "hamate"),  # the helicoid triquetrohamate joint
 )
 """The midcarpal facets: (proximal row bone, distal row bone)."""
-DISTAL_ROW = BODY_PARTS["capitate"]
+DISTAL_ROW = ("capitate", "trapezium", "trapezoid", "hamate")
+"""The four distal row bones, seated as one (the capitate body and the radial column)."""
 FACET_REACH_MM = 2.0  # proximal-row vertices within this of a facet's closest approach stand for it
 SMALLEST_MOVE = 1e-3  # weight of the move (deg², mm²) in the least squares: the smallest move of several equal fits
 

@@ -29,7 +29,7 @@ from numpy.typing import ArrayLike
 from wrist_env.anatomy.midcarpal import DISTAL_ROW, read_seat
 from wrist_env.anatomy.myosim import load_myosim_anatomy
 from wrist_env.anatomy.radius_cap import build_radius_cap
-from wrist_env.model import BODY_PARTS, BONES, PARTS
+from wrist_env.model import BODY_PARTS, BONES, CARRIED_WITH, PARTS, SUPPLIED
 
 CARPALS = ("scaphoid", "lunate", "capitate")
 ROW = ("scaphoid", "lunate")  # the proximal row bones that articulate with the radius
@@ -75,8 +75,8 @@ class BoneSurface:
 class Template:
     """The template in the RCS (mm), neutral pose.
 
-    bones: the five rigid bodies (`BONES`); with the distal row, each composed of its
-        `BODY_PARTS`, otherwise the principal bones alone.
+    bones: the rigid bodies (`BONES`); with the distal row, each composed of its
+        `BODY_PARTS`, otherwise the principal bones alone (and the radial column).
     parts: the nine bones one by one (`PARTS`).
     rcs_from_myosim: 4x4 transform from the myo-sim radius body frame (mm) to the RCS (the distal
         row's bones are moved on from there by `midcarpal.read_seat()`).
@@ -88,12 +88,13 @@ class Template:
 
 
 def compose(parts: dict, distal_row: bool = True) -> dict:
-    """The five rigid bodies from the bones (name -> BoneSurface): each body's parts
-    concatenated in `BODY_PARTS` order, with `part` labels (without the distal row:
-    the principal bones alone)."""
+    """The rigid bodies from the bones (name -> BoneSurface): each body's parts concatenated in
+    `BODY_PARTS` order, with `part` labels (without the distal row: the principal bones alone, and the
+    radial column, a body of its own, whole)."""
     bodies = {}
     for body in BONES:
-        members = [parts[p] for p in (BODY_PARTS[body] if distal_row else BODY_PARTS[body][:1])]
+        whole = distal_row or body not in SUPPLIED
+        members = [parts[p] for p in (BODY_PARTS[body] if whole else BODY_PARTS[body][:1])]
         counts = np.cumsum([0] + [len(m.vertices) for m in members])
         bodies[body] = BoneSurface(
             body,
@@ -105,30 +106,33 @@ def compose(parts: dict, distal_row: bool = True) -> dict:
     return bodies
 
 
-def carry_parts(bodies: dict, template: "Template") -> dict:
-    """Bodies with the distal row for a participant who supplies the five principal bones only
-    (name -> BoneSurface, RCS mm): each other bone of a body (`BODY_PARTS`) is the template's,
-    carried by the similarity (rotation, translation, isotropic scale) that registers the
-    template's principal bone onto the participant's (ICP from the shared RCS)."""
-    parts = {b: bodies[b] for b in BONES}
-    for body in BONES:
-        if len(BODY_PARTS[body]) == 1:
+def _registration(source: "BoneSurface", target: "BoneSurface") -> np.ndarray:
+    """The similarity (4×4: rotation, translation, isotropic scale) that registers `source` onto
+    `target` (ICP from the shared RCS)."""
+    mesh = trimesh.Trimesh(target.vertices, target.faces, process=False)
+    T, _, _ = trimesh.registration.icp(
+        source.vertices, mesh, initial=np.eye(4), threshold=1e-6, max_iterations=60, reflection=False, scale=True
+    )
+    return T
+
+
+def carry_parts(bodies: dict, template: "Template", distal_row: bool = True) -> dict:
+    """All bodies for a participant who supplies the principal bones only (`SUPPLIED`: name ->
+    BoneSurface, RCS mm): each other bone of a supplied body (`BODY_PARTS`; with `distal_row`) and
+    each carried body (`CARRIED_WITH`) is the template's, carried by the similarity that registers
+    the template's principal bone of its supplied body onto the participant's."""
+    parts = {b: bodies[b] for b in SUPPLIED}
+    moved = {}
+    for body in SUPPLIED:
+        extra = list(BODY_PARTS[body][1:]) if distal_row else []
+        extra += [p for c, host in CARRIED_WITH.items() if host == body for p in BODY_PARTS[c]]
+        if not extra:
             continue
-        principal = template.parts[body]
-        target = trimesh.Trimesh(bodies[body].vertices, bodies[body].faces, process=False)
-        T, _, _ = trimesh.registration.icp(
-            principal.vertices,
-            target,
-            initial=np.eye(4),
-            threshold=1e-6,
-            max_iterations=60,
-            reflection=False,
-            scale=True,
-        )
-        for p in BODY_PARTS[body][1:]:
+        T = _registration(template.parts[body], bodies[body])
+        for p in extra:
             src = template.parts[p]
-            parts[p] = BoneSurface(p, src.vertices @ T[:3, :3].T + T[:3, 3], src.faces.copy(), src.solid.copy())
-    return compose(parts, True)
+            moved[p] = BoneSurface(p, src.vertices @ T[:3, :3].T + T[:3, 3], src.faces.copy(), src.solid.copy())
+    return compose(parts | moved, distal_row)
 
 
 def rcs_rotation(

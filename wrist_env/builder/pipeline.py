@@ -19,17 +19,17 @@ import trimesh
 from scipy.spatial import cKDTree
 from tqdm import tqdm
 
-from wrist_env.anatomy.annotations import template_annotations
+from wrist_env.anatomy.annotations import read_annotation_data, template_annotations
 from wrist_env.anatomy.template import load_template
 from wrist_env.builder import cartilage, contact_law, fibres, mass, morph, sdf
-from wrist_env.design import ALL_LIGAMENTS, LIGAMENT_NAMES, LIGAMENTS, RSC_INDEX
+from wrist_env.design import ALL_LIGAMENTS, COLUMN_LIGAMENTS, LIGAMENT_NAMES, LIGAMENTS, RSC_INDEX
 from wrist_env.errors import BuildError
 from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model, offsets
 
 if TYPE_CHECKING:
     import argparse
 
-BUILDER_VERSION = 4  # 2: distal row and triquetrum as body parts, swept fossae; 3: both by default, TC and TH; 4: the distal row seated (anatomy.midcarpal)
+BUILDER_VERSION = 5  # 5: the radial column a body of its own (trapezium + trapezoid), its STT and trapeziocapitate contacts and ligaments; 2: distal row and triquetrum as body parts, swept fossae; 3: both by default, TC and TH; 4: the distal row seated (anatomy.midcarpal)
 BUILD_STEPS = ("morph", "cartilage", "ligaments", "contact_law", "grids", "mass")  # timed in the report
 GRID_BONES = ("radius", "scaphoid", "lunate", "capitate")
 MIN_SITE_VERTICES = 8
@@ -184,8 +184,9 @@ def _transfer(morphs: dict, bones: dict, params: BuildParams) -> tuple[dict, dic
 def _ligaments(bones: dict, sites: dict, params: BuildParams):
     bundles, membrane = [], None
     for k, lig in enumerate(ALL_LIGAMENTS):
-        if lig.name not in sites or (lig not in LIGAMENTS and not params.fixed_ligaments):
-            continue  # a fixed ligament of the distal row, in a model without it or without them
+        optional = lig not in LIGAMENTS and lig.name not in COLUMN_LIGAMENTS
+        if lig.name not in sites or (optional and not params.fixed_ligaments):
+            continue  # a fixed TC/TH, in a model without the distal row or without them
         (ob, om), (ib, im) = sites[lig.name]
         if lig.fibres == 0:
             scaphoid = trimesh.Trimesh(bones["scaphoid"].vertices, bones["scaphoid"].faces, process=False)
@@ -237,7 +238,8 @@ def _thin(points, spacing_mm) -> np.ndarray:
 def _contact_samples(bones, thickness, coverage, params):
     """Pair-sorted contact samples on each pair's sample bone (see `Model`)."""
     pts, nrm, area, h, sizes = [], [], [], [], []
-    displaced = {b: cartilage.displaced_vertices(bones[b].vertices, bones[b].faces, thickness[b]) for b in GRID_BONES}
+    paired = sorted({BONES[i] for i in np.unique(PAIR_BONES)})
+    displaced = {b: cartilage.displaced_vertices(bones[b].vertices, bones[b].faces, thickness[b]) for b in paired}
     for p, art in enumerate(PAIRS):
         a, b = BONES[PAIR_BONES[p][0]], BONES[PAIR_BONES[p][1]]
         ca, cb = coverage[art][2], coverage[art][3]
@@ -419,9 +421,7 @@ def build_model(
 
 def _articulation_summary(articulations: dict) -> dict:
     """Per articulation (`PAIRS` names): cartilage thickness over both layers and the joint space (mm)."""
-    names = dict(
-        zip(("radius-scaphoid", "radius-lunate", "scaphoid-lunate", "scaphoid-capitate", "lunate-capitate"), PAIRS)
-    )
+    names = {"-".join(read_annotation_data()["cartilage"][art]["bones"]): art for art in PAIRS}
     thickness, space, overclosure = {}, {}, {}
     for key, art in articulations.items():
         sides = [v for v in art["thickness_mm"].values() if v]

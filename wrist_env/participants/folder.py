@@ -28,7 +28,7 @@ import trimesh
 
 from wrist_env.builder.cartilage import closed_face_mask
 from wrist_env.errors import MeshError, ParticipantError
-from wrist_env.model import BONES
+from wrist_env.model import SUPPLIED
 from wrist_env.trial import ROLES, Trial, mirror_trial, read_trial_csv, write_trial_csv
 
 PARTICIPANT_FILE = "participant.toml"
@@ -63,7 +63,7 @@ class ParticipantSource:
 
     meta: the optional fields of participant.toml (sex, age, facet_type, task, frames) plus
         side, the side of the files (the arrays here are always a right wrist).
-    bones: {bone: (vertices of shape (n, 3) float64 mm, faces of shape (m, 3) int64)}, BONES order, RCS.
+    bones: {bone: (vertices of shape (n, 3) float64 mm, faces of shape (m, 3) int64)}, SUPPLIED order, RCS.
     trials: {name: Trial}. folder: where it was loaded from.
     """
 
@@ -74,10 +74,10 @@ class ParticipantSource:
     folder: Path
 
     def __post_init__(self):
-        if sorted(self.bones) != sorted(BONES):
-            raise ParticipantError(f"participant {self.name!r}: bones must be {BONES}, but got {tuple(self.bones)}.")
+        if sorted(self.bones) != sorted(SUPPLIED):
+            raise ParticipantError(f"participant {self.name!r}: bones must be {SUPPLIED}, but got {tuple(self.bones)}.")
         bones = {}
-        for bone in BONES:
+        for bone in SUPPLIED:
             vertices = np.array(self.bones[bone][0], dtype=np.float64)
             faces = np.array(self.bones[bone][1], dtype=np.int64)
             if vertices.ndim != 2 or vertices.shape[1] != 3 or faces.ndim != 2 or faces.shape[1] != 3:
@@ -130,11 +130,11 @@ def load_participant_folder(path: str | Path) -> ParticipantSource:
     meta = _check_meta(config, toml_path)
 
     bone_table = _check_table(config, "bones", toml_path)
-    absent = [b for b in BONES if b not in bone_table]
-    extra = [b for b in bone_table if b not in BONES]
+    absent = [b for b in SUPPLIED if b not in bone_table]
+    extra = [b for b in bone_table if b not in SUPPLIED]
     if absent or extra:
-        raise ParticipantError(f"{toml_path}: [bones] must list exactly {BONES}, but {absent=} and {extra=}.")
-    bones = {b: read_bone_mesh(_listed_file(folder, bone_table[b], f"bones.{b}", toml_path), b) for b in BONES}
+        raise ParticipantError(f"{toml_path}: [bones] must list exactly {SUPPLIED}, but {absent=} and {extra=}.")
+    bones = {b: read_bone_mesh(_listed_file(folder, bone_table[b], f"bones.{b}", toml_path), b) for b in SUPPLIED}
     _check_arrangement(bones, toml_path)
 
     trial_table = _check_table(config, "trials", toml_path)

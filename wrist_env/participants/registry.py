@@ -94,7 +94,7 @@ def bones(name: str, params: BuildParams | None = None) -> dict:
 
     source = _SOURCES[name]
     principal = {b: BoneSurface(b, v, f, solid_mask(v, f)) for b, (v, f) in source.bones.items()}
-    return carry_parts(principal, load_template()) if params.distal_row else principal
+    return carry_parts(principal, load_template(), params.distal_row)
 
 
 def trials(name: str) -> dict:

@@ -31,20 +31,23 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-from wrist_env.model import CAPITATE, LUNATE, SCAPHOID
+from wrist_env.model import CAPITATE, LUNATE, SCAPHOID, TRAPEZIUM
 from wrist_env.solver.arrays import LOADED
 from wrist_env.solver.contact import law_slope, sdf_lookup_scalar
 from wrist_env.solver.forces import pair_transform, sample_lookup, sample_lookup_smooth, to_local, to_world
 from wrist_env.solver.ligaments import blankevoort_force, blankevoort_slope
 
-N_DOF = 15
-"""Unknowns of the tangent: scaphoid 0–5, lunate 6–11 (shift, rotation), the loaded capitate's shift 12–14."""
+N_DOF = 21
+"""Unknowns of the tangent: scaphoid 0–5, lunate 6–11, radial column 12–17 (shift, rotation), the loaded
+capitate's shift 18–20."""
+SOLVED = (SCAPHOID, LUNATE, TRAPEZIUM, CAPITATE)
+"""The bodies with unknowns (`dof`), in their order."""
 POWER_ITERATIONS = 30
 """Power iterations for the whole tangent's stiffest mode (a Rayleigh quotient: converged to < 1 %)."""
 
 Metric = namedtuple("Metric", ["stiffness", "mass", "inverse", "block", "coupling", "lever", "product"])
-"""The block mass: the free bones' tangent stiffness (15, 15) (N/mm, N/rad, N·mm/rad); the mass
-(t, t·mm, t·mm²) and its inverse (15, 15), block diagonal; scratch: a 6×6 block, a 3×3 coupling (N/mm),
+"""The block mass: the free bones' tangent stiffness (21, 21) (N/mm, N/rad, N·mm/rad); the mass
+(t, t·mm, t·mm²) and its inverse (21, 21), block diagonal; scratch: a 6×6 block, a 3×3 coupling (N/mm),
 two levers [I; [r]×] (2, 6, 3) and a product (6, 3)."""
 
 
@@ -69,8 +72,10 @@ def dof(st, b):
         return 0, 6
     if b == LUNATE:
         return 6, 6
+    if b == TRAPEZIUM:
+        return 12, 6
     if b == CAPITATE and st.driver == LOADED:
-        return 12, 3
+        return 18, 3
     return -1, 0
 
 
@@ -374,7 +379,7 @@ def block_mass(R, bod, st, m):
     M0 = np.zeros((N_DOF, N_DOF))
     M0inv = np.zeros((N_DOF, N_DOF))
     n = 0
-    for b in (SCAPHOID, LUNATE, CAPITATE):
+    for b in SOLVED:
         i0, nb = dof(st, b)
         if i0 < 0:
             continue
@@ -394,7 +399,7 @@ def block_mass(R, bod, st, m):
                     M0[i0 + 3 + p, i0 + 3 + q] = acc
                     M0inv[i0 + 3 + p, i0 + 3 + q] = inv
     top = 0.0
-    for b in (SCAPHOID, LUNATE, CAPITATE):
+    for b in SOLVED:
         i0, nb = dof(st, b)
         if i0 >= 0:
             top = max(top, _top(K, M0, M0inv, i0, i0 + nb))
@@ -403,7 +408,7 @@ def block_mass(R, bod, st, m):
     D[:] = 0.0
     Dinv[:] = 0.0
     ok = top > 0.0
-    for b in (SCAPHOID, LUNATE, CAPITATE):
+    for b in SOLVED:
         i0, nb = dof(st, b)
         if i0 < 0:
             continue
