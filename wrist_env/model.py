@@ -19,6 +19,9 @@ from wrist_env.io import load_dataclass, save_dataclass
 BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate")
 """The five rigid bodies, each named after its principal bone."""
 RADIUS, ULNA, SCAPHOID, LUNATE, CAPITATE = range(5)
+N_BODIES = len(BONES)
+FREE = (SCAPHOID, LUNATE)
+"""The bodies free in 6 DOF under every driver (the capitate is driven; the radius and ulna fixed)."""
 BODY_PARTS = {
     "radius": ("radius",),
     "ulna": ("ulna",),

@@ -33,10 +33,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import trimesh
 
 from wrist_env.anatomy.midcarpal import read_seat
 from wrist_env.anatomy.myosim import CHAIN_XML, _body_transform
+from wrist_env.anatomy.template import load_template
 from wrist_env.errors import BuildError
+from wrist_env.model import BODY_PARTS, BONES
 
 TENDON_XML = "models/arm/assets/myoarm_r_tendon.xml"
 FOREARM_BODIES = ("humerus_r", "ulna_r", "radius_r")
@@ -153,7 +156,6 @@ def load_tendons(rig: str | dict = "erhart2020", chain_xml=None, tendon_xml=None
     """The tendons of `rig` (a `RIGS` name or tendon -> N) at neutral, RCS (see module).
 
     chain_xml, tendon_xml: paths of myo-sim's XMLs (default: the installed package's)."""
-    from wrist_env.anatomy.template import load_template
 
     tensions = RIGS[rig] if isinstance(rig, str) else dict(rig)
     unknown = sorted(set(tensions) - set(LOADED_BONE))
@@ -219,6 +221,40 @@ def carpal_loads(tendons: Tendons, total_n: float, about=None) -> dict:
         point = about + np.cross(F, M) / max(F @ F, 1e-300)
         out[carpal] = CarpalLoad(carpal, F, M, about.copy(), point)
     return out
+
+
+_LINES: dict = {}
+
+
+def _lines(rig: str, model) -> tuple:
+    tendons = load_tendons(rig)
+    template = load_template()
+    body, point = [], []
+    for carpal, site in zip(tendons.carpal, tendons.point):
+        owner = next(b for b in BONES if carpal in BODY_PARTS[b])
+        mine = trimesh.Trimesh(*model.part_mesh(carpal), process=False)
+        theirs = template.parts[carpal].trimesh(solid_only=True)
+        scale = (mine.volume / theirs.volume) ** (1.0 / 3.0)
+        body.append(BONES.index(owner))
+        point.append(mine.center_mass + scale * (site - theirs.center_mass))
+    share = tendons.tension / tendons.tension.sum()
+    arrays = (np.array(body, np.int64), np.array(point), tendons.direction.copy(), share)
+    for a in arrays:
+        a.setflags(write=False)
+    return arrays
+
+
+def model_lines(model, rig: str = "erhart2020") -> tuple:
+    """The `rig`'s tendons as lines of action on a participant model: (body (n,) index into `BONES`,
+    point (n, 3) mm in the model's neutral pose, direction (n, 3) unit pull, share (n,) of the total
+    tension). Each template site moves with the carpal it loads (`carpal`): by the shift of that
+    bone's centroid and the cube root of its volume ratio (both in the RCS at neutral)."""
+    if rig not in RIGS:
+        raise ValueError(f"unknown tendon rig {rig!r}; known: {sorted(RIGS)}")
+    key = (model.name, model.source_hash, rig)
+    if key not in _LINES:
+        _LINES[key] = _lines(rig, model)
+    return _LINES[key]
 
 
 def crossing(point: np.ndarray, direction: np.ndarray, y: float) -> np.ndarray:

@@ -18,11 +18,11 @@ from numba import njit
 from scipy.optimize import least_squares
 
 from wrist_env.design import Design
-from wrist_env.model import Model
+from wrist_env.model import CAPITATE, FREE, Model
 from wrist_env.solver import arrays, kernel, preconditioner
-from wrist_env.solver.kernel import CAPITATE, LEVER_MM, LUNATE, SCAPHOID
+from wrist_env.solver.kernel import LEVER_MM
 from wrist_env.solver.rigid import rotate_in_place
-from wrist_env.solver.simulate import prepare, stiffness
+from wrist_env.solver.simulate import prepare, stiffness, with_loads
 
 JACOBIAN_STEP = 1e-6  # finite-difference step of the Jacobian (rad, mm)
 MAX_EVALUATIONS = 60  # residual evaluations per frame (each with a Jacobian): where contact stalls it, stop
@@ -31,13 +31,13 @@ MAX_EVALUATIONS = 60  # residual evaluations per frame (each with a Jacobian): w
 @njit(cache=True, error_model="numpy")
 def moved_state(q, R0, x0, nodes0, free_nodes, loaded):
     """Rotations, centres of mass (mm) and membrane nodes (mm) of the state (R0, x0, nodes0) moved by
-    the unknowns q: rotation vectors (rad) and shifts (mm) of the scaphoid and lunate, the capitate's
+    the unknowns q: rotation vectors (rad) and shifts (mm) of the free bodies (`model.FREE`), the capitate's
     shift if `loaded`, the free nodes' shifts (mm)."""
     R = R0.copy()
     x = x0.copy()
     nodes = nodes0.copy()
     k = 0
-    for b in (SCAPHOID, LUNATE):
+    for b in FREE:
         rotate_in_place(R[b], q[k], q[k + 1], q[k + 2])
         for i in range(3):
             x[b, i] += q[k + 3 + i]
@@ -64,7 +64,7 @@ def _residual(q, R0, x0, nodes0, free_nodes, bod, grids, law, fib, stiffness, me
     kernel._forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, True)
     F, T, node_force = work.F, work.T, work.node_force
     k = 0
-    for b in (SCAPHOID, LUNATE):
+    for b in FREE:
         for i in range(3):
             out[k + i] = F[b, i]
             out[k + 3 + i] = T[b, i] / LEVER_MM
@@ -106,7 +106,7 @@ class Equilibrium:
     poses (n_frames, 5, 4, 4): neutral → frame transforms at equilibrium, RCS mm.
     residual (n_frames, 2): largest net force (N) and moment (N·mm) left on the free bones.
     distance (n_frames, 2): largest centre-of-mass distance (mm) and rotation (deg) of a moving
-        bone (scaphoid, lunate, capitate) between the explicit answer and the equilibrium.
+        bone (the free bodies and the capitate) between the explicit answer and the equilibrium.
     """
 
     poses: np.ndarray
@@ -116,9 +116,9 @@ class Equilibrium:
 
 def distance(a: np.ndarray, b: np.ndarray, com0: np.ndarray) -> np.ndarray:
     """Per frame, the largest centre-of-mass distance (mm) and rotation (deg) of a moving bone
-    (scaphoid, lunate, capitate) between two pose arrays (n_frames, 5, 4, 4); shape (n_frames, 2)."""
+    (the free bodies and the capitate) between two pose arrays (n_frames, 5, 4, 4); shape (n_frames, 2)."""
     out = np.zeros((len(a), 2))
-    for k in (SCAPHOID, LUNATE, CAPITATE):
+    for k in FREE + (CAPITATE,):
         ca = np.einsum("fij,j->fi", a[:, k, :3, :3], com0[k]) + a[:, k, :3, 3]
         cb = np.einsum("fij,j->fi", b[:, k, :3, :3], com0[k]) + b[:, k, :3, 3]
         cos = (np.einsum("fij,fij->f", a[:, k, :3, :3], b[:, k, :3, :3]) - 1.0) / 2.0
@@ -130,7 +130,7 @@ def distance(a: np.ndarray, b: np.ndarray, com0: np.ndarray) -> np.ndarray:
 def _unknowns(model: Model, driver) -> tuple[np.ndarray, int]:
     """The membrane's free nodes and the number of unknowns (`moved_state`)."""
     free_nodes = np.flatnonzero(np.asarray(model.membrane_bone) < 0).astype(np.int64)
-    return free_nodes, 12 + (3 if driver.mode == arrays.LOADED else 0) + 3 * len(free_nodes)
+    return free_nodes, 6 * len(FREE) + (3 if driver.mode == arrays.LOADED else 0) + 3 * len(free_nodes)
 
 
 def _frame_args(p, design_stiffness, free_nodes, driver, result, f: int) -> tuple:
@@ -143,7 +143,7 @@ def _frame_args(p, design_stiffness, free_nodes, driver, result, f: int) -> tupl
         x0,
         nodes0,
         free_nodes,
-        p.bodies,
+        with_loads(p.bodies, driver),
         p.grids,
         p.law,
         p.fibres,
@@ -232,7 +232,7 @@ def tangent_stiffness(
     # (shift, rotation) against (force, moment) so that K = −∂(force, moment)/∂(shift, rotation)
     order = np.arange(n_unknown)
     rows = np.ones(n_unknown)
-    for k in range(2):
+    for k in range(len(FREE)):
         order[6 * k : 6 * k + 6] = np.r_[6 * k + 3 : 6 * k + 6, 6 * k : 6 * k + 3]
         rows[6 * k + 3 : 6 * k + 6] = LEVER_MM
     K = -(J * rows[:, None])[:, order]
@@ -242,11 +242,12 @@ def tangent_stiffness(
         condensed = condensed - K[bones, nodes] @ np.linalg.pinv(K[nodes, nodes], rcond=1e-9) @ K[nodes, bones]
     R0 = args[0]
     mass = np.zeros((n_bones, n_bones))
-    for k, b in enumerate((SCAPHOID, LUNATE)):
+    for k, b in enumerate(FREE):
         mass[6 * k : 6 * k + 3, 6 * k : 6 * k + 3] = p.bodies.mass[b] * np.eye(3)
         mass[6 * k + 3 : 6 * k + 6, 6 * k + 3 : 6 * k + 6] = R0[b] @ p.bodies.inertia[b] @ R0[b].T
-    if n_bones > 12:
-        mass[12:, 12:] = p.bodies.mass[CAPITATE] * np.eye(3)
+    n_free = 6 * len(FREE)
+    if n_bones > n_free:
+        mass[n_free:, n_free:] = p.bodies.mass[CAPITATE] * np.eye(3)
     asymmetry = float(np.linalg.norm(condensed - condensed.T) / np.linalg.norm(condensed))
     membrane = K[nodes, nodes]
     return Tangent(0.5 * (condensed + condensed.T), mass, asymmetry, 0.5 * (membrane + membrane.T))
@@ -280,7 +281,8 @@ def block_mass(
         R0.copy(), x0.copy(), np.zeros_like(x0), np.zeros_like(x0), nodes0.copy(), np.zeros_like(nodes0)
     )
     work = kernel.new_work(g, nodes0)
-    kernel._forces(state, work, p.bodies, g, p.law, p.fibres, st, p.membrane, p.settings, driver.load(frame), True)
+    bodies = with_loads(p.bodies, driver)
+    kernel._forces(state, work, bodies, g, p.law, p.fibres, st, p.membrane, p.settings, driver.load(frame), True)
     m = preconditioner.metric()
     preconditioner.tangent(
         state.R,

@@ -1,10 +1,11 @@
 """The explicit time-stepping kernel: settle → move to the first pose → motion (Numba).
 
 Semi-implicit Euler with implicit mass-proportional damping for a
-quasi-static answer. The radius and ulna are fixed, the scaphoid and lunate
+quasi-static answer. The radius and ulna are fixed, the free bodies (`model.FREE`)
 free in 6 DOF, the capitate driven (all 6 DOF prescribed, or, for the
-idealized driver, rotations prescribed and translations free under a
-compressive load), the RSC membrane's interior nodes free point masses.
+loaded driver, rotations prescribed and translations free under its
+loads), the RSC membrane's interior nodes free point masses; the driver's
+loads are lines of action on the bodies (`simulate.Loads`).
 The free bones' masses are their (scaled) physical ones or, with
 `Settings.block_mass`, one block each from the tangent stiffness
 (`preconditioner`): the answer is the same equilibrium, reached in fewer steps.
@@ -18,7 +19,7 @@ import numpy as np
 from numba import njit, prange
 
 from wrist_env.design import ALL_LIGAMENT_NAMES, RSC_INDEX
-from wrist_env.model import BONES, CAPITATE, LUNATE, PAIRS, SCAPHOID
+from wrist_env.model import BONES, CAPITATE, FREE, PAIRS
 from wrist_env.solver.arrays import EXPERIMENTAL, LOADED
 from wrist_env.solver.forces import (
     C_AREA,
@@ -28,13 +29,15 @@ from wrist_env.solver.forces import (
     R_FORCE,
     R_MEAN,
     R_PEAK,
+    apply_force,
     contact_forces,
     fibre_forces,
     membrane_forces,
     place_nodes,
+    to_world,
 )
 from wrist_env.solver.membrane import new_scratch, substep
-from wrist_env.solver.preconditioner import block_mass, dof, metric, tangent
+from wrist_env.solver.preconditioner import SOLVED, block_mass, dof, metric, tangent
 from wrist_env.solver.predictor import capitate_move, history, predict, record
 from wrist_env.solver.rigid import (
     LEVER_MM,
@@ -81,7 +84,7 @@ def _mix_metric(v, w, F, T, st, m, a):
     """FIRE mixing of each free body's velocity (v; w) towards M⁻¹(F; T) in the block mass's metric
     (preconditioned FIRE): u ← (1 − a)·u + a·|u|_M·M⁻¹g / |M⁻¹g|_M."""
     M, Minv = m.mass, m.inverse
-    for b in (SCAPHOID, LUNATE, CAPITATE):
+    for b in SOLVED:
         i0, nb = dof(st, b)
         if i0 < 0:
             continue
@@ -114,7 +117,7 @@ def _fire(v, w, nv, F, T, node_force, mem, st, fire, m):
     fire = [alpha, steps with positive power, 1 after a restart (the caller clears it)]."""
     power = 0.0
     for k in range(3):
-        for b in (SCAPHOID, LUNATE):
+        for b in FREE:
             power += F[b, k] * v[b, k] + T[b, k] * w[b, k]
         if st.driver == LOADED:
             power += F[CAPITATE, k] * v[CAPITATE, k]
@@ -125,7 +128,7 @@ def _fire(v, w, nv, F, T, node_force, mem, st, fire, m):
         if st.block_mass:
             _mix_metric(v, w, F, T, st, m, a)
         else:
-            for b in (SCAPHOID, LUNATE):
+            for b in FREE:
                 _mix(v[b : b + 1], F[b : b + 1], a)
                 _mix(w[b : b + 1], T[b : b + 1], a)
             if st.driver == LOADED:
@@ -182,9 +185,12 @@ def _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, rebuild
         e_mem, rsc = membrane_forces(R, x, com0, mem, nodes, m_l0, m_K, k_mem, F, T, node_force, want_energy, False)
     energy += e_mem
     bundle[RSC] += rsc
-    if st.driver == LOADED:
-        for i in range(3):
-            F[CAPITATE, i] += load[i]
+    for i in range(load.shape[0]):  # the driver's lines of action, tensions `load` (N)
+        if load[i] != 0.0:
+            b = bod.load_body[i]
+            p, u = bod.load_point[i], bod.load_direction[i]
+            px, py, pz = to_world(R, x, com0, b, p[0], p[1], p[2])
+            apply_force(F, T, x, b, load[i] * u[0], load[i] * u[1], load[i] * u[2], px, py, pz)
     return energy
 
 
@@ -193,7 +199,8 @@ def _step(
     state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step_index, fire, m, refresh, scratch
 ):
     """One explicit step with the capitate at target (capR, capx), or, for the loaded
-    driver, at rotation capR under the force `load` (3,) N, RCS; with st.block_mass and
+    driver, at rotation capR; `load` (n_lines,) N, the tension of each of the driver's lines of action
+    (`Bodies.load_body`, `load_point`, `load_direction`); with st.block_mass and
     `refresh`, the block mass m (`preconditioner.Metric`) is rebuilt at this state first; with
     st.membrane_substeps the membrane's free nodes then take that many more steps of their own
     (`membrane.substep`; scratch its arrays)."""
@@ -226,7 +233,7 @@ def _step(
             place_nodes(R, x, bod.com0, mem, nodes)
             substep(R, x, bod.com0, mem, nodes, nv, stiffness.m_l0, stiffness.m_K, stiffness.node_mass, st, scratch)
     if step_index % 100 == 0:
-        for b in (SCAPHOID, LUNATE):
+        for b in FREE:
             R[b] = orthonormalize(R[b])
 
 
@@ -237,7 +244,7 @@ def _move_diagonal(R, x, v, w, F, T, bod, st):
     dt = st.dt
     lin = 1.0 / (1.0 + st.damping * dt)
     rot = 1.0 / (1.0 + st.rot_damping * dt)
-    for b in (SCAPHOID, LUNATE):
+    for b in FREE:
         for k in range(3):
             v[b, k] = (v[b, k] + dt * bod.inv_mass[b] * F[b, k]) * lin
             x[b, k] += dt * v[b, k]
@@ -266,7 +273,7 @@ def _move_blocks(R, x, v, w, F, T, st, m):
     refreshes is stiffer than it says."""
     dt = st.dt
     Minv = m.inverse
-    for b in (SCAPHOID, LUNATE, CAPITATE):
+    for b in SOLVED:
         i0, nb = dof(st, b)
         if i0 < 0:
             continue
@@ -301,7 +308,7 @@ def _converged(F, T, bundle, st):
     for i in range(bundle.shape[0]):
         largest = max(largest, bundle[i])
     tol = max(st.force_floor, st.tolerance * largest)
-    for b in (SCAPHOID, LUNATE, CAPITATE):
+    for b in SOLVED:
         if b == CAPITATE and st.driver == EXPERIMENTAL:
             continue
         f2 = F[b, 0] * F[b, 0] + F[b, 1] * F[b, 1] + F[b, 2] * F[b, 2]
@@ -318,7 +325,7 @@ def _converged(F, T, bundle, st):
 def _residual(F, T, st):
     """The largest net force (N) on a free body, or net moment (N·mm) / LEVER_MM."""
     worst = 0.0
-    for b in (SCAPHOID, LUNATE, CAPITATE):
+    for b in SOLVED:
         if b == CAPITATE and st.driver == EXPERIMENTAL:
             continue
         worst = max(worst, np.sqrt(F[b, 0] ** 2 + F[b, 1] ** 2 + F[b, 2] ** 2))
@@ -357,14 +364,14 @@ def _kinetic(R, v, w, nv, bod, st, node_mass, m):
     with st.block_mass, in the block mass m)."""
     ke = 0.0
     if st.block_mass:
-        for b in (SCAPHOID, LUNATE, CAPITATE):
+        for b in SOLVED:
             i0, nb = dof(st, b)
             for i in range(nb if i0 >= 0 else 0):
                 ui = v[b, i] if i < 3 else w[b, i - 3]
                 for j in range(nb):
                     ke += 0.5 * ui * m.mass[i0 + i, i0 + j] * (v[b, j] if j < 3 else w[b, j - 3])
     else:
-        for b in (SCAPHOID, LUNATE):
+        for b in FREE:
             # body-frame angular velocity Rᵀw against the neutral-pose inertia
             u0 = R[b, 0, 0] * w[b, 0] + R[b, 1, 0] * w[b, 1] + R[b, 2, 0] * w[b, 2]
             u1 = R[b, 0, 1] * w[b, 0] + R[b, 1, 1] * w[b, 1] + R[b, 2, 1] * w[b, 2]
@@ -413,8 +420,8 @@ Stiffness = namedtuple("Stiffness", ["f_l0", "f_K", "m_l0", "m_K", "node_mass"])
 membrane's free-node mass (t) its connectors need (`arrays.node_mass`)."""
 Frames = namedtuple("Frames", ["rotation", "com", "load"])
 """The capitate's targets per frame: rotation (n_frames, 3, 3), centre of mass (n_frames, 3) mm (for the
-loaded driver only the start: the centre is free), load (n_frames, 3) N, the force on the distal row
-(RCS; the loaded driver's only)."""
+loaded driver only the start: the centre is free), load (n_frames, n_lines) N, the tension of each line of
+action (`Bodies.load_body`, `load_point`, `load_direction`: the tendons where they enter, `simulate.Driver`)."""
 Outputs = namedtuple(
     "Outputs", ["poses", "contact", "bundle", "energy", "residual", "steps", "settled", "nodes", "status"]
 )
@@ -431,7 +438,7 @@ SETTLE, MOVE = -2, -1
 @njit(cache=True, error_model="numpy")
 def _stage(f, R0, x0, frame_R, frame_x, frame_load, st):
     """Capitate targets of stage f (`SETTLE`, `MOVE` or a frame): start and end rotation, centre (mm)
-    and load (3,) N, ramp steps, most hold steps."""
+    and line tensions (n_lines,) N, ramp steps, most hold steps."""
     if f == SETTLE:
         return R0, x0, frame_load[0], R0, x0, frame_load[0], 0, st.settle_steps
     if f == MOVE:
@@ -484,7 +491,7 @@ def _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes, fir
     x0 = com0[CAPITATE].copy()
     fire = np.array([st.fire_alpha0, 0.0, 0.0])
     capR = np.eye(3)
-    load = np.zeros(3)
+    load = np.zeros(frame_load.shape[1])
     m = metric()
     scratch = new_scratch(nodes)
     hist = history(N_BONES, nodes)
@@ -507,7 +514,7 @@ def _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes, fir
         while k < ramp + most:
             s = smoothstep((k + 1) / ramp) if ramp > 0 else 1.0
             capx = interpolate_pose(Ra, xa, axis, capR, shift, s)
-            for i in range(3):
+            for i in range(load.shape[0]):
                 load[i] = la[i] + s * (lb[i] - la[i])
             refresh = k % st.block_refresh_steps == 0 or (st.block_refresh_restart and fire[2] > 0.0)
             fire[2] = 0.0
@@ -521,14 +528,14 @@ def _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes, fir
                 break
         taken += k
         bad = False
-        for b in (SCAPHOID, LUNATE, CAPITATE):
+        for b in SOLVED:
             for i in range(3):
                 if not np.isfinite(x[b, i]):
                     bad = True
         if bad:
             status[0] = FAILED_NAN
         else:
-            for b in (SCAPHOID, LUNATE):
+            for b in FREE:
                 if np.linalg.norm(x[b] - com0[b]) > st.max_disp_mm:
                     status[0] = FAILED_DIVERGED
                 rel = matrix_to_rotvec(R[b] @ R[CAPITATE].T)
@@ -556,8 +563,11 @@ def _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes, fir
         bundle_out[f] = bundle
         energy_out[f, 0] = _kinetic(R, v, w, nv, bod, st, stiffness.node_mass, m)
         energy_out[f, 1] = energy
-        residual_out[f, 0] = max(np.linalg.norm(F[SCAPHOID]), np.linalg.norm(F[LUNATE]))
-        residual_out[f, 1] = max(np.linalg.norm(T[SCAPHOID]), np.linalg.norm(T[LUNATE]))
+        residual_out[f, 0] = 0.0
+        residual_out[f, 1] = 0.0
+        for b in FREE:
+            residual_out[f, 0] = max(residual_out[f, 0], np.linalg.norm(F[b]))
+            residual_out[f, 1] = max(residual_out[f, 1], np.linalg.norm(T[b]))
         steps_out[f] = taken
         settled_out[f] = 1 if settled else 0
         nodes_out[f] = nodes

@@ -31,20 +31,27 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-from wrist_env.model import CAPITATE, LUNATE, SCAPHOID
+from wrist_env.model import CAPITATE, FREE, N_BODIES
 from wrist_env.solver.arrays import LOADED
 from wrist_env.solver.contact import law_slope, sdf_lookup_scalar
 from wrist_env.solver.forces import pair_transform, sample_lookup, sample_lookup_smooth, to_local, to_world
 from wrist_env.solver.ligaments import blankevoort_force, blankevoort_slope
 
-N_DOF = 15
-"""Unknowns of the tangent: scaphoid 0–5, lunate 6–11 (shift, rotation), the loaded capitate's shift 12–14."""
+N_FREE_DOF = 6 * len(FREE)
+N_DOF = N_FREE_DOF + 3
+"""Unknowns of the tangent: 6 per free body (`model.FREE`, shift then rotation), then the loaded
+capitate's shift (3)."""
+FIRST_DOF = np.full(N_BODIES, -1, np.int64)
+FIRST_DOF[list(FREE)] = 6 * np.arange(len(FREE))
+"""Each body's first unknown (-1: none; the loaded capitate's is `N_FREE_DOF`)."""
+SOLVED = FREE + (CAPITATE,)
+"""The bodies with unknowns (`dof`), in their order."""
 POWER_ITERATIONS = 30
 """Power iterations for the whole tangent's stiffest mode (a Rayleigh quotient: converged to < 1 %)."""
 
 Metric = namedtuple("Metric", ["stiffness", "mass", "inverse", "block", "coupling", "lever", "product"])
-"""The block mass: the free bones' tangent stiffness (15, 15) (N/mm, N/rad, N·mm/rad); the mass
-(t, t·mm, t·mm²) and its inverse (15, 15), block diagonal; scratch: a 6×6 block, a 3×3 coupling (N/mm),
+"""The block mass: the free bones' tangent stiffness (N_DOF, N_DOF) (N/mm, N/rad, N·mm/rad); the mass
+(t, t·mm, t·mm²) and its inverse (N_DOF, N_DOF), block diagonal; scratch: a 6×6 block, a 3×3 coupling (N/mm),
 two levers [I; [r]×] (2, 6, 3) and a product (6, 3)."""
 
 
@@ -65,12 +72,11 @@ def metric():
 @njit(cache=True, error_model="numpy", inline="always")
 def dof(st, b):
     """(first unknown, number of unknowns) of body b; (-1, 0) if it is not free."""
-    if b == SCAPHOID:
-        return 0, 6
-    if b == LUNATE:
-        return 6, 6
+    i0 = FIRST_DOF[b]
+    if i0 >= 0:
+        return i0, 6
     if b == CAPITATE and st.driver == LOADED:
-        return 12, 3
+        return N_FREE_DOF, 3
     return -1, 0
 
 
@@ -374,7 +380,7 @@ def block_mass(R, bod, st, m):
     M0 = np.zeros((N_DOF, N_DOF))
     M0inv = np.zeros((N_DOF, N_DOF))
     n = 0
-    for b in (SCAPHOID, LUNATE, CAPITATE):
+    for b in SOLVED:
         i0, nb = dof(st, b)
         if i0 < 0:
             continue
@@ -394,7 +400,7 @@ def block_mass(R, bod, st, m):
                     M0[i0 + 3 + p, i0 + 3 + q] = acc
                     M0inv[i0 + 3 + p, i0 + 3 + q] = inv
     top = 0.0
-    for b in (SCAPHOID, LUNATE, CAPITATE):
+    for b in SOLVED:
         i0, nb = dof(st, b)
         if i0 >= 0:
             top = max(top, _top(K, M0, M0inv, i0, i0 + nb))
@@ -403,7 +409,7 @@ def block_mass(R, bod, st, m):
     D[:] = 0.0
     Dinv[:] = 0.0
     ok = top > 0.0
-    for b in (SCAPHOID, LUNATE, CAPITATE):
+    for b in SOLVED:
         i0, nb = dof(st, b)
         if i0 < 0:
             continue

@@ -17,7 +17,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-from wrist_env.model import CAPITATE, LUNATE, SCAPHOID
+from wrist_env.model import CAPITATE, FREE
 from wrist_env.solver.arrays import LOADED
 from wrist_env.solver.rigid import LEVER_MM, matrix_to_rotvec, rotate_in_place
 
@@ -72,7 +72,7 @@ def predict(h, R, x, v, w, nodes, nv, mem, st, move):
     if h.count[0] < 2 or not h.move[1] > 1e-9:
         return False
     ratio = min(move / h.move[1], MAX_RATIO)
-    for b in (SCAPHOID, LUNATE):
+    for b in FREE:
         turn = matrix_to_rotvec(h.rotation[1, b] @ h.rotation[0, b].T)
         R[b] = h.rotation[1, b]
         rotate_in_place(R[b], ratio * turn[0], ratio * turn[1], ratio * turn[2])

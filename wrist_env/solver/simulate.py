@@ -11,7 +11,7 @@ maximum flexion to maximum extension about the RCS z axis.
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numba
 import numpy as np
@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
 from wrist_env.design import ALL_LIGAMENT_NAMES, Design
-from wrist_env.model import BONES, Model
+from wrist_env.model import CAPITATE, N_BODIES, PAIRS, Model
 from wrist_env.solver import arrays, kernel
 
 IDEALIZED_LOAD_N = 10.0  # compressive load that keeps the joint in contact (N)
@@ -33,13 +33,14 @@ STATUS = {
 
 @dataclass(frozen=True)
 class Driver:
-    """Capitate targets per frame: rotations (n_frames, 3, 3), centre of mass (n_frames, 3) mm.
+    """Capitate targets per frame and the loads on the bodies.
 
-    mode: arrays.EXPERIMENTAL (all 6 DOF prescribed) or arrays.LOADED
-    (rotations prescribed, translations free under `load_n`); load_n
-    (n_frames,) compressive load on the distal row, N, along load_direction (3,), a unit
-    vector in the RCS (the same in every frame: the tendons pull along the forearm);
-    angle_deg (n_frames,) the wrist flexion angle of each frame (idealized) or NaN.
+    mode: arrays.EXPERIMENTAL (the capitate's 6 DOF prescribed) or arrays.LOADED (its rotations
+    prescribed, its translations free under its loads); rotation (n_frames, 3, 3), com (n_frames, 3)
+    mm; angle_deg (n_frames,) the wrist flexion angle of each frame (idealized) or NaN.
+    Loads, as lines of action (`Loads`): load_n (n_frames,) the total tension, N, shared among the
+    lines by `loads.share`; each line pulls its body at a point fixed in the body along a direction
+    fixed in the RCS (the tendons run along the forearm).
     """
 
     mode: int
@@ -47,26 +48,72 @@ class Driver:
     com: np.ndarray
     angle_deg: np.ndarray
     load_n: np.ndarray
-    load_direction: np.ndarray = field(default_factory=lambda: np.array(AXIAL))
+    loads: "Loads" = None
+
+    def __post_init__(self):
+        if self.loads is None:
+            object.__setattr__(self, "loads", axial_load())
 
     @property
     def n_frames(self) -> int:
         return len(self.rotation)
 
     def load(self, frame: int | None = None) -> np.ndarray:
-        """The force on the distal row (N, RCS): (3,) at `frame`, or (n_frames, 3)."""
+        """Tension of each line (N): (n_lines,) at `frame`, or (n_frames, n_lines)."""
         if frame is None:
-            return np.ascontiguousarray(self.load_n[:, None] * self.load_direction)
-        return self.load_n[frame] * self.load_direction
+            return np.ascontiguousarray(self.load_n[:, None] * self.loads.share)
+        return self.load_n[frame] * self.loads.share
+
+    def resultant(self, frame: int) -> np.ndarray:
+        """The loads' resultant force (3,) N, RCS, at `frame`."""
+        return self.load(frame) @ self.loads.direction
 
 
-def experimental(model: Model, transforms: ArrayLike) -> Driver:
-    """Driver from the capitate's 4×4 transforms (n_frames, 4, 4), neutral → frame, RCS mm."""
+@dataclass(frozen=True)
+class Loads:
+    """Lines of action: body (n,) index into `BONES`; point (n, 3) mm, where each pulls, in its body's
+    neutral pose (RCS); direction (n, 3) unit pull, RCS; share (n,) of the total tension (sum 1);
+    name: what they are (a `LOAD_DIRECTIONS` name or "custom")."""
+
+    body: np.ndarray
+    point: np.ndarray
+    direction: np.ndarray
+    share: np.ndarray
+    name: str = "custom"
+
+
+def axial_load(model: Model | None = None, direction: ArrayLike = AXIAL) -> Loads:
+    """One line on the capitate's centre of mass along `direction` (default `AXIAL`)."""
+    com = np.zeros(3) if model is None else model.com[CAPITATE]
+    d = np.asarray(direction, dtype=np.float64)
+    return Loads(
+        np.array([CAPITATE]),
+        com[None].copy(),
+        (d / np.linalg.norm(d))[None],
+        np.ones(1),
+        "axial" if model else "custom",
+    )
+
+
+def experimental(
+    model: Model, transforms: ArrayLike, load_n: float = 0.0, direction: str | ArrayLike = "axial"
+) -> Driver:
+    """Driver from the capitate's 4×4 transforms (n_frames, 4, 4), neutral → frame, RCS mm; the free
+    bodies under `load_n` (N, total) on the lines of `direction` (see `loads`; the capitate's lines do
+    nothing: it is prescribed)."""
     T = np.asarray(transforms, dtype=np.float64)
-    com0 = model.com[BONES.index("capitate")]
+    com0 = model.com[CAPITATE]
     rotation = np.ascontiguousarray(T[:, :3, :3])
     com = np.einsum("fij,j->fi", rotation, com0) + T[:, :3, 3]
-    return Driver(arrays.EXPERIMENTAL, rotation, np.ascontiguousarray(com), np.full(len(T), np.nan), np.zeros(len(T)))
+    n = len(T)
+    return Driver(
+        arrays.EXPERIMENTAL,
+        rotation,
+        np.ascontiguousarray(com),
+        np.full(n, np.nan),
+        np.full(n, float(load_n)),
+        loads(model, direction),
+    )
 
 
 def loaded(
@@ -77,37 +124,37 @@ def loaded(
     direction: str | ArrayLike = "axial",
 ) -> Driver:
     """Capitate rotations (n_frames, 3, 3) prescribed, its translations free under a
-    compressive load `load_n` (N; a scalar or one per frame) along `direction` (a `LOAD_DIRECTIONS`
-    name or a (3,) vector, RCS)."""
+    total load `load_n` (N; a scalar or one per frame) on the lines of `direction` (see `loads`)."""
     rotation = np.ascontiguousarray(np.asarray(rotations, dtype=np.float64))
     n = len(rotation)
-    com = np.tile(model.com[BONES.index("capitate")], (n, 1))
+    com = np.tile(model.com[CAPITATE], (n, 1))
     load = np.broadcast_to(np.asarray(load_n, dtype=np.float64), (n,)).copy()
     angle = np.full(n, np.nan) if angle_deg is None else np.asarray(angle_deg, dtype=np.float64)
-    return Driver(arrays.LOADED, rotation, com, angle, load, load_direction(direction))
+    return Driver(arrays.LOADED, rotation, com, angle, load, loads(model, direction))
 
 
 LOAD_DIRECTIONS = ("axial", "erhart2020", "erhart2020_groups")
-"""Named load directions: "axial", along the radius' long axis (`AXIAL`), or the resultant on the hand
-at neutral of a tendon rig (`anatomy.tendons.RIGS`), the loads where the tendons put them."""
+"""Named loads: "axial", one compressive line on the capitate along the radius' long axis (`AXIAL`), or
+a tendon rig (`anatomy.tendons.RIGS`): each tendon on the body it loads, where it enters the hand."""
 
 
-def load_direction(direction: str | ArrayLike) -> np.ndarray:
-    """The unit load direction (3,) RCS of a `LOAD_DIRECTIONS` name or a (3,) vector; a wrong name or
-    shape, a non-finite or a zero vector is refused."""
+def loads(model: Model, direction: str | ArrayLike) -> Loads:
+    """The `Loads` of a `LOAD_DIRECTIONS` name, or one line on the capitate along a (3,) vector; a wrong
+    name or shape, a non-finite or a zero vector is refused."""
     if isinstance(direction, str):
         if direction not in LOAD_DIRECTIONS:
             raise ValueError(f"load_direction must be one of {LOAD_DIRECTIONS} or a (3,) vector, but got {direction!r}")
         if direction == "axial":
-            return np.array(AXIAL)
-        from wrist_env.anatomy.tendons import resultant_direction
+            return axial_load(model)
+        from wrist_env.anatomy.tendons import model_lines
 
-        return resultant_direction(direction)
+        body, point, pull, share = model_lines(model, direction)
+        return Loads(body, point, pull, share, direction)
     d = np.asarray(direction, dtype=np.float64)
     norm = float(np.linalg.norm(d)) if d.shape == (3,) else np.nan
     if not np.isfinite(norm) or norm < 1e-9:
         raise ValueError(f"load_direction must be a finite, non-zero (3,) vector (RCS), but got {direction!r}")
-    return d / norm
+    return axial_load(model, d / norm)
 
 
 def static(model: Model, n_frames: int = 3) -> Driver:
@@ -140,10 +187,10 @@ def idealized(
 class Result:
     """Per-frame outputs of one simulation.
 
-    poses (n_frames, 5, 4, 4): neutral → frame transforms of `BONES`, RCS mm.
-    contact (n_frames, 5, 4): per pair (`model.PAIRS`) mean pressure over the
+    poses (n_frames, 6, 4, 4): neutral → frame transforms of `BONES`, RCS mm.
+    contact (n_frames, 7, 4): per pair (`model.PAIRS`) mean pressure over the
         contacting area (MPa), peak pressure (MPa), contact area (mm²), force (N).
-    bundle_force (n_frames, 13): tension of each ligament, `design.ALL_LIGAMENT_NAMES` order (N).
+    bundle_force (n_frames, 16): tension of each ligament, `design.ALL_LIGAMENT_NAMES` order (N).
     energy (n_frames, 2): kinetic and internal energy (N·mm).
     residual (n_frames, 2): largest net force (N) and moment (N·mm) on the free bones.
     steps (n_frames,): explicit steps since the previous frame (ramp + hold to equilibrium;
@@ -174,8 +221,8 @@ class Result:
 def _outputs(n: int, n_frames: int, n_nodes: int) -> kernel.Outputs:
     shape = (n,) if n else ()
     return kernel.Outputs(
-        np.full(shape + (n_frames, 5, 4, 4), np.nan),
-        np.full(shape + (n_frames, 5, 4), np.nan),
+        np.full(shape + (n_frames, N_BODIES, 4, 4), np.nan),
+        np.full(shape + (n_frames, len(PAIRS), 4), np.nan),
         np.full(shape + (n_frames, len(ALL_LIGAMENT_NAMES)), np.nan),
         np.full(shape + (n_frames, 2), np.nan),
         np.full(shape + (n_frames, 2), np.nan),
@@ -269,7 +316,7 @@ def simulate_frame(
     prepared: Prepared | None = None,
 ) -> Result:
     """Simulate one frame of `driver` (≥ 1) alone, from the state of frame − 1 given as the bones'
-    poses (5, 4, 4) and the membrane's nodes (M, 3) mm (another run's answer there): the capitate ramps
+    poses (6, 4, 4) and the membrane's nodes (M, 3) mm (another run's answer there): the capitate ramps
     from frame − 1's pose to frame's and holds. A `Result` of two frames, the first left NaN."""
     if not 1 <= frame < driver.n_frames:
         raise ValueError(f"frame must be in 1..{driver.n_frames - 1}, but got {frame}")
@@ -287,7 +334,7 @@ def simulate_frame(
     out = _outputs(0, 2, len(model.membrane_nodes))
     frames = kernel.Frames(two.rotation, two.com, two.load())
     kernel.run_from(
-        p.bodies,
+        with_loads(p.bodies, driver),
         p.grids,
         p.law,
         p.fibres,
@@ -327,7 +374,17 @@ def simulate_batch(
 def _run(entry, p: Prepared, stiffness: kernel.Stiffness, driver: Driver, out: kernel.Outputs) -> None:
     """Call a kernel entry point (`kernel.run` or `kernel.run_batch`) on prepared arrays; fills `out`."""
     frames = kernel.Frames(driver.rotation, driver.com, driver.load())
-    entry(p.bodies, p.grids, p.law, p.fibres, stiffness, p.membrane, p.settings, frames, out)
+    entry(with_loads(p.bodies, driver), p.grids, p.law, p.fibres, stiffness, p.membrane, p.settings, frames, out)
+
+
+def with_loads(bodies: arrays.Bodies, driver: Driver) -> arrays.Bodies:
+    """The kernel's `Bodies` with the driver's lines of action."""
+    lines = driver.loads
+    return bodies._replace(
+        load_body=np.ascontiguousarray(lines.body, dtype=np.int64),
+        load_point=np.ascontiguousarray(lines.point, dtype=np.float64),
+        load_direction=np.ascontiguousarray(lines.direction, dtype=np.float64),
+    )
 
 
 def _result(out: kernel.Outputs, driver: Driver, status: int) -> Result:
