@@ -89,12 +89,14 @@ def ulnocarpal_space(model) -> dict:
 
 
 def main(names, load_direction: str = "axial") -> None:
-    direction = sim.load_direction(load_direction)
     for name in names:
         model = load_model(name)
-        driver = sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=direction)
+        driver = sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=load_direction)
         result = sim.simulate(model, design.population(), driver)
-        print(f"{name}, population design, neutral, {NEUTRAL_LOAD_N:g} N along {load_direction} {direction.round(3)}")
+        total = driver.resultant(0)
+        print(
+            f"{name}, population design, neutral, {NEUTRAL_LOAD_N:g} N on the {load_direction} lines, resultant {total.round(2)} N"
+        )
         print("| pair | part | force (N) | sample area (mm²) | neutral gap min / median (mm) |\n|---|---|---|---|---|")
         for r in part_gaps(name, model, result.poses[0]):
             print(

@@ -8,6 +8,7 @@ import pytest
 
 from wrist_env import design, validation
 from wrist_env.cli import main
+from wrist_env.model import CAPITATE
 
 pytestmark = pytest.mark.slow  # builds models or runs simulations/studies (minutes)
 
@@ -149,20 +150,26 @@ def test_builtins_move_like_a_wrist(name, built):
 
 
 def test_load_directions_are_the_clis_choices_and_unit_vectors():
-    """`validate --load-direction` offers exactly `simulate.LOAD_DIRECTIONS`; each is a unit vector
-    pulling proximally, the axial one the radius' axis, and another name is refused by name."""
+    """`validate --load-direction` offers exactly `simulate.LOAD_DIRECTIONS`; each is a set of lines of
+    unit pulls whose shares sum to 1 and whose resultant pulls proximally, the axial one a single line
+    along the radius' axis on the capitate, and another name is refused by name."""
     from wrist_env.cli import parser
+    from wrist_env.participants.registry import load_model
     from wrist_env.solver import simulate
 
     validate = parser()._subparsers._group_actions[0].choices["validate"]
     option = next(a for a in validate._actions if "--load-direction" in a.option_strings)
     assert tuple(option.choices) == simulate.LOAD_DIRECTIONS and option.default == "axial"
+    p1 = load_model("P1")
     for name in simulate.LOAD_DIRECTIONS:
-        d = simulate.load_direction(name)
-        assert np.isclose(np.linalg.norm(d), 1.0) and d[1] > 0.95, (name, d)
-    assert np.array_equal(simulate.load_direction("axial"), [0.0, 1.0, 0.0])
+        lines = simulate.loads(p1, name)
+        assert np.allclose(np.linalg.norm(lines.direction, axis=1), 1.0) and np.isclose(lines.share.sum(), 1.0)
+        total = lines.share @ lines.direction
+        assert total[1] > 0.9 * np.linalg.norm(total), (name, total)
+    axial = simulate.loads(p1, "axial")
+    assert np.array_equal(axial.direction, [[0.0, 1.0, 0.0]]) and axial.body.tolist() == [CAPITATE]
     with pytest.raises(ValueError, match="sideways"):
-        simulate.load_direction("sideways")
+        simulate.loads(p1, "sideways")
 
 
 def test_the_preconditioned_solver_validates_like_the_default(built):

@@ -276,7 +276,7 @@ def validate(
     model = model if model is not None else load_model(name, params)
     intact_design = d if d is not None else design_mod.population()
     torn_design = with_tears(intact_design, SLIL)
-    direction = sim.load_direction(load_direction)
+    direction = load_direction
     sweep = sim.idealized(model, n_frames=n_frames, load_n=load_n, direction=direction)
     intact, torn = sim.simulate_batch(model, [intact_design, torn_design], sweep, settings)
     neutral = sim.simulate(

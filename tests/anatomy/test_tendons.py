@@ -27,7 +27,7 @@ def _row(t, name):
 
 
 def test_each_tendon_loads_its_anatomical_carpal(tendons):
-    expected = {"FCR": "trapezoid", "ECRL": "trapezoid", "ECRB": "capitate", "ECU": "hamate", "FCU": "triquetrum"}
+    expected = {"FCR": "trapezoid", "ECRL": "trapezoid", "ECRB": "capitate", "ECU": "hamate", "FCU": "hamate"}
     expected |= {"APL": "trapezium", "EPB": "trapezium", "FPL": "trapezium"}
     expected |= {
         f"{m}{k}": c

@@ -143,7 +143,7 @@ def test_a_load_along_the_tendons_moves_the_distal_row_its_way_and_balances(p1):
 
 
 def test_a_load_direction_must_be_a_finite_nonzero_vector(p1):
-    assert np.allclose(loaded(p1, [np.eye(3)], 5.0, direction=(0.0, 2.0, 0.0)).load(0), (0.0, 5.0, 0.0))
+    assert np.allclose(loaded(p1, [np.eye(3)], 5.0, direction=(0.0, 2.0, 0.0)).resultant(0), (0.0, 5.0, 0.0))
     for bad in ((0.0, 0.0, 0.0), (np.nan, 1.0, 0.0), (1.0, 0.0), "sideways"):
         with pytest.raises(ValueError, match="load_direction"):
             loaded(p1, [np.eye(3)], 5.0, direction=bad)

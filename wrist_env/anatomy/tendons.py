@@ -15,7 +15,9 @@ Per tendon:
   FCR, ECRL, ECRB (round tori on the lunate body) and ECU (on the radius) by 6-13 degrees.
 - `insertion_site`: its first site on the bone it loads (`LOADED_BONE`), which fixes `carpal`:
   1st metacarpal -> trapezium, 2nd -> trapezoid, 3rd -> capitate, 4th-5th -> hamate, pisiform ->
-  triquetrum; a finger flexor loads its ray's metacarpal.
+  hamate (the pisiform is a sesamoid in the FCU, whose tendon is "thence prolonged to the hamate and
+  fifth metacarpal bone by pisohamate and pisometacarpal ligaments": Standring 2005, Gray's Anatomy,
+  39th ed.); a finger flexor loads its ray's metacarpal.
 
 Tensions: Erhart et al. 2020 (J Orthop Surg Res 15, doi:10.1186/s13018-020-01897-y, Table 1): a
 rig that loads every wrist motor and the thumb and finger flexors with weights, holding the hand in
@@ -52,7 +54,7 @@ CARPAL_OF = {
     "thirdmc_r": "capitate",
     "fourthmc_r": "hamate",
     "fifthmc_r": "hamate",
-    "pisiform_r": "triquetrum",
+    "pisiform_r": "hamate",
 }
 RAY_MC = {2: "secondmc_r", 3: "thirdmc_r", 4: "fourthmc_r", 5: "fifthmc_r"}
 LOADED_BONE = {

@@ -18,9 +18,8 @@ from numba import njit
 from scipy.optimize import least_squares
 
 from wrist_env.design import Design
-from wrist_env.model import Model
+from wrist_env.model import CAPITATE, FREE, Model
 from wrist_env.solver import arrays, kernel, preconditioner
-from wrist_env.model import CAPITATE, FREE, LUNATE, SCAPHOID
 from wrist_env.solver.kernel import LEVER_MM
 from wrist_env.solver.rigid import rotate_in_place
 from wrist_env.solver.simulate import prepare, stiffness, with_loads

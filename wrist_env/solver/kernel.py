@@ -1,10 +1,11 @@
 """The explicit time-stepping kernel: settle → move to the first pose → motion (Numba).
 
 Semi-implicit Euler with implicit mass-proportional damping for a
-quasi-static answer. The radius and ulna are fixed, the scaphoid, lunate and
-radial column free in 6 DOF, the capitate driven (all 6 DOF prescribed, or, for the
-idealized driver, rotations prescribed and translations free under a
-compressive load), the RSC membrane's interior nodes free point masses.
+quasi-static answer. The radius and ulna are fixed, the free bodies (`model.FREE`)
+free in 6 DOF, the capitate driven (all 6 DOF prescribed, or, for the
+loaded driver, rotations prescribed and translations free under its
+loads), the RSC membrane's interior nodes free point masses; the driver's
+loads are lines of action on the bodies (`simulate.Loads`).
 The free bones' masses are their (scaled) physical ones or, with
 `Settings.block_mass`, one block each from the tangent stiffness
 (`preconditioner`): the answer is the same equilibrium, reached in fewer steps.

@@ -31,23 +31,27 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-from wrist_env.model import CAPITATE, LUNATE, SCAPHOID, TRAPEZIUM
+from wrist_env.model import CAPITATE, FREE, N_BODIES
 from wrist_env.solver.arrays import LOADED
 from wrist_env.solver.contact import law_slope, sdf_lookup_scalar
 from wrist_env.solver.forces import pair_transform, sample_lookup, sample_lookup_smooth, to_local, to_world
 from wrist_env.solver.ligaments import blankevoort_force, blankevoort_slope
 
-N_DOF = 21
-"""Unknowns of the tangent: scaphoid 0–5, lunate 6–11, radial column 12–17 (shift, rotation), the loaded
-capitate's shift 18–20."""
-SOLVED = (SCAPHOID, LUNATE, TRAPEZIUM, CAPITATE)
+N_FREE_DOF = 6 * len(FREE)
+N_DOF = N_FREE_DOF + 3
+"""Unknowns of the tangent: 6 per free body (`model.FREE`, shift then rotation), then the loaded
+capitate's shift (3)."""
+FIRST_DOF = np.full(N_BODIES, -1, np.int64)
+FIRST_DOF[list(FREE)] = 6 * np.arange(len(FREE))
+"""Each body's first unknown (-1: none; the loaded capitate's is `N_FREE_DOF`)."""
+SOLVED = FREE + (CAPITATE,)
 """The bodies with unknowns (`dof`), in their order."""
 POWER_ITERATIONS = 30
 """Power iterations for the whole tangent's stiffest mode (a Rayleigh quotient: converged to < 1 %)."""
 
 Metric = namedtuple("Metric", ["stiffness", "mass", "inverse", "block", "coupling", "lever", "product"])
-"""The block mass: the free bones' tangent stiffness (21, 21) (N/mm, N/rad, N·mm/rad); the mass
-(t, t·mm, t·mm²) and its inverse (21, 21), block diagonal; scratch: a 6×6 block, a 3×3 coupling (N/mm),
+"""The block mass: the free bones' tangent stiffness (N_DOF, N_DOF) (N/mm, N/rad, N·mm/rad); the mass
+(t, t·mm, t·mm²) and its inverse (N_DOF, N_DOF), block diagonal; scratch: a 6×6 block, a 3×3 coupling (N/mm),
 two levers [I; [r]×] (2, 6, 3) and a product (6, 3)."""
 
 
@@ -68,14 +72,11 @@ def metric():
 @njit(cache=True, error_model="numpy", inline="always")
 def dof(st, b):
     """(first unknown, number of unknowns) of body b; (-1, 0) if it is not free."""
-    if b == SCAPHOID:
-        return 0, 6
-    if b == LUNATE:
-        return 6, 6
-    if b == TRAPEZIUM:
-        return 12, 6
+    i0 = FIRST_DOF[b]
+    if i0 >= 0:
+        return i0, 6
     if b == CAPITATE and st.driver == LOADED:
-        return 18, 3
+        return N_FREE_DOF, 3
     return -1, 0
 
 

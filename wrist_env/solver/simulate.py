@@ -11,7 +11,7 @@ maximum flexion to maximum extension about the RCS z axis.
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numba
 import numpy as np
@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
 from wrist_env.design import ALL_LIGAMENT_NAMES, Design
-from wrist_env.model import BONES, CAPITATE, N_BODIES, PAIRS, Model
+from wrist_env.model import CAPITATE, N_BODIES, PAIRS, Model
 from wrist_env.solver import arrays, kernel
 
 IDEALIZED_LOAD_N = 10.0  # compressive load that keeps the joint in contact (N)
@@ -87,7 +87,11 @@ def axial_load(model: Model | None = None, direction: ArrayLike = AXIAL) -> Load
     com = np.zeros(3) if model is None else model.com[CAPITATE]
     d = np.asarray(direction, dtype=np.float64)
     return Loads(
-        np.array([CAPITATE]), com[None].copy(), (d / np.linalg.norm(d))[None], np.ones(1), "axial" if model else "custom"
+        np.array([CAPITATE]),
+        com[None].copy(),
+        (d / np.linalg.norm(d))[None],
+        np.ones(1),
+        "axial" if model else "custom",
     )
 
 
@@ -103,7 +107,11 @@ def experimental(
     com = np.einsum("fij,j->fi", rotation, com0) + T[:, :3, 3]
     n = len(T)
     return Driver(
-        arrays.EXPERIMENTAL, rotation, np.ascontiguousarray(com), np.full(n, np.nan), np.full(n, float(load_n)),
+        arrays.EXPERIMENTAL,
+        rotation,
+        np.ascontiguousarray(com),
+        np.full(n, np.nan),
+        np.full(n, float(load_n)),
         loads(model, direction),
     )
 

@@ -1,0 +1,84 @@
+"""The drivers' loads as lines of action (`simulate.Loads`): where each tendon pulls, and the force and
+moment each line puts on its body."""
+
+import numpy as np
+import pytest
+
+from wrist_env import design
+from wrist_env.anatomy.tendons import load_tendons, model_lines
+from wrist_env.model import BODY_PARTS, BONES, FREE, LUNATE
+from wrist_env.solver import kernel
+from wrist_env.solver.simulate import Loads, loaded, loads, prepare, stiffness, with_loads
+
+
+def test_each_tendon_pulls_the_body_of_the_carpal_it_loads_near_its_template_site(p1):
+    """Every line of the Erhart rig is on the body holding its carpal (`tendons.CARPAL_OF`), pulls along
+    the template tendon's direction, and sits within 3 mm of its template site (P1 is the template under
+    a smooth warp of a few mm); the shares are the rig's tensions over their sum."""
+    tendons = load_tendons("erhart2020")
+    body, point, direction, share = model_lines(p1, "erhart2020")
+    for k, carpal in enumerate(tendons.carpal):
+        assert carpal in BODY_PARTS[BONES[body[k]]], (tendons.names[k], carpal, BONES[body[k]])
+    assert np.array_equal(direction, tendons.direction)
+    assert np.allclose(share, tendons.tension / tendons.tension.sum()) and np.isclose(share.sum(), 1.0)
+    assert np.linalg.norm(point - tendons.point, axis=1).max() < 3.0
+    assert tendons.carpal[tendons.names.index("FCU")] == "hamate"  # the pisohamate ligament (Standring 2005)
+
+
+def test_a_line_adds_its_force_and_its_moment_about_the_centre_of_mass(p1):
+    """One line of tension t at body point p along u adds t·u to its body's force and (R(p − c0) ) × t·u
+    to its moment, at a rotated and shifted pose: the closed form of a force on a rigid body."""
+    p = prepare(p1, mode=1)
+    design_arrays = stiffness(p, design.population())
+    rng = np.random.default_rng(0)
+    R = np.tile(np.eye(3), (len(BONES), 1, 1))
+    angle = 0.2
+    R[LUNATE] = [[np.cos(angle), -np.sin(angle), 0.0], [np.sin(angle), np.cos(angle), 0.0], [0.0, 0.0, 1.0]]
+    x = p.bodies.com0.copy()
+    x[LUNATE] += (0.3, -0.2, 0.1)
+    point = p1.com[LUNATE] + rng.normal(0.0, 5.0, 3)
+    u = np.array([0.2, 0.9, -0.3])
+    u /= np.linalg.norm(u)
+    line = Loads(np.array([LUNATE]), point[None], u[None], np.ones(1))
+    driver = loaded(p1, [np.eye(3)], 12.0)
+    with_line = type(driver)(driver.mode, driver.rotation, driver.com, driver.angle_deg, driver.load_n, line)
+
+    def forces(d, tension):
+        nodes = np.array(p1.membrane_nodes, dtype=np.float64)
+        state = kernel.State(R.copy(), x.copy(), np.zeros_like(x), np.zeros_like(x), nodes, np.zeros_like(nodes))
+        work = kernel.new_work(p.grids, nodes)
+        bod = with_loads(p.bodies, d)
+        kernel._forces(state, work, bod, p.grids, p.law, p.fibres, design_arrays, p.membrane, p.settings, tension, True)
+        return work.F.copy(), work.T.copy()
+
+    F0, T0 = forces(with_line, np.zeros(1))
+    F1, T1 = forces(with_line, np.array([12.0]))
+    f = 12.0 * u
+    arm = R[LUNATE] @ (point - p1.com[LUNATE])
+    assert np.allclose(F1[LUNATE] - F0[LUNATE], f, atol=1e-12)
+    assert np.allclose(T1[LUNATE] - T0[LUNATE], np.cross(arm, f), atol=1e-9)
+    others = [b for b in range(len(BONES)) if b != LUNATE]
+    assert np.array_equal(F1[others], F0[others]) and np.array_equal(T1[others], T0[others])
+
+
+def test_lines_on_the_driven_row_act_as_their_resultant(p1):
+    """Every Erhart line loads the distal row, whose rotations the driver prescribes: the run under the
+    lines ends where the run under their resultant on the capitate ends (the moments go to the driver),
+    to 1e-4 mm and 1e-3 N (float sums in another order), and it balances (every free body's net force under 0.05 N)."""
+    from wrist_env.solver.simulate import simulate
+
+    lines = loaded(p1, [np.eye(3)], 100.0, direction="erhart2020")
+    assert set(lines.loads.body) == {BONES.index("capitate")}
+    total = lines.resultant(0)
+    resultant = loaded(p1, [np.eye(3)], float(np.linalg.norm(total)), direction=total)
+    a, b = (simulate(p1, design.population(), d) for d in (lines, resultant))
+    assert a.ok and b.ok and a.settled.all() and a.residual[0, 0] < 0.05, (a.message, a.residual)
+    assert np.abs(a.poses - b.poses).max() < 1e-4 and np.abs(a.contact[..., 3] - b.contact[..., 3]).max() < 1e-3
+    assert set(FREE) >= {LUNATE}
+
+
+def test_lines_need_a_known_rig(p1):
+    with pytest.raises(ValueError, match="sideways"):
+        loads(p1, "sideways")
+    with pytest.raises(ValueError, match="rig"):
+        model_lines(p1, "no_such_rig")
