@@ -51,16 +51,23 @@ LIGAMENTS = (
     Ligament("UL", "ulnolunate ligament", 3, 40.0, 12.0, False, "Nagao 2005"),
 )
 LIGAMENT_NAMES = tuple(lig.name for lig in LIGAMENTS)
-STIFFNESS_TZC, SOURCE_TZC = 75.0, "PLACEHOLDER"
-STIFFNESS_STT, SOURCE_STT = 40.0, "PLACEHOLDER"
+STIFFNESS_TZC, SOURCE_TZC = 75.0, "Nagao 2005 (Table 2's palmar radiocarpal); Bajuri 2013"
+STIFFNESS_STT, SOURCE_STT = 40.0, "Apergis 2013 (Table 2's SCL); Bajuri 2013"
+"""No stiffness of the trapezocapitate or STT ligaments is published. As wrist FE models do for
+ligaments without data (Bajuri & Abdul Kadir 2013, Computational Biomechanics of the Wrist Joint,
+Springer: neighbours' properties, 40–350 N/mm in all), each takes a Table 2 neighbour's mean: the
+trapezocapitate bands the short palmar radiocarpal ligaments' 75 N/mm (Nagao 2005), the palmar STT
+ligament the scaphocapitate ligament's 40 N/mm (Apergis 2013), which shares its origin on the
+scaphoid's distal pole; SD 30 % as in Table 2."""
 FIXED_LIGAMENTS = (
     Ligament("TC", "palmar triquetrocapitate ligament", 3, 20.0, 6.0, False, "Garcia-Elias 2017; Weaver 1994"),
     Ligament("TH", "palmar triquetrohamate ligament", 3, 20.0, 6.0, False, "Garcia-Elias 2017; Weaver 1994"),
-    Ligament("TZC_p", "palmar trapezocapitate ligament", 3, STIFFNESS_TZC, 0.0, False, SOURCE_TZC),
-    Ligament("TZC_d", "dorsal trapezocapitate ligament", 3, STIFFNESS_TZC, 0.0, False, SOURCE_TZC),
-    Ligament("STT", "palmar scaphotrapeziotrapezoid ligament", 3, STIFFNESS_STT, 0.0, False, SOURCE_STT),
+    Ligament("TZC_p", "palmar trapezocapitate ligament", 3, STIFFNESS_TZC, 23.0, False, SOURCE_TZC),
+    Ligament("TZC_d", "dorsal trapezocapitate ligament", 3, STIFFNESS_TZC, 23.0, False, SOURCE_TZC),
+    Ligament("STT", "palmar scaphotrapeziotrapezoid ligament", 3, STIFFNESS_STT, 12.0, False, SOURCE_STT),
 )
-"""Ligaments outside the design, built with the distal row: the two insertions (capitate,
+"""Ligaments outside the design: the radial column's (TZC_p, TZC_d, STT: `COLUMN_LIGAMENTS`,
+stiffness above) and, built with the distal row, the two insertions (capitate,
 hamate) of the triquetrum–hamate–capitate ligament, the ulnar arm of the palmar arcuate
 (midcarpal) ligament and the main passive stabilizer of the midcarpal joint in neutral
 (Garcia-Elias 2017, Hand Clin 33:511; Weaver, Tencer & Trumble 1994, J Hand Surg Am 19:464;

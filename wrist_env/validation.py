@@ -23,7 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from wrist_env import design as design_mod
-from wrist_env.model import BONES, MIDCARPAL, PAIRS, Model
+from wrist_env.model import BONES, CAPITATE, MIDCARPAL, PAIRS, TRAPEZIUM, Model
 from wrist_env.solver.simulate import IDEALIZED_LOAD_N
 
 if TYPE_CHECKING:
@@ -75,11 +75,22 @@ SOURCES = {
         "Palmer & Werner 1984, Clin Orthop 187:26-35 (neutral ulnar variance: 18.4 % of the axial load "
         "through the ulna); Hara et al. 1992, J Hand Surg Am 17:339-347 (TFC 15 %)"
     ),
+    "column_rotation_deg": (
+        "Akhbari et al. 2019, J Orthop Res 37:2661-2670 (in-vivo CT, the distal row moves as one rigid "
+        "body within 3 deg)"
+    ),
     "slil_force_30ext_n": (
         "Dimitris et al. 2015, J Hand Surg Am 40:1525-1533 (total SLIL force in active wrist "
         "motion ~20 N, 20.0 +- 3.3 N at 30 deg extension; the preprint's ref. 63)"
     ),
 }
+
+
+def column_rotation_deg(poses: np.ndarray) -> float:
+    """The radial column's largest rotation (deg) relative to the capitate over a run's poses (n, 6, 4, 4)."""
+    relative = np.einsum("fij,fkj->fik", poses[:, TRAPEZIUM, :3, :3], poses[:, CAPITATE, :3, :3])
+    cos = np.clip((np.trace(relative, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+    return float(np.degrees(np.arccos(cos)).max())
 
 
 @dataclass(frozen=True)
@@ -351,6 +362,14 @@ def validate(
             ULNAR_SHARE_PCT,
             "%",
             fail_n,
+        ),
+        _row(
+            "column_rotation_deg",
+            "largest rotation of the radial column (trapezium + trapezoid) relative to the capitate over the sweep",
+            column_rotation_deg(intact.poses) if intact.ok else np.nan,
+            (0.0, 3.0),
+            "deg",
+            fail_i,
         ),
         _row(
             "sl_gap_growth_mm",
