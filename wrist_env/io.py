@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 
-from wrist_env.errors import StoreError
+from wrist_env.errors import InputError, StoreError
 
 if TYPE_CHECKING:
     from _typeshed import DataclassInstance
@@ -95,7 +95,12 @@ def load_dataclass(cls: type[_D], path: str | Path) -> _D:
     for f in dataclasses.fields(cls):
         if isinstance(kwargs.get(f.name), list) and str(f.type).startswith("tuple"):
             kwargs[f.name] = tuple(kwargs[f.name])
-    return cls(**{f.name: kwargs[f.name] for f in dataclasses.fields(cls) if f.name in kwargs})
+    try:
+        return cls(**{f.name: kwargs[f.name] for f in dataclasses.fields(cls) if f.name in kwargs})
+    except StoreError:
+        raise
+    except InputError as e:  # a field of another layout (e.g. a model of another body count)
+        raise StoreError(f"{path}: {e}; delete it to rebuild") from None
 
 
 def sha256_file(path: str | Path) -> str:

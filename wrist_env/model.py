@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
+from wrist_env.errors import InputError
 from wrist_env.io import load_dataclass, save_dataclass
 
 BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate", "trapezium")
@@ -147,9 +148,43 @@ class Model:
     report: dict = field(default_factory=dict)
 
     def __post_init__(self):
+        self._check_layout()
         for name, value in vars(self).items():
             if isinstance(value, np.ndarray):
                 value.setflags(write=False)
+
+    def _check_layout(self) -> None:
+        """`InputError` naming the model and the field unless the per-body, per-pair and offset arrays
+        have this version's body and pair counts (`BONES`, `PAIRS`) and the bone indices are bodies
+        (the kernels do not check bounds: a model of another layout would corrupt memory)."""
+        n, m = len(BONES), len(PAIRS)
+        expected = {
+            "mass": (n,),
+            "com": (n, 3),
+            "inertia": (n, 3, 3),
+            "centroid": (n, 3),
+            "grid_origin": (n, 3),
+            "grid_spacing": (n,),
+            "grid_shape": (n, 3),
+            "vertex_offsets": (n + 1,),
+            "face_offsets": (n + 1,),
+            "grid_offsets": (n + 1,),
+            "sample_offsets": (m + 1,),
+        }
+        for name, shape in expected.items():
+            got = np.shape(getattr(self, name))
+            if got != shape:
+                raise InputError(
+                    f"model {self.name!r}: {name} has shape {got}, but this version's {n} bodies ({', '.join(BONES)}) "
+                    f"and {m} contact pairs need {shape}; rebuild the model"
+                )
+        for name in ("fibre_bones", "membrane_bone"):
+            values = np.asarray(getattr(self, name))
+            if values.size and (values.min() < (-1 if name == "membrane_bone" else 0) or values.max() >= n):
+                raise InputError(
+                    f"model {self.name!r}: {name} holds body index {int(values.max())} or {int(values.min())}, "
+                    f"outside 0..{n - 1}; rebuild the model"
+                )
 
     def bone_mesh(self, bone: str) -> tuple[np.ndarray, np.ndarray]:
         """(vertices (n, 3) mm, faces (m, 3)) of one bone, neutral pose."""
