@@ -96,6 +96,22 @@ def box_inertia(mass: float, size) -> np.ndarray:
     return mass / 12.0 * np.diag([b + c, a + c, a + b])
 
 
+IDLE_COM_MM = (1000.0, 0.0, 0.0)
+"""Where a body a synthetic model does not give sits: far from everything, so nothing acts on it."""
+
+
+def _all_bodies(mass, com, inertia):
+    """mass, com, inertia padded to every body of `BONES` (the fixtures give the first five): an idle body
+    of 1 mg at `IDLE_COM_MM` (free bodies need a mass: it stays at rest, no force reaches it)."""
+    mass, com, inertia = (np.asarray(a, float) for a in (mass, com, inertia))
+    extra = len(BONES) - len(mass)
+    if extra > 0:
+        mass = np.concatenate([mass, np.full(extra, 1e-9)])
+        com = np.vstack([com, np.tile(IDLE_COM_MM, (extra, 1))])
+        inertia = np.concatenate([inertia, np.tile(1e-9 * np.eye(3), (extra, 1, 1))])
+    return mass, com, inertia
+
+
 def model(
     *,
     mass,
@@ -114,6 +130,7 @@ def model(
     fibres: a sequence of `Fibre`.
     """
     grids, patches = grids or {}, patches or {}
+    mass, com, inertia = _all_bodies(mass, com, inertia)
     empty_grid = Grid(np.zeros(3), 0.0, np.zeros((0, 0, 0)))
     g = [grids.get(b, empty_grid) for b in range(len(BONES))]
     empty_patch = _patch(np.zeros((0, 3)), np.zeros((0, 3)), 0.0, 0.0)

@@ -7,7 +7,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from wrist_env import design
-from wrist_env.model import CAPITATE, LUNATE, SCAPHOID
+from wrist_env.model import CAPITATE, FREE, N_BODIES
 from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.forces import membrane_forces, place_nodes
 from wrist_env.solver.membrane import _gaps, _substep_forces, new_scratch, substep
@@ -36,7 +36,19 @@ def _shaken_neutral(model, shake_mm, seed):
     def exact():
         force = np.zeros_like(nodes)
         membrane_forces(
-            R, x, model.com, p.membrane, nodes, s.m_l0, s.m_K, k, np.zeros((5, 3)), np.zeros((5, 3)), force, False, True
+            R,
+            x,
+            model.com,
+            p.membrane,
+            nodes,
+            s.m_l0,
+            s.m_K,
+            k,
+            np.zeros((N_BODIES, 3)),
+            np.zeros((N_BODIES, 3)),
+            force,
+            False,
+            True,
         )
         return force
 
@@ -72,11 +84,11 @@ def test_substeps_relax_the_nodes_to_their_equilibrium(p1):
 
 
 def _rigid_path(t):
-    """Rotations (5, 3, 3) and centres (5, 3) mm on a screw path: each body turns 0.05 rad per unit t
-    about its own axis and moves 0.3 mm per unit t."""
-    axes = np.array([[0, 0, 1.0], [1.0, 0, 0], [0, 1.0, 0], [1.0, 1.0, 0], [0, 1.0, 1.0]])
+    """Rotations (n_bodies, 3, 3) and centres (n_bodies, 3) mm on a screw path: each body turns 0.05 rad
+    per unit t about its own axis and moves 0.3 mm per unit t."""
+    axes = np.array([[0, 0, 1.0], [1.0, 0, 0], [0, 1.0, 0], [1.0, 1.0, 0], [0, 1.0, 1.0], [1.0, 0, 1.0]])[:N_BODIES]
     R = np.stack([Rotation.from_rotvec(0.05 * t * a / np.linalg.norm(a)).as_matrix() for a in axes])
-    x = np.arange(15.0).reshape(5, 3) + 0.3 * t * axes
+    x = np.arange(3.0 * N_BODIES).reshape(N_BODIES, 3) + 0.3 * t * axes
     return R, x
 
 
@@ -91,17 +103,17 @@ def test_the_secant_predictor_continues_a_screw_path_exactly():
     the attached nodes alone."""
     st = _LOADED
     nodes0 = np.zeros((4, 3))
-    h = history(5, nodes0)
+    h = history(N_BODIES, nodes0)
     for t in (0.0, 1.0):
         R, x = _rigid_path(t)
         record(h, R, x, nodes0 + t * np.array([0.1, 0.2, 0.3]), move=2.0)
     for move, t_next in ((3.0, 2.5), (100.0, 1.0 + MAX_RATIO)):
         R, x = _rigid_path(1.0)
         nodes = nodes0 + np.array([0.1, 0.2, 0.3])
-        v, w, nv = np.ones((5, 3)), np.ones((5, 3)), np.ones((4, 3))
+        v, w, nv = np.ones((N_BODIES, 3)), np.ones((N_BODIES, 3)), np.ones((4, 3))
         assert predict(h, R, x, v, w, nodes, nv, _Membrane, st, move)
         R_expect, x_expect = _rigid_path(t_next)
-        for b in (SCAPHOID, LUNATE):
+        for b in FREE:
             np.testing.assert_allclose(R[b], R_expect[b], atol=1e-12)
             np.testing.assert_allclose(x[b], x_expect[b], atol=1e-12)
         np.testing.assert_allclose(x[CAPITATE], x_expect[CAPITATE], atol=1e-12)
@@ -114,9 +126,9 @@ def test_the_secant_predictor_continues_a_screw_path_exactly():
 
 def test_the_predictor_needs_two_equilibria_and_a_moving_capitate():
     st = _LOADED
-    h = history(5, np.zeros((4, 3)))
+    h = history(N_BODIES, np.zeros((4, 3)))
     R, x = _rigid_path(0.0)
-    args = (np.zeros((5, 3)), np.zeros((5, 3)), np.zeros((4, 3)), np.zeros((4, 3)), _Membrane, st, 1.0)
+    args = (np.zeros((N_BODIES, 3)), np.zeros((N_BODIES, 3)), np.zeros((4, 3)), np.zeros((4, 3)), _Membrane, st, 1.0)
     assert not predict(h, R, x, *args)
     record(h, R, x, np.zeros((4, 3)), 1.0)
     assert not predict(h, R, x, *args)

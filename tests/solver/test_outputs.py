@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from wrist_env import design
-from wrist_env.model import BONES, PAIR_BONES, PAIRS
+from wrist_env.model import BONES, N_BODIES, PAIR_BONES, PAIRS
 from wrist_env.solver import arrays, forces
 from wrist_env.solver.contact import sdf_lookup
 from wrist_env.solver.outputs import pair_slice, pressure_map, result_to_dict
@@ -66,7 +66,18 @@ def test_pressure_map_sums_to_the_solver_contact_force_at_the_same_state(p1, swe
         com = np.ascontiguousarray(p1.com)
         every = 1e9  # a band holding every sample
         forces.contact_forces(
-            R, x, com, grids, law, every, active, n_active, unset, np.zeros((5, 3)), np.zeros((5, 3)), stats
+            R,
+            x,
+            com,
+            grids,
+            law,
+            every,
+            active,
+            n_active,
+            unset,
+            np.zeros((N_BODIES, 3)),
+            np.zeros((N_BODIES, 3)),
+            stats,
         )
         assert n_active.sum() == n
         p = pressure_map(p1, sweep.poses[f])

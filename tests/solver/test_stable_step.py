@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from wrist_env import design
+from wrist_env.model import N_BODIES
 from wrist_env.participants import registry
 from wrist_env.solver import arrays
 from wrist_env.solver.forces import membrane_forces, place_nodes
@@ -34,7 +35,7 @@ def test_membrane_eigenvalue_matches_the_force_kernels_jacobian(p1):
     _, _, l0, K = arrays.design_arrays(p1, p.fibres, mem, stiff_rsc())
     m_l0 = mem.rest_length / (1.0 + 2.0 * EPSILON_L + 0.01)  # every connector into its linear region
     m_K = K / l0 * m_l0  # the same N/mm per connector
-    R, x = np.tile(np.eye(3), (5, 1, 1)), p1.com.copy()
+    R, x = np.tile(np.eye(3), (N_BODIES, 1, 1)), p1.com.copy()
     nodes = mem.rest.copy()
     place_nodes(R, x, p1.com, mem, nodes)
     free = np.flatnonzero(np.asarray(p1.membrane_bone) < 0)
@@ -43,7 +44,9 @@ def test_membrane_eigenvalue_matches_the_force_kernels_jacobian(p1):
         moved = nodes.copy()
         moved[free] += q.reshape(-1, 3)
         out = np.zeros_like(nodes)
-        membrane_forces(R, x, p1.com, mem, moved, m_l0, m_K, 0.0, np.zeros((5, 3)), np.zeros((5, 3)), out, False)
+        membrane_forces(
+            R, x, p1.com, mem, moved, m_l0, m_K, 0.0, np.zeros((N_BODIES, 3)), np.zeros((N_BODIES, 3)), out, False
+        )
         return out[free].ravel()
 
     h = 1e-6

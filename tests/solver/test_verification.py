@@ -27,12 +27,11 @@ from scipy.spatial.transform import Rotation
 from wrist_env import design
 from wrist_env.builder.contact_law import fit_contact_law
 from wrist_env.design import LIGAMENT_NAMES
-from wrist_env.model import BONES, PAIRS
+from wrist_env.model import BONES, CAPITATE, LUNATE, PAIRS, RADIUS, SCAPHOID
 from wrist_env.participants.builtin import truth
 from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.simulate import experimental, idealized, simulate
 
-RADIUS, ULNA, SCAPHOID, LUNATE, CAPITATE = range(5)
 LUNOCAPITATE = PAIRS.index("lunocapitate")
 MEAN, PEAK, AREA, FORCE = range(4)
 EPSILON_L = 0.03  # Blankevoort's spring parameter (DESIGN.md)
