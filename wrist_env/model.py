@@ -76,6 +76,7 @@ ARTICULATIONS = {
     "scaphocapitate": ("scaphocapitate", ("capitate",)),
     "lunocapitate": ("lunocapitate", ("capitate",)),
     "triquetrohamate": ("lunocapitate", ("hamate",)),
+    "trapeziocapitate": ("trapeziocapitate", ("trapezium", "trapezoid")),
 }
 """Each articulation as (contact pair, the parts of the pair's sample body on its side): a pair whose
 sample body holds several bones (`BODY_PARTS`) spans several joints (the capitate body's samples
