@@ -272,7 +272,8 @@ def _resultant_direction(rig: str) -> tuple:
 
 def resultant_direction(rig: str = "erhart2020") -> np.ndarray:
     """The unit direction (3,) of the `rig`'s (a `RIGS` name) tendon resultant on the hand at
-    neutral, RCS: the loaded driver's `load_direction` for loads where the tendons put them."""
+    neutral, RCS: the direction of the sum of its lines (`model_lines`), which a driver whose lines all
+    load the driven distal row acts as."""
     if rig not in RIGS:
         raise ValueError(f"unknown tendon rig {rig!r}; known: {sorted(RIGS)}")
     return np.array(_resultant_direction(rig))

@@ -16,7 +16,7 @@ from wrist_env.design import RSC_INDEX, Design, ligament_arrays
 from wrist_env.model import BONES, PAIR_BONES, Model
 from wrist_env.solver.contact import nodal_normals
 
-Bodies = namedtuple("Bodies", "com0 inv_mass inv_inertia mass inertia load_body load_point load_direction")
+Bodies = namedtuple("Bodies", "com0 inv_mass inv_inertia mass inertia")
 Grids = namedtuple(
     "Grids",
     "pair_bones sample_offsets points thickness area values offsets shape origin spacing normals pair_centre pair_reach",
@@ -160,8 +160,7 @@ def bodies(model: Model, s: SolverSettings) -> Bodies:
     inertia = model.inertia * (s.mass_scale * s.inertia_scale)
     inv_mass = np.where(mass > 0, 1.0 / np.where(mass > 0, mass, 1.0), 0.0)
     inv_inertia = np.array([np.linalg.inv(I) if m > 0 else np.zeros((3, 3)) for I, m in zip(inertia, mass)])
-    no_lines = (np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros((0, 3)))  # the driver's (`simulate.with_loads`)
-    return Bodies(np.ascontiguousarray(model.com), inv_mass, inv_inertia, mass, inertia, *no_lines)
+    return Bodies(np.ascontiguousarray(model.com), inv_mass, inv_inertia, mass, inertia)
 
 
 _NORMALS: dict[int, tuple[weakref.ref, np.ndarray]] = {}

@@ -22,7 +22,7 @@ from wrist_env.model import CAPITATE, FREE, Model
 from wrist_env.solver import arrays, kernel, preconditioner
 from wrist_env.solver.kernel import LEVER_MM
 from wrist_env.solver.rigid import rotate_in_place
-from wrist_env.solver.simulate import prepare, stiffness, with_loads
+from wrist_env.solver.simulate import prepare, stiffness
 
 JACOBIAN_STEP = 1e-6  # finite-difference step of the Jacobian (rad, mm)
 MAX_EVALUATIONS = 60  # residual evaluations per frame (each with a Jacobian): where contact stalls it, stop
@@ -143,14 +143,14 @@ def _frame_args(p, design_stiffness, free_nodes, driver, result, f: int) -> tupl
         x0,
         nodes0,
         free_nodes,
-        with_loads(p.bodies, driver),
+        p.bodies,
         p.grids,
         p.law,
         p.fibres,
         design_stiffness,
         p.membrane,
         p.settings,
-        driver.load(f),
+        driver.kernel_load(f),
     )
 
 
@@ -281,8 +281,8 @@ def block_mass(
         R0.copy(), x0.copy(), np.zeros_like(x0), np.zeros_like(x0), nodes0.copy(), np.zeros_like(nodes0)
     )
     work = kernel.new_work(g, nodes0)
-    bodies = with_loads(p.bodies, driver)
-    kernel._forces(state, work, bodies, g, p.law, p.fibres, st, p.membrane, p.settings, driver.load(frame), True)
+    load = driver.kernel_load(frame)
+    kernel._forces(state, work, p.bodies, g, p.law, p.fibres, st, p.membrane, p.settings, load, True)
     m = preconditioner.metric()
     preconditioner.tangent(
         state.R,

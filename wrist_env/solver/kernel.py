@@ -185,12 +185,13 @@ def _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, rebuild
         e_mem, rsc = membrane_forces(R, x, com0, mem, nodes, m_l0, m_K, k_mem, F, T, node_force, want_energy, False)
     energy += e_mem
     bundle[RSC] += rsc
-    for i in range(load.shape[0]):  # the driver's lines of action, tensions `load` (N)
-        if load[i] != 0.0:
-            b = bod.load_body[i]
-            p, u = bod.load_point[i], bod.load_direction[i]
+    tension = load.tension
+    for i in range(tension.shape[0]):  # the driver's lines of action (`Load`)
+        if tension[i] != 0.0:
+            b = load.body[i]
+            p, u = load.point[i], load.direction[i]
             px, py, pz = to_world(R, x, com0, b, p[0], p[1], p[2])
-            apply_force(F, T, x, b, load[i] * u[0], load[i] * u[1], load[i] * u[2], px, py, pz)
+            apply_force(F, T, x, b, tension[i] * u[0], tension[i] * u[1], tension[i] * u[2], px, py, pz)
     return energy
 
 
@@ -199,8 +200,7 @@ def _step(
     state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step_index, fire, m, refresh, scratch
 ):
     """One explicit step with the capitate at target (capR, capx), or, for the loaded
-    driver, at rotation capR; `load` (n_lines,) N, the tension of each of the driver's lines of action
-    (`Bodies.load_body`, `load_point`, `load_direction`); with st.block_mass and
+    driver, at rotation capR; `load` (`Load`) the driver's lines of action at this step's tensions; with st.block_mass and
     `refresh`, the block mass m (`preconditioner.Metric`) is rebuilt at this state first; with
     st.membrane_substeps the membrane's free nodes then take that many more steps of their own
     (`membrane.substep`; scratch its arrays)."""
@@ -418,10 +418,14 @@ def new_work(grids, nodes):
 Stiffness = namedtuple("Stiffness", ["f_l0", "f_K", "m_l0", "m_K", "node_mass"])
 """A design's zero-load lengths (mm) and stiffnesses of the fibres and the membrane connectors, and the
 membrane's free-node mass (t) its connectors need (`arrays.node_mass`)."""
-Frames = namedtuple("Frames", ["rotation", "com", "load"])
+Load = namedtuple("Load", ["body", "point", "direction", "tension"])
+"""The driver's loads as lines of action (the tendons where they enter, `simulate.Loads`): each line's
+body (n_lines,) int64, point (n_lines, 3) mm fixed in the body (RCS at neutral), direction (n_lines, 3)
+unit, RCS, and tension N: (n_lines,) at one state, (n_frames, n_lines) per frame in `Frames`."""
+Frames = namedtuple("Frames", ["rotation", "com", "tension", "body", "point", "direction"])
 """The capitate's targets per frame: rotation (n_frames, 3, 3), centre of mass (n_frames, 3) mm (for the
-loaded driver only the start: the centre is free), load (n_frames, n_lines) N, the tension of each line of
-action (`Bodies.load_body`, `load_point`, `load_direction`: the tendons where they enter, `simulate.Driver`)."""
+loaded driver only the start: the centre is free); the loads per frame, tension (n_frames, n_lines) N on
+the lines (body, point, direction) of `Load` (flat: a parallel loop takes no nested tuples)."""
 Outputs = namedtuple(
     "Outputs", ["poses", "contact", "bundle", "energy", "residual", "steps", "settled", "nodes", "status"]
 )
@@ -475,7 +479,7 @@ def run_from(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes)
 @njit(cache=True, error_model="numpy")
 def _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes, first):
     """`run` from the state (R, x, nodes), its stages from `first` (`SETTLE`, or 1 from a frame-0 state)."""
-    frame_R, frame_x, frame_load = frames
+    frame_R, frame_x, frame_load, body, point, direction = frames
     poses, contact, bundle_out, energy_out, residual_out, steps_out, settled_out, nodes_out, status = out
     com0 = bod.com0
     n_frames = frame_R.shape[0]
@@ -491,13 +495,14 @@ def _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes, fir
     x0 = com0[CAPITATE].copy()
     fire = np.array([st.fire_alpha0, 0.0, 0.0])
     capR = np.eye(3)
-    load = np.zeros(frame_load.shape[1])
+    load = Load(body, point, direction, np.zeros(frame_load.shape[1]))
     m = metric()
     scratch = new_scratch(nodes)
     hist = history(N_BONES, nodes)
     taken = 0
     for f in range(first, n_frames):
         Ra, xa, la, Rb, xb, lb, ramp, most = _stage(f, R0, x0, frame_R, frame_x, frame_load, st)
+        at_end = Load(body, point, direction, lb)  # the loads at the stage's end
         axis = matrix_to_rotvec(Rb @ Ra.T)
         shift = xb - xa
         move = capitate_move(axis, shift)
@@ -505,7 +510,7 @@ def _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes, fir
             st.predict
             and st.driver == LOADED
             and f > 0
-            and _predicted(state, work, bod, grids, law, fib, stiffness, mem, st, hist, Rb, xb, lb, move)
+            and _predicted(state, work, bod, grids, law, fib, stiffness, mem, st, hist, Rb, xb, at_end, move)
         ):
             ramp = st.predict_ramp_steps
             fire[0], fire[1], fire[2] = st.fire_alpha0, 0.0, 1.0
@@ -514,8 +519,8 @@ def _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes, fir
         while k < ramp + most:
             s = smoothstep((k + 1) / ramp) if ramp > 0 else 1.0
             capx = interpolate_pose(Ra, xa, axis, capR, shift, s)
-            for i in range(load.shape[0]):
-                load[i] = la[i] + s * (lb[i] - la[i])
+            for i in range(frame_load.shape[1]):
+                load.tension[i] = la[i] + s * (lb[i] - la[i])
             refresh = k % st.block_refresh_steps == 0 or (st.block_refresh_restart and fire[2] > 0.0)
             fire[2] = 0.0
             _step(
@@ -548,7 +553,7 @@ def _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes, fir
         if st.predict:
             record(hist, R, x, nodes, move)
         # outputs at the state reached (the last step's forces were those before it)
-        energy = _forces(state, work, bod, grids, law, fib, stiffness, mem, st, lb, True)
+        energy = _forces(state, work, bod, grids, law, fib, stiffness, mem, st, at_end, True)
         for b in range(N_BONES):
             poses[f, b, :3, :3] = R[b]
             poses[f, b, :3, 3] = x[b] - R[b] @ com0[b]

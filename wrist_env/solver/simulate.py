@@ -64,6 +64,16 @@ class Driver:
             return np.ascontiguousarray(self.load_n[:, None] * self.loads.share)
         return self.load_n[frame] * self.loads.share
 
+    def kernel_load(self, frame: int | None = None) -> kernel.Load:
+        """The lines of action as the kernel takes them (`kernel.Load`), tensions as `load(frame)`."""
+        lines = self.loads
+        return kernel.Load(
+            np.ascontiguousarray(lines.body, dtype=np.int64),
+            np.ascontiguousarray(lines.point, dtype=np.float64),
+            np.ascontiguousarray(lines.direction, dtype=np.float64),
+            np.ascontiguousarray(self.load(frame), dtype=np.float64),
+        )
+
     def resultant(self, frame: int) -> np.ndarray:
         """The loads' resultant force (3,) N, RCS, at `frame`."""
         return self.load(frame) @ self.loads.direction
@@ -332,9 +342,9 @@ def simulate_frame(
     R = np.ascontiguousarray(poses[:, :3, :3], dtype=np.float64)
     x = np.ascontiguousarray(np.einsum("bij,bj->bi", R, model.com) + poses[:, :3, 3])
     out = _outputs(0, 2, len(model.membrane_nodes))
-    frames = kernel.Frames(two.rotation, two.com, two.load())
+    frames = _frames(two)
     kernel.run_from(
-        with_loads(p.bodies, driver),
+        p.bodies,
         p.grids,
         p.law,
         p.fibres,
@@ -373,18 +383,14 @@ def simulate_batch(
 
 def _run(entry, p: Prepared, stiffness: kernel.Stiffness, driver: Driver, out: kernel.Outputs) -> None:
     """Call a kernel entry point (`kernel.run` or `kernel.run_batch`) on prepared arrays; fills `out`."""
-    frames = kernel.Frames(driver.rotation, driver.com, driver.load())
-    entry(with_loads(p.bodies, driver), p.grids, p.law, p.fibres, stiffness, p.membrane, p.settings, frames, out)
+    frames = _frames(driver)
+    entry(p.bodies, p.grids, p.law, p.fibres, stiffness, p.membrane, p.settings, frames, out)
 
 
-def with_loads(bodies: arrays.Bodies, driver: Driver) -> arrays.Bodies:
-    """The kernel's `Bodies` with the driver's lines of action."""
-    lines = driver.loads
-    return bodies._replace(
-        load_body=np.ascontiguousarray(lines.body, dtype=np.int64),
-        load_point=np.ascontiguousarray(lines.point, dtype=np.float64),
-        load_direction=np.ascontiguousarray(lines.direction, dtype=np.float64),
-    )
+def _frames(driver: Driver) -> kernel.Frames:
+    """The driver's targets and loads per frame, as the kernel takes them."""
+    body, point, direction, tension = driver.kernel_load()
+    return kernel.Frames(driver.rotation, driver.com, tension, body, point, direction)
 
 
 def _result(out: kernel.Outputs, driver: Driver, status: int) -> Result:
