@@ -221,6 +221,9 @@ def main() -> None:
         "lunocapitate": {"bones": ["lunate", "capitate"], "max_gap_mm": 2.5},
         "scaphotrapezial": {"bones": ["scaphoid", "trapezium"], "max_gap_mm": 3.0},
         "trapeziocapitate": {"bones": ["trapezium", "capitate"], "max_gap_mm": 2.5},
+        # the TFCC fills the ulnocarpal space: the lunate lies 5.8-6.6 mm and the triquetrum 8.8-10.1 mm
+        # from the template's ulnar head (issue 33); the disc covers the head's distal face
+        "ulnocarpal": {"bones": ["ulna", "lunate"], "max_gap_mm": 10.5},
     }
     data = {
         "about": "wrist-env template annotations in the template RCS (mm); written by experiments/make_annotations.py",

@@ -53,6 +53,7 @@ PAIRS = (
     "lunocapitate",
     "scaphotrapezial",
     "trapeziocapitate",
+    "ulnocarpal",
 )
 PAIR_BONES = np.array(
     [
@@ -63,11 +64,14 @@ PAIR_BONES = np.array(
         [CAPITATE, LUNATE],
         [TRAPEZIUM, SCAPHOID],
         [TRAPEZIUM, CAPITATE],
+        [LUNATE, ULNA],
     ]
 )
 """(sample bone, grid bone) of each contact pair: samples of the first are looked up in the second's grid.
 "scaphotrapezial" is the STT joint (the trapezium's and trapezoid's facets on the scaphoid's distal
-pole), "trapeziocapitate" the radial column against the capitate (chiefly the trapezoid–capitate joint)."""
+pole), "trapeziocapitate" the radial column against the capitate (chiefly the trapezoid–capitate joint),
+"ulnocarpal" the lunate and triquetrum on the ulnar head through the TFCC, a compliant layer on the ulna
+filling the ulnocarpal space (`builder.pipeline`): the ulnar load path (Palmer & Werner 1984)."""
 ARTICULATIONS = {
     "radioscaphoid": ("radioscaphoid", ("scaphoid",)),
     "radiolunate": ("radiolunate", ("lunate", "triquetrum")),
@@ -77,6 +81,8 @@ ARTICULATIONS = {
     "lunocapitate": ("lunocapitate", ("capitate",)),
     "triquetrohamate": ("lunocapitate", ("hamate",)),
     "trapeziocapitate": ("trapeziocapitate", ("trapezium", "trapezoid")),
+    "ulnolunate": ("ulnocarpal", ("lunate",)),
+    "ulnotriquetral": ("ulnocarpal", ("triquetrum",)),
 }
 """Each articulation as (contact pair, the parts of the pair's sample body on its side): a pair whose
 sample body holds several bones (`BODY_PARTS`) spans several joints (the capitate body's samples
@@ -96,7 +102,7 @@ class Model:
         mass (6,) t; com (6, 3) mm; inertia (6, 3, 3) t·mm² about the com, RCS axes;
         centroid (6, 3) mm, volume centroid of each body's principal bone alone (the point
         whose motion the kinematic cost tracks; the lunate's without the triquetrum).
-    Contact grids (one per bone; empty for the ulna and the radial column):
+    Contact grids (one per bone; empty for the radial column; the ulna's its head, closed, with the TFCC):
         grid_origin (6, 3) mm; grid_spacing (6,) mm; grid_shape (6, 3);
         grid_values (G,) float32 mm, C-order per bone, grid_offsets (7,).
     Contact samples (pair-sorted, 7 pairs in `PAIRS` order, bones in `PAIR_BONES`):

@@ -23,7 +23,6 @@ from scipy.optimize import minimize
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
-
 FACETS = (
     ("scaphoid", "capitate"),
     ("scaphoid", "trapezium"),  # the STT joint

@@ -159,6 +159,37 @@ def _distal_part(mesh: trimesh.Trimesh, y_max: float) -> trimesh.Trimesh:
     return part
 
 
+def closed(surface: BoneSurface) -> BoneSurface:
+    """The bone with each open boundary loop (a cut shaft) closed by a fan to the loop's centroid,
+    all of it solid: the ulna's head for its contact grid (the TFCC, `model.PAIRS` "ulnocarpal").
+    A closed bone comes back as it is."""
+    faces = np.asarray(surface.faces, dtype=np.int64)
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    _, inverse, counts = np.unique(np.sort(edges, axis=1), axis=0, return_inverse=True, return_counts=True)
+    boundary = edges[counts[inverse.ravel()] == 1]
+    if len(boundary) == 0:
+        return surface
+    after = dict(zip(boundary[:, 1].tolist(), boundary[:, 0].tolist()))  # each loop against the faces' order
+    centres, fans, parts = [], [], []
+    while after:
+        loop = [next(iter(after))]
+        while after[loop[-1]] != loop[0]:
+            loop.append(after.pop(loop[-1]))
+        after.pop(loop[-1])
+        centre = len(surface.vertices) + len(centres)
+        centres.append(surface.vertices[loop].mean(axis=0))
+        parts.append(surface.part[loop[0]])
+        fans.extend([loop[k], loop[(k + 1) % len(loop)], centre] for k in range(len(loop)))
+    vertices = np.vstack([surface.vertices, centres])
+    return BoneSurface(
+        surface.name,
+        vertices,
+        np.vstack([faces, np.asarray(fans, dtype=np.int64)]),
+        np.ones(len(vertices), bool),
+        np.concatenate([surface.part, parts]).astype(np.int64),
+    )
+
+
 def _transform(mesh: trimesh.Trimesh, T: np.ndarray) -> trimesh.Trimesh:
     out = mesh.copy()
     out.apply_transform(T)
@@ -211,8 +242,8 @@ def load_template(fossa_sweep_deg: tuple = (0.0, 0.0), distal_row: bool = False)
     ulna = _distal_part(m["ulna"], y_cut)
     bones = {
         "radius": BoneSurface("radius", radius_vertices, radius_faces.astype(np.int64), radius_solid),
-        "ulna": BoneSurface(
-            "ulna", ulna.vertices.copy(), ulna.faces.astype(np.int64), np.zeros(len(ulna.vertices), bool)
+        "ulna": closed(
+            BoneSurface("ulna", ulna.vertices.copy(), ulna.faces.astype(np.int64), np.zeros(len(ulna.vertices), bool))
         ),
     }
     for b in PARTS[2:]:

@@ -20,7 +20,7 @@ from scipy.spatial import cKDTree
 from tqdm import tqdm
 
 from wrist_env.anatomy.annotations import read_annotation_data, template_annotations
-from wrist_env.anatomy.template import load_template
+from wrist_env.anatomy.template import closed, load_template
 from wrist_env.builder import cartilage, contact_law, fibres, mass, morph, sdf
 from wrist_env.design import ALL_LIGAMENTS, COLUMN_LIGAMENTS, LIGAMENT_NAMES, LIGAMENTS, RSC_INDEX
 from wrist_env.errors import BuildError
@@ -29,9 +29,13 @@ from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model, offsets
 if TYPE_CHECKING:
     import argparse
 
-BUILDER_VERSION = 5  # 5: the radial column a body of its own (trapezium + trapezoid), its STT and trapeziocapitate contacts and ligaments; 2: distal row and triquetrum as body parts, swept fossae; 3: both by default, TC and TH; 4: the distal row seated (anatomy.midcarpal)
+BUILDER_VERSION = 6  # 6: the TFCC (the ulna's head closed and gridded, the ulnocarpal pair); 5: the radial column a body of its own (trapezium + trapezoid), its STT and trapeziocapitate contacts and ligaments; 2: distal row and triquetrum as body parts, swept fossae; 3: both by default, TC and TH; 4: the distal row seated (anatomy.midcarpal)
 BUILD_STEPS = ("morph", "cartilage", "ligaments", "contact_law", "grids", "mass")  # timed in the report
-GRID_BONES = ("radius", "scaphoid", "lunate", "capitate")
+GRID_BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate")
+TFCC = "ulnocarpal"
+"""The pair through the TFCC: its articular disc and meniscus homologue fill the ulnocarpal space
+between the ulnar head and the lunate and triquetrum (Palmer & Werner 1981), so the disc is a layer
+on the ulnar head as thick as that space at neutral (`tfcc_thickness`), under the cartilage law."""
 MIN_SITE_VERTICES = 8
 JOINT_SPACE_MM = {art: (0.3, 4.0) for art in PAIRS} | {"scapholunate": (0.3, 8.0)}
 """Plausible neutral joint space per articulation (mm; the median bone-to-bone gap over its cartilage
@@ -217,6 +221,29 @@ def _ligaments(bones: dict, sites: dict, params: BuildParams):
     return bundles, membrane
 
 
+def tfcc_thickness(bones: dict, thickness: dict, coverage: tuple, bandwidth_mm: float) -> tuple[np.ndarray, dict]:
+    """The TFCC as a layer on the ulnar head (`TFCC`): per ulna vertex (mm, zero off its coverage) the
+    distance along its extrusion direction (`cartilage.extrusion_directions`) to the lunate body's
+    cartilage surface (the closest distance where that ray misses), smoothed over the patch
+    (`cartilage.grnn_smooth`); and its min/mean/max."""
+    a, _, mask_a, mask_b = coverage
+    ulna, carpal = (mask_a, mask_b) if a == "ulna" else (mask_b, mask_a)
+    head, lunate = bones["ulna"], bones["lunate"]
+    surface = cartilage.displaced_vertices(lunate.vertices, lunate.faces, thickness["lunate"])
+    gap = cartilage.gap_to(head.vertices, ulna, surface, lunate.faces, carpal)[0]
+    origins = head.vertices[ulna]
+    rays = cartilage.extrusion_directions(head.vertices, head.faces, ulna)[ulna]
+    target = trimesh.Trimesh(surface, lunate.faces, process=False)
+    hits, ray_ids, _ = target.ray.intersects_location(origins, rays, multiple_hits=False)
+    along = np.einsum("ij,ij->i", hits - origins[ray_ids], rays[ray_ids])
+    gap[ray_ids] = np.where(along > 0, along, gap[ray_ids])
+    out = np.zeros(len(head.vertices))
+    out[ulna] = cartilage.grnn_smooth(origins, gap, bandwidth_mm)
+    layer = out[ulna]
+    report = {k: round(float(f(layer)), 4) for k, f in (("min", np.min), ("mean", np.mean), ("max", np.max))}
+    return out, report | {"rays_hit": int(len(ray_ids)), "vertices": int(ulna.sum())}
+
+
 def _vertex_areas(vertices, faces) -> np.ndarray:
     area = trimesh.triangles.area(vertices[faces])
     out = np.zeros(len(vertices))
@@ -316,16 +343,18 @@ def build_model(
         following = BUILD_STEPS.index(step) + 1
         bar.set_postfix_str(BUILD_STEPS[following] if following < len(BUILD_STEPS) else "done")
 
+    bones = {**bones, "ulna": closed(bones["ulna"])}  # an open ulna's head, closed for its grid (the TFCC)
     morphs, morph_report = _morph_all(bones, params, workers)
     lap("morph")
     coverage, sites, relocated = _transfer(morphs, bones, params)
-    articulations = {(a, b): (ma, mb) for (a, b, ma, mb) in coverage.values()}
+    articulations = {(a, b): (ma, mb) for art, (a, b, ma, mb) in coverage.items() if art != TFCC}
     verts = {b: bones[b].vertices for b in BONES}
     faces = {b: bones[b].faces for b in BONES}
     thickness, cart_report = cartilage.build_cartilage(
         verts, faces, articulations, bandwidth_mm=params.grnn_bandwidth_mm, max_thickness_mm=params.max_thickness_mm
     )
     thickness = {b: thickness.get(b, np.zeros(len(verts[b]))) for b in BONES}
+    thickness["ulna"], tfcc_report = tfcc_thickness(bones, thickness, coverage[TFCC], params.grnn_bandwidth_mm)
     summary = _articulation_summary(cart_report["cartilage"]["articulations"])
     _check_joint_spaces(name, summary["joint_space_mm"])
     lap("cartilage")
@@ -378,6 +407,7 @@ def build_model(
         "contact_samples": {p: int(s_off[i + 1] - s_off[i]) for i, p in enumerate(PAIRS)},
         "contact_seating_mm": round(seated, 4),
         **cart_report,
+        "tfcc_thickness_mm": tfcc_report,
     }
     return Model(
         name=name,

@@ -32,7 +32,12 @@ BONE_COLOUR = {
 }
 DISTAL_CROP_MM = 12.0  # radius and ulna are drawn by their distal end only (RCS y below this, mm)
 VIEWS = (("volar view", 0, 0), ("radial view", 0, 90), ("oblique", 25, 40))
-LIGAMENT_COLOURS = dict(zip(ALL_LIGAMENT_NAMES, plt.get_cmap("tab10").colors + ("#000000", "#7a5195", "#ef5675", "#ffa600", "#003f5c", "#58508d")))
+LIGAMENT_COLOURS = dict(
+    zip(
+        ALL_LIGAMENT_NAMES,
+        plt.get_cmap("tab10").colors + ("#000000", "#7a5195", "#ef5675", "#ffa600", "#003f5c", "#58508d"),
+    )
+)
 
 
 def save(fig, out: str | Path, dpi: int = 110, **kwargs) -> Path:
