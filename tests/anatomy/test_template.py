@@ -3,10 +3,11 @@
 import igl
 import numpy as np
 import pytest
+import trimesh
 
 from wrist_env.anatomy.annotations import template_annotations
 from wrist_env.anatomy.myosim import load_myosim_anatomy
-from wrist_env.anatomy.template import JOINT_SPACE_MM, load_template
+from wrist_env.anatomy.template import JOINT_SPACE_MM, BoneSurface, closed, load_template
 
 
 @pytest.fixture(scope="module")
@@ -36,6 +37,24 @@ def test_ulna_is_ulnar_and_carpus_distal(template):
     assert template.bones["ulna"].vertices.mean(axis=0)[2] < -10
     for bone in ("scaphoid", "lunate", "capitate"):
         assert template.bones[bone].vertices.mean(axis=0)[1] < 0
+
+
+def test_the_ulnas_cut_is_closed_into_a_solid_head(template):
+    """The ulna (its distal 20 mm) is closed at the cut for its contact grid (the TFCC): watertight,
+    outward, its volume that of a 20 mm piece of ulna (a 15-20 mm wide head: 2-6 cm³), and a closed
+    bone comes back as it is; a cut cylinder gets the disc's area back (π r², within the polygon's)."""
+    ulna = template.bones["ulna"]
+    mesh = ulna.trimesh()
+    assert ulna.solid.all() and mesh.is_watertight and mesh.is_winding_consistent
+    assert 2000.0 < mesh.volume < 6000.0, mesh.volume
+    assert closed(ulna) is ulna
+    tube = trimesh.creation.cylinder(radius=5.0, height=10.0, sections=64)
+    top = tube.triangles_center[:, 2] > 4.99
+    cut = tube.submesh([np.flatnonzero(~top)], append=True)
+    surface = BoneSurface("ulna", cut.vertices, cut.faces.astype(np.int64), np.zeros(len(cut.vertices), bool))
+    capped = closed(surface).trimesh()
+    assert capped.is_watertight and capped.volume > 0
+    assert capped.area - cut.area == pytest.approx(tube.area - cut.area, rel=1e-9)
 
 
 def test_scaphoid_is_flexed_with_its_distal_pole_volar(template):

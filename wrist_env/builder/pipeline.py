@@ -37,6 +37,7 @@ TFCC = "ulnocarpal"
 between the ulnar head and the lunate and triquetrum (Palmer & Werner 1981), so the disc is a layer
 on the ulnar head as thick as that space at neutral (`tfcc_thickness`), under the cartilage law."""
 MIN_SITE_VERTICES = 8
+SEAT_ITERATIONS = 6  # `_seat_samples`: the TFCC's domed layer needs more than the cartilage's 3
 JOINT_SPACE_MM = {art: (0.3, 4.0) for art in PAIRS} | {"scapholunate": (0.3, 8.0)}
 """Plausible neutral joint space per articulation (mm; the median bone-to-bone gap over its cartilage
 coverage, `cartilage.build_cartilage`). Normal radiocarpal and intercarpal spaces are ~1.5–2 mm
@@ -224,7 +225,8 @@ def _ligaments(bones: dict, sites: dict, params: BuildParams):
 def tfcc_thickness(bones: dict, thickness: dict, coverage: tuple, bandwidth_mm: float) -> tuple[np.ndarray, dict]:
     """The TFCC as a layer on the ulnar head (`TFCC`): per ulna vertex (mm, zero off its coverage) the
     distance along its extrusion direction (`cartilage.extrusion_directions`) to the lunate body's
-    cartilage surface (the closest distance where that ray misses), smoothed over the patch
+    cartilage surface (the closest distance where that ray misses or runs beyond the coverage's
+    max_gap_mm), smoothed over the patch
     (`cartilage.grnn_smooth`); and its min/mean/max."""
     a, _, mask_a, mask_b = coverage
     ulna, carpal = (mask_a, mask_b) if a == "ulna" else (mask_b, mask_a)
@@ -236,7 +238,8 @@ def tfcc_thickness(bones: dict, thickness: dict, coverage: tuple, bandwidth_mm: 
     target = trimesh.Trimesh(surface, lunate.faces, process=False)
     hits, ray_ids, _ = target.ray.intersects_location(origins, rays, multiple_hits=False)
     along = np.einsum("ij,ij->i", hits - origins[ray_ids], rays[ray_ids])
-    gap[ray_ids] = np.where(along > 0, along, gap[ray_ids])
+    reach = read_annotation_data()["cartilage"][TFCC]["max_gap_mm"]  # a grazing ray leaves the space
+    gap[ray_ids] = np.where((along > 0) & (along <= reach), along, gap[ray_ids])
     out = np.zeros(len(head.vertices))
     out[ulna] = cartilage.grnn_smooth(origins, gap, bandwidth_mm)
     layer = out[ulna]
@@ -302,7 +305,7 @@ def _seat_samples(points, normals, sample_offsets, grids):
     for p in range(len(PAIRS)):
         grid = grids[BONES[PAIR_BONES[p][1]]]
         sl = slice(sample_offsets[p], sample_offsets[p + 1])
-        for _ in range(3):
+        for _ in range(SEAT_ITERATIONS):
             d, _ = sdf.trilinear(grid, points[sl])
             inside = np.minimum(d, 0.0)
             worst = max(worst, float(-inside.min()))
