@@ -88,7 +88,7 @@ def ulnocarpal_space(model) -> dict:
     return out | {"ulnar_variance_mm": float(corner[1] - head[:, 1].min())}
 
 
-def main(names, load_direction: str = "axial") -> None:
+def main(names, load_direction: str = sim.DEFAULT_LOADS) -> None:
     for name in names:
         model = load_model(name)
         driver = sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=load_direction)
@@ -122,6 +122,6 @@ def main(names, load_direction: str = "axial") -> None:
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("participants", nargs="*", default=["P1"])
-    parser.add_argument("--load-direction", choices=sim.LOAD_DIRECTIONS, default="axial")
+    parser.add_argument("--load-direction", choices=sim.LOAD_DIRECTIONS, default=sim.DEFAULT_LOADS)
     args = parser.parse_args()
     main(args.participants, args.load_direction)

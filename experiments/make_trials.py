@@ -7,8 +7,9 @@ one motion cycle (extremum → other extremum → back), as CSV of 4×4
 transforms per bone per frame (RCS, mm):
 
 1. the capitate's rotations follow the task (Cardan Z-X-Y angles below);
-   its translations are free under a compressive load (10 N unresisted,
-   40 N resisted; grip clenches from 10 N to 60 N / 120 N);
+   its translations, and the radial column, are free under the tendon lines
+   (`simulate.DEFAULT_LOADS`) at a total of 10 N unresisted, 40 N resisted
+   (grip clenches from 10 N to 60 N / 120 N), the load each frame records;
 2. the scaphoid and lunate come from a higher-fidelity run of the model —
    finer contact sampling (0.7 mm instead of 1.0 mm), half the time step,
    a ten times tighter equilibrium tolerance and force floor, holds up to

@@ -103,6 +103,19 @@ def test_pose_and_read_only():
         trial.pose("hamate")
 
 
+def test_a_trials_load_is_one_finite_nonnegative_value_per_frame():
+    """A trial may carry its total tendon load per frame (N); a wrong length, a NaN or a pull is refused,
+    naming the trial; a mirrored trial keeps it."""
+    trial = make_trial(n_frames=7)
+    assert trial.load_n is None
+    loaded = Trial(trial.name, trial.role, trial.bones, trial.transforms, np.linspace(10.0, 40.0, 7))
+    assert loaded.load_n[-1] == 40.0 and not loaded.load_n.flags.writeable
+    np.testing.assert_array_equal(mirror_trial(loaded).load_n, loaded.load_n)
+    for bad in (np.ones(6), np.r_[np.ones(6), np.nan], np.r_[np.ones(6), -1.0]):
+        with pytest.raises(TrialError, match=f"trial {trial.name!r}: load_n"):
+            Trial(trial.name, trial.role, trial.bones, trial.transforms, bad)
+
+
 def test_mirror_trial_moves_mirrored_points_to_mirrored_poses():
     trial = make_trial()
     mirrored = mirror_trial(trial)

@@ -42,12 +42,15 @@ class Trial:
     name: trial name, e.g. "unresisted". role: "calibrate", "validate" or "other".
     bones: bone names, a subset of BONES in BONES order.
     transforms: array of shape (n_bones, n_frames, 4, 4), float64, mm; neutral pose → frame f, RCS.
+    load_n: the total tendon load of each frame (n_frames,), N, where it is known (the built-in trials'
+        truth runs), else None (taken as 0: the bones not prescribed by the trial move unloaded).
     """
 
     name: str
     role: str
     bones: tuple[str, ...]
     transforms: np.ndarray
+    load_n: np.ndarray | None = None
 
     def __post_init__(self):
         if self.role not in ROLES:
@@ -66,6 +69,15 @@ class Trial:
         transforms.setflags(write=False)
         object.__setattr__(self, "bones", bones)
         object.__setattr__(self, "transforms", transforms)
+        if self.load_n is not None:
+            load = np.array(self.load_n, dtype=np.float64)
+            if load.shape != (transforms.shape[1],) or not np.isfinite(load).all() or (load < 0).any():
+                raise TrialError(
+                    f"trial {self.name!r}: load_n must be finite, >= 0 N, one per frame ({transforms.shape[1]},), "
+                    f"but got shape {load.shape}, values {load.ravel()[:5]}"
+                )
+            load.setflags(write=False)
+            object.__setattr__(self, "load_n", load)
 
     @property
     def n_frames(self) -> int:
@@ -80,7 +92,7 @@ class Trial:
 
 def mirror_trial(trial: Trial) -> Trial:
     """The trial of the mirror-image wrist (left ↔ right): each transform conjugated by diag(1, 1, −1, 1)."""
-    return Trial(trial.name, trial.role, trial.bones, MIRROR @ trial.transforms @ MIRROR)
+    return Trial(trial.name, trial.role, trial.bones, MIRROR @ trial.transforms @ MIRROR, trial.load_n)
 
 
 def validate_transforms(array: ArrayLike, source: str, bones: tuple[str, ...] | None = None) -> np.ndarray:

@@ -24,7 +24,7 @@ from numpy.typing import ArrayLike
 
 from wrist_env import design as design_mod
 from wrist_env.model import BONES, CAPITATE, MIDCARPAL, PAIRS, TRAPEZIUM, Model
-from wrist_env.solver.simulate import IDEALIZED_LOAD_N
+from wrist_env.solver.simulate import DEFAULT_LOADS, IDEALIZED_LOAD_N
 
 if TYPE_CHECKING:
     from wrist_env.builder.pipeline import BuildParams
@@ -267,7 +267,7 @@ def validate(
     n_frames: int = 17,
     params: BuildParams | None = None,
     load_n: float = IDEALIZED_LOAD_N,
-    load_direction: str = "axial",
+    load_direction: str = DEFAULT_LOADS,
     settings=None,
 ) -> Report:
     """Run the published-measurement checks on participant `name` (population design by default).

@@ -9,7 +9,9 @@ import wrist_env
 from wrist_env import design
 from wrist_env.envs.task import task
 from wrist_env.envs.wrappers import FreezeVariables
+from wrist_env.model import TRAPEZIUM
 from wrist_env.participants import builtin
+from wrist_env.solver.simulate import DEFAULT_LOADS
 
 IDS = wrist_env.registered_ids()
 
@@ -129,8 +131,8 @@ def test_a_bad_row_of_a_vector_action_is_named(bad):
 
 def test_the_idealized_sweep_under_the_tendons_load_is_its_own_task():
     """`load_direction` reaches the sweep's driver through `gym.make`: the tendons' lines move the
-    truth's radioscaphoid pressure, the reward stays 0 at the truth under either load, and the trials,
-    whose capitate is prescribed, refuse any load but the axial one."""
+    truth's radioscaphoid pressure, the reward stays 0 at the truth under either load; an unknown load
+    is refused."""
     truth = design.to_action(builtin.truth("P1"))
     rs = {}
     for direction in ("axial", "erhart2020"):
@@ -143,4 +145,15 @@ def test_the_idealized_sweep_under_the_tendons_load_is_its_own_task():
         assert lines.name == direction and len(lines.share) == (1 if direction == "axial" else 16), lines
     assert np.abs(rs["axial"] - rs["erhart2020"]).max() > 0.01, rs
     with pytest.raises(ValueError, match="load_direction"):
-        task("P1", "calibrate", "erhart2020")
+        task("P1", "calibrate", "upward")
+
+
+@pytest.mark.parametrize("motion", ["calibrate", "validate"])
+def test_a_trial_loads_the_radial_column_as_its_truth_run_did(motion):
+    """In a trial the capitate is prescribed and the radial column is free under the default tendon lines
+    at the trial's recorded total load per frame (`Trial.load_n`, the truth run's)."""
+    t = task("P1", motion)
+    trial = builtin.trials("P1")["unresisted" if motion == "calibrate" else "resisted"]
+    assert t.load_direction == DEFAULT_LOADS and t.driver.loads.name == DEFAULT_LOADS
+    np.testing.assert_array_equal(t.driver.load_n, trial.load_n)
+    assert trial.load_n.min() >= 10.0 and TRAPEZIUM in t.driver.loads.body

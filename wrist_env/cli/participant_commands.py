@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from wrist_env.errors import UsageError
+from wrist_env.solver.simulate import DEFAULT_LOADS, LOAD_DIRECTIONS
 
 if TYPE_CHECKING:
     from wrist_env.design import Design
@@ -245,7 +246,10 @@ def _validate(args) -> int:
         settings=solver_settings(args.solver),
     )
     default = (
-        params == BuildParams() and args.load is None and args.load_direction == "axial" and args.solver == "default"
+        params == BuildParams()
+        and args.load is None
+        and args.load_direction == DEFAULT_LOADS
+        and args.solver == "default"
     )
     variant = "" if default else "_variant"
     from wrist_env.figures.draw import FIGURES as figures_dir
@@ -386,8 +390,8 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     )
     s.add_argument(
         "--load-direction",
-        choices=("axial", "erhart2020", "erhart2020_groups"),
-        default="axial",
+        choices=LOAD_DIRECTIONS,
+        default=DEFAULT_LOADS,
         help="the loads' direction: along the radius (default), or the resultant at neutral of a tendon "
         "rig's tensions along myo-sim's tendon paths (Erhart 2020; see anatomy/tendons.py)",
     )

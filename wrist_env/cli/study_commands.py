@@ -11,6 +11,7 @@ from pathlib import Path
 
 from wrist_env.cli.participant_commands import PARTICIPANT_HELP
 from wrist_env.errors import UsageError
+from wrist_env.solver.simulate import DEFAULT_LOADS, LOAD_DIRECTIONS
 
 
 def _calibrate(args) -> int:
@@ -292,8 +293,8 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     )
     s.add_argument(
         "--load-direction",
-        choices=("axial", "erhart2020", "erhart2020_groups"),
-        default="axial",
+        choices=LOAD_DIRECTIONS,
+        default=DEFAULT_LOADS,
         help="the sweeps' load: along the radius (default), or a tendon rig's resultant (see validate)",
     )
     s.add_argument("--out", default="runs/montecarlo", help="run-log folder (default runs/montecarlo)")

@@ -22,6 +22,7 @@ from wrist_env.participants import builtin, registry
 from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.forces import CONTACT_FIELDS
 from wrist_env.solver.simulate import (
+    DEFAULT_LOADS,
     LOAD_DIRECTIONS,
     Driver,
     Result,
@@ -50,8 +51,8 @@ class Task:
     """Participant × motion: "calibrate" (unresisted trial), "validate" (held-out resisted
     trial) or "idealized" (flexion–extension sweep; reference = the hidden truth's
     sweep for built-in participants, none for user participants → reward 0).
-    load_direction: the idealized sweep's load direction (`simulate.LOAD_DIRECTIONS`); the
-    trials' capitate is prescribed, so the other motions take only "axial"."""
+    load_direction: the loads' lines (`simulate.LOAD_DIRECTIONS`, default `simulate.DEFAULT_LOADS`): the
+    sweep's, and in a trial the radial column's (the capitate is prescribed) at the trial's `load_n`."""
 
     def __init__(
         self,
@@ -60,15 +61,12 @@ class Task:
         *,
         settings: SolverSettings | None = None,
         weights: CostWeights | None = None,
-        load_direction: str = "axial",
+        load_direction: str = DEFAULT_LOADS,
     ):
         if motion not in MOTIONS:
             raise ValueError(f"motion must be one of {MOTIONS}, but got {motion!r}")
-        if load_direction not in LOAD_DIRECTIONS or (motion != "idealized" and load_direction != "axial"):
-            raise ValueError(
-                f"load_direction must be one of {LOAD_DIRECTIONS} (the idealized motion's; the trials take "
-                f"'axial'), but got {load_direction!r} for motion {motion!r}"
-            )
+        if load_direction not in LOAD_DIRECTIONS:
+            raise ValueError(f"load_direction must be one of {LOAD_DIRECTIONS}, but got {load_direction!r}")
         self.participant, self.motion, self.load_direction = participant, motion, load_direction
         self.settings, self.weights = settings, weights
         self.model: Model = registry.load_model(participant)
@@ -84,7 +82,8 @@ class Task:
             truth = simulate(self.model, builtin.truth(self.participant), driver, self.settings)
             return driver, cost_poses(truth.poses)
         trial = registry.trial(self.participant, "calibrate" if self.motion == "calibrate" else "validate")
-        driver = experimental(self.model, trial.pose("capitate"))
+        load_n = 0.0 if trial.load_n is None else trial.load_n
+        driver = experimental(self.model, trial.pose("capitate"), load_n, self.load_direction)
         return driver, np.stack([trial.pose(b) for b in COST_BONES])
 
     def evaluate(self, design: Design) -> Evaluation:
@@ -153,7 +152,7 @@ def _zero_undefined(per_bone: dict) -> dict:
 
 
 @functools.lru_cache(maxsize=32)
-def task(participant: str, motion: str, load_direction: str = "axial") -> Task:
+def task(participant: str, motion: str, load_direction: str = DEFAULT_LOADS) -> Task:
     """A shared Task per participant, motion and load direction with default settings (models are big;
     build once)."""
     return Task(participant, motion, load_direction=load_direction)

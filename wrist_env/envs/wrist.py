@@ -18,6 +18,7 @@ from wrist_env import design
 from wrist_env.envs.task import task
 from wrist_env.errors import DesignError
 from wrist_env.limits import MAX_BATCH, check_int
+from wrist_env.solver.simulate import DEFAULT_LOADS
 
 OBSERVATION = np.zeros(design.N_DESIGN, dtype=np.float32)
 
@@ -32,14 +33,14 @@ class WristEnv(gym.Env):
 
     participant: a registered participant name; motion: "calibrate",
     "validate" or "idealized"; load_direction: the idealized sweep's load
-    (`simulate.LOAD_DIRECTIONS`, default "axial"). info: cost, per-DOF 75th-percentile errors and
+    (`simulate.LOAD_DIRECTIONS`, default `simulate.DEFAULT_LOADS`). info: cost, per-DOF 75th-percentile errors and
     RMSE (mm, deg), per-frame contact (MPa, mm², N), bundle forces (N),
     energies (N·mm), poses, and `failed` — deterministic, NaN-free.
     """
 
     metadata = {"render_modes": []}
 
-    def __init__(self, participant: str = "P1", motion: str = "calibrate", load_direction: str = "axial"):
+    def __init__(self, participant: str = "P1", motion: str = "calibrate", load_direction: str = DEFAULT_LOADS):
         self.participant, self.motion = participant, motion
         self.task = task(participant, motion, load_direction)
         self.action_space, self.observation_space = _spaces()
@@ -67,7 +68,12 @@ class WristVectorEnv(VectorEnv):
     metadata = {"autoreset_mode": AutoresetMode.SAME_STEP, "render_modes": []}
 
     def __init__(
-        self, num_envs: int = 1, participant: str = "P1", motion: str = "calibrate", load_direction: str = "axial", **_
+        self,
+        num_envs: int = 1,
+        participant: str = "P1",
+        motion: str = "calibrate",
+        load_direction: str = DEFAULT_LOADS,
+        **_,
     ):
         self.num_envs = check_int("num_envs", num_envs, 1, MAX_BATCH)
         self.participant, self.motion = participant, motion

@@ -41,6 +41,7 @@ from numpy.typing import ArrayLike
 from wrist_env import design
 from wrist_env.design import INJURABLE, LIGAMENT_NAMES, N_DESIGN, N_MATERIAL, NAMES, SPAN_SD
 from wrist_env.errors import DesignError
+from wrist_env.solver.simulate import DEFAULT_LOADS
 
 if TYPE_CHECKING:
     from pathlib import Path
@@ -146,7 +147,7 @@ def block_actions(
 _ENVS: dict = {}
 
 
-def vector_env(participant: str, num_envs: int, load_direction: str = "axial") -> VectorEnv:
+def vector_env(participant: str, num_envs: int, load_direction: str = DEFAULT_LOADS) -> VectorEnv:
     """The participant's Idealized vector env with `num_envs` slots under `load_direction`
     (`simulate.LOAD_DIRECTIONS`; one per process, size and direction)."""
     import gymnasium as gym
@@ -185,7 +186,7 @@ def run_chunk(
     *,
     exclude_above_mpa: float = EXCLUDE_ABOVE_MPA,
     folders: Iterable[str | Path] = (),
-    load_direction: str = "axial",
+    load_direction: str = DEFAULT_LOADS,
 ) -> pa.Table:
     """Simulate k runs (actions of shape (k, 27)) in one vector-env step; their log rows (`SCHEMA`).
 

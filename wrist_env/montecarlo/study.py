@@ -47,7 +47,7 @@ from wrist_env.limits import MAX_BATCH, MAX_RUNS, MAX_SEED, MAX_WORKERS, check_i
 from wrist_env.montecarlo import sampler
 from wrist_env.runs.executor import executor
 from wrist_env.runs.store import RunStore
-from wrist_env.solver.simulate import LOAD_DIRECTIONS
+from wrist_env.solver.simulate import DEFAULT_LOADS, LOAD_DIRECTIONS
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -72,7 +72,7 @@ class StudyConfig:
     exclude_above_mpa: float = sampler.EXCLUDE_ABOVE_MPA
     max_attempts: int | None = None
     """Give up (StudyError) after this many runs of one participant; default 5 n + 100."""
-    load_direction: str = "axial"
+    load_direction: str = DEFAULT_LOADS
     """The sweeps' load direction (`simulate.LOAD_DIRECTIONS`): along the radius, or a tendon rig's."""
 
     def __post_init__(self):

@@ -14,7 +14,7 @@ from __future__ import annotations
 import functools
 import importlib.resources
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -69,7 +69,9 @@ def trials(name: str) -> dict:
     meta = _data(name, "trials.json")
     root = importlib.resources.files("wrist_env.participants") / "data" / name
     return {
-        t: read_trial_csv(root / entry["file"], t, entry["role"], n_frames=meta["frames"])
+        t: replace(
+            read_trial_csv(root / entry["file"], t, entry["role"], n_frames=meta["frames"]), load_n=entry["load_n"]
+        )
         for t, entry in meta["trials"].items()
     }
 

@@ -24,6 +24,9 @@ from wrist_env.solver import arrays, kernel
 
 IDEALIZED_LOAD_N = 10.0  # compressive load that keeps the joint in contact (N)
 AXIAL = (0.0, 1.0, 0.0)  # the load along the radius' long axis, proximal (RCS +y)
+DEFAULT_LOADS = "erhart2020"
+"""Every driver's loads unless told otherwise (`LOAD_DIRECTIONS`): the tendons where they enter the hand
+(issue 33: under the axial load the radial column carries nothing)."""
 STATUS = {
     kernel.OK: "ok",
     kernel.FAILED_NAN: "failed: NaN in the state",
@@ -106,11 +109,12 @@ def axial_load(model: Model | None = None, direction: ArrayLike = AXIAL) -> Load
 
 
 def experimental(
-    model: Model, transforms: ArrayLike, load_n: float = 0.0, direction: str | ArrayLike = "axial"
+    model: Model, transforms: ArrayLike, load_n: ArrayLike = 0.0, direction: str | ArrayLike = DEFAULT_LOADS
 ) -> Driver:
     """Driver from the capitate's 4×4 transforms (n_frames, 4, 4), neutral → frame, RCS mm; the free
-    bodies under `load_n` (N, total) on the lines of `direction` (see `loads`; the capitate's lines do
-    nothing: it is prescribed)."""
+    bodies under `load_n` (N, total: a scalar or one per frame, e.g. a `Trial`'s) on the lines of
+    `direction` (see `loads`; the capitate's lines do nothing: it is prescribed, the radial column's
+    load it)."""
     T = np.asarray(transforms, dtype=np.float64)
     com0 = model.com[CAPITATE]
     rotation = np.ascontiguousarray(T[:, :3, :3])
@@ -121,7 +125,7 @@ def experimental(
         rotation,
         np.ascontiguousarray(com),
         np.full(n, np.nan),
-        np.full(n, float(load_n)),
+        np.broadcast_to(np.asarray(load_n, dtype=np.float64), (n,)).copy(),
         loads(model, direction),
     )
 
@@ -131,7 +135,7 @@ def loaded(
     rotations: ArrayLike,
     load_n: ArrayLike = IDEALIZED_LOAD_N,
     angle_deg: ArrayLike | None = None,
-    direction: str | ArrayLike = "axial",
+    direction: str | ArrayLike = DEFAULT_LOADS,
 ) -> Driver:
     """Capitate rotations (n_frames, 3, 3) prescribed, its translations free under a
     total load `load_n` (N; a scalar or one per frame) on the lines of `direction` (see `loads`)."""
@@ -144,6 +148,7 @@ def loaded(
 
 
 LOAD_DIRECTIONS = ("axial", "erhart2020", "erhart2020_groups")
+
 """Named loads: "axial", one compressive line on the capitate along the radius' long axis (`AXIAL`), or
 a tendon rig (`anatomy.tendons.RIGS`): each tendon on the body it loads, where it enters the hand."""
 
@@ -182,7 +187,7 @@ def idealized(
     n_frames: int = 17,
     angles_deg: ArrayLike | None = None,
     load_n: float = IDEALIZED_LOAD_N,
-    direction: str | ArrayLike = "axial",
+    direction: str | ArrayLike = DEFAULT_LOADS,
 ) -> Driver:
     """Idealized flexion–extension (preprint 2.2.3.2): the capitate from `flexion_deg` of
     flexion to `extension_deg` of extension about the RCS z axis in `n_frames` equal steps
