@@ -160,7 +160,7 @@ def test_load_directions_are_the_clis_choices_and_unit_vectors():
 
     validate = parser()._subparsers._group_actions[0].choices["validate"]
     option = next(a for a in validate._actions if "--load-direction" in a.option_strings)
-    assert tuple(option.choices) == simulate.LOAD_DIRECTIONS and option.default == "axial"
+    assert tuple(option.choices) == simulate.LOAD_DIRECTIONS and option.default == simulate.DEFAULT_LOADS
     p1 = load_model("P1")
     for name in simulate.LOAD_DIRECTIONS:
         lines = simulate.loads(p1, name)

@@ -22,7 +22,9 @@ def wrist():
 
 
 def test_default_bodies_are_the_principal_bones(default):
-    for body in BONES:
+    """Without the distal row each body is its principal bone, but the radial column, which is two
+    bones in every variant (`model.BODY_PARTS`)."""
+    for body in (b for b in BONES if b != "trapezium"):
         assert (default.bones[body].part == 0).all()
         np.testing.assert_array_equal(default.bones[body].vertices, default.parts[body].vertices)
     assert sorted(default.parts) == sorted(PARTS)

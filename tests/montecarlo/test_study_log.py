@@ -11,6 +11,7 @@ from wrist_env import cli
 from wrist_env.errors import InputError, StoreError
 from wrist_env.montecarlo import StudyConfig, StudyError, read_runs, run_study, sampler
 from wrist_env.montecarlo.study import config_of, counts
+from wrist_env.solver.simulate import DEFAULT_LOADS
 
 CONFIG = StudyConfig(("P1",), n=10, seed=0)
 
@@ -125,17 +126,17 @@ def test_sizes_are_refused_before_anything_is_allocated(tmp_path, capsys):
 
 def test_a_resume_under_another_load_direction_is_refused(study, tmp_path_factory):
     """The load direction decides every run: a study logged under one load does not resume under the
-    other, either way round (a key names the direction only when not the axial default, so older logs
-    resume), and the folder's recorded study says which load it ran."""
+    other, either way round (a key names the direction only when it is not the axial load, so logs
+    from before the tendon lines resume as axial), and the folder's recorded study says which load it ran."""
     out, _ = study
-    assert "load_direction" not in CONFIG.key()
-    tendons = StudyConfig(("P1",), n=10, seed=0, load_direction="erhart2020")
-    assert tendons.key()["load_direction"] == "erhart2020"
+    assert CONFIG.load_direction == DEFAULT_LOADS and CONFIG.key()["load_direction"] == DEFAULT_LOADS
+    axial = StudyConfig(("P1",), n=10, seed=0, load_direction="axial")
+    assert "load_direction" not in axial.key()
     with pytest.raises(StudyError, match="load_direction"):
-        run_study(tendons, out, batch=4)
-    other = tmp_path_factory.mktemp("tendons") / "mc"
-    assert run_study(tendons, other, batch=4).done
-    assert config_of(other).load_direction == "erhart2020"
+        run_study(axial, out, batch=4)
+    other = tmp_path_factory.mktemp("axial") / "mc"
+    assert run_study(axial, other, batch=4).done
+    assert config_of(other).load_direction == "axial"
     with pytest.raises(StudyError, match="load_direction"):
         run_study(CONFIG, other, batch=4)
     with pytest.raises(StudyError, match="sideways"):

@@ -11,6 +11,7 @@ from wrist_env.builder.pipeline import BuildParams
 from wrist_env.builder.warp import random_warp
 from wrist_env.design import ALL_LIGAMENTS
 from wrist_env.errors import BuildError, ParticipantError
+from wrist_env.model import SUPPLIED
 from wrist_env.participants import registry
 from wrist_env.participants.folder import ParticipantSource, write_participant_folder
 from wrist_env.trial import Trial
@@ -24,7 +25,8 @@ def warped_template_folder(path, name="U1", seed=7):
     shaft, the ulna as the hull of its distal end."""
     warp = random_warp(seed, amplitude_mm=0.7, width_mm=15.0, extent_mm=25.0)
     bones = {}
-    for bone, surface in load_template().bones.items():
+    for bone in SUPPLIED:
+        surface = load_template().bones[bone]
         mesh = surface.trimesh(solid_only=bone == "radius")
         if bone == "radius":
             shaft = trimesh.Trimesh(surface.vertices[~surface.solid]).convex_hull.subdivide_to_size(max_edge=2.0)

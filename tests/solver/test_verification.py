@@ -243,10 +243,10 @@ def pressed(patch, span_mm: float, law, load_n: float):
     model = syn.model(mass=mass, com=com, inertia=inertia, law=law, grids={LUNATE: grid}, patches={LUNOCAPITATE: patch})
     settings = replace(SolverSettings(), settle_steps=3000)
     if "compressive_load_n" in _FIELDS:  # the load as a solver setting
-        driver = idealized(model, flexion_deg=0.0, extension_deg=0.0, n_frames=3)
+        driver = idealized(model, flexion_deg=0.0, extension_deg=0.0, n_frames=3, direction="axial")
         settings = replace(settings, compressive_load_n=load_n)
     else:  # the load as part of the driver
-        driver = idealized(model, flexion_deg=0.0, extension_deg=0.0, n_frames=3, load_n=load_n)
+        driver = idealized(model, flexion_deg=0.0, extension_deg=0.0, n_frames=3, load_n=load_n, direction="axial")
     result = simulate(model, design.population(), driver, settings)
     assert result.ok, result.message
     np.testing.assert_allclose(result.poses[:, CAPITATE, :3, :3], np.tile(np.eye(3), (3, 1, 1)), atol=1e-12)
@@ -388,8 +388,10 @@ def test_rigidly_moved_model_gives_the_same_relative_kinematics(p1, move):
     (a turn about a coordinate axis, so the axis-aligned float32 grids are permuted exactly,
     plus a translation) with the capitate driven by G T G⁻¹: the scaphoid, lunate and
     capitate poses relative to the radius, mapped back (G⁻¹ P G), match the unmoved run's
-    within 1e-6 mm (centre of mass) and 1e-5°; contact outputs and bundle forces within
-    1e-6 of their largest values. Only float64 round-off differs between the runs."""
+    within 1e-5 mm (centre of mass) and 1e-4°; contact outputs and bundle forces within
+    1e-5 of their largest values. Only float64 round-off differs between the runs (with the free
+    radial column and the TFCC's soft layer it reaches 3e-6 mm and 3e-5°; five bodies kept it under
+    1e-6 mm and 1e-5°)."""
     (axis, turns), t = MOVES[move]
     Q = syn.rotation_90(axis, turns)
     G = homogeneous(Q, t)
@@ -428,5 +430,5 @@ def test_rigidly_moved_model_gives_the_same_relative_kinematics(p1, move):
         summary += f", steps {a.steps.sum()} vs {b.steps.sum()}"
     print(summary)
     for shift, turn in worst.values():
-        assert shift < 1e-6 and turn < 1e-5, summary
-    assert contact < 1e-6 and bundle < 1e-6, summary
+        assert shift < 1e-5 and turn < 1e-4, summary
+    assert contact < 1e-5 and bundle < 1e-5, summary

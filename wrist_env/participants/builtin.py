@@ -22,6 +22,7 @@ from wrist_env.anatomy.template import BoneSurface, load_template
 from wrist_env.builder.warp import Warp
 from wrist_env.design import Design
 from wrist_env.errors import ParticipantError
+from wrist_env.model import SUPPLIED
 
 if TYPE_CHECKING:
     from wrist_env.participants.folder import ParticipantSource
@@ -119,7 +120,8 @@ def source(name: str, fossa_sweep_deg: tuple | None = None) -> ParticipantSource
     as in `load_template`; default: `BuildParams()`'s), its trials and Table 1 facts, a right wrist.
 
     `folder.write_participant_folder` writes it as a folder that loads back; its radius keeps the open
-    shaft beside the closed articular solid, and its ulna is open (see `folder`).
+    shaft beside the closed articular solid, and its ulna is closed at the cut (`anatomy.template.closed`);
+    the radial column is not a folder's: it comes with the capitate (`model.SUPPLIED`).
     """
     from wrist_env.builder.pipeline import BuildParams
     from wrist_env.participants.folder import ParticipantSource
@@ -137,7 +139,7 @@ def source(name: str, fossa_sweep_deg: tuple | None = None) -> ParticipantSource
     surfaces = bones(name, tuple(float(a) for a in sweep), False)
     root = importlib.resources.files("wrist_env.participants") / "data" / name
     return ParticipantSource(
-        name, meta, {b: (s.vertices, s.faces) for b, s in surfaces.items()}, trials(name), Path(str(root))
+        name, meta, {b: (surfaces[b].vertices, surfaces[b].faces) for b in SUPPLIED}, trials(name), Path(str(root))
     )
 
 
