@@ -16,6 +16,7 @@ from wrist_env.errors import StoreError
 from wrist_env.montecarlo import StudyConfig, StudyError, read_runs, run_study
 from wrist_env.montecarlo.sampler import FRAME_COLUMNS, SCHEMA, TEAR_COLUMNS
 from wrist_env.runs import StoreBusyError
+from wrist_env.solver.simulate import DEFAULT_LOADS
 
 pytestmark = pytest.mark.slow  # builds models or runs simulations/studies (minutes)
 
@@ -233,4 +234,4 @@ def test_report_sets_the_preprints_tables_beside_ours_and_compares_signs(referen
             assert r["sign"] == ("same" if agree else "differs"), r
     text = (tmp_path / "report.md").read_text()
     assert "## Beside the preprint" in text and "| RSC | 0.304 | 0.005 |" in text
-    assert summary["study"]["load_direction"] == "axial"
+    assert summary["study"]["load_direction"] == DEFAULT_LOADS

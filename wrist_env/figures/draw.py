@@ -29,6 +29,7 @@ BONE_COLOUR = {
     "scaphoid": "#e8dcc8",
     "lunate": "#e3d5bd",
     "capitate": "#eadfcf",
+    "trapezium": "#e6d9c4",
 }
 DISTAL_CROP_MM = 12.0  # radius and ulna are drawn by their distal end only (RCS y below this, mm)
 VIEWS = (("volar view", 0, 0), ("radial view", 0, 90), ("oblique", 25, 40))
