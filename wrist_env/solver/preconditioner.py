@@ -71,7 +71,10 @@ def metric():
 
 @njit(cache=True, error_model="numpy", inline="always")
 def dof(st, b):
-    """(first unknown, number of unknowns) of body b; (-1, 0) if it is not free."""
+    """(first unknown, number of unknowns) of body b; (-1, 0) if it is not free or b < 0 (a membrane's
+    free node: `add_point`'s convention; a negative index would read the last body's entry)."""
+    if b < 0:
+        return -1, 0
     i0 = FIRST_DOF[b]
     if i0 >= 0:
         return i0, 6
