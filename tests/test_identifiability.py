@@ -29,22 +29,29 @@ def p1_calibrate():
 
 
 def test_the_jacobian_predicts_the_simulated_change(p1_calibrate):
-    """P1's calibration trial at the hidden truth: for a random 0.2-SD move of all 22 materials, the
-    residual change J·δz predicts the simulated change within 30 % (norm; measured 19 %: the ligaments'
-    toe regions make it nonlinear); halving the step changes the Jacobian by < 25 % (measured 15 %)."""
+    """P1's calibration trial at the hidden truth: for random 0.2-SD moves of all 22 materials, the
+    residual change J·δz predicts the simulated change within 30 % (norm, median of 5 draws; measured
+    26 %, single draws 16–37 %: the ligaments' toe regions and the contacts make it nonlinear, and a
+    0.05-SD move still misses by 10–40 %, the settled state's own tolerance); halving the step changes
+    the Jacobian by < 25 % (measured 15 %)."""
     task, truth = p1_calibrate, builtin.truth("P1")
     J = identifiability.jacobian(task, truth)
     J_half = identifiability.jacobian(task, truth, step=identifiability.STEP_Z / 2)
     assert np.linalg.norm(J - J_half) < 0.25 * np.linalg.norm(J)
-    dz = np.random.default_rng(3).normal(size=design.N_MATERIAL)
-    dz *= 0.2 / np.sqrt(np.mean(dz**2))
+    moves = []
+    for seed in range(5):
+        dz = np.random.default_rng(seed).normal(size=design.N_MATERIAL)
+        moves.append(dz * 0.2 / np.sqrt(np.mean(dz**2)))
     from wrist_env.solver.simulate import simulate_batch
 
-    base, moved = simulate_batch(
-        task.model, [truth, design.with_z(truth, design.z_scores(truth) + dz)], task.driver, prepared=task.prepared
-    )
-    change = posterior.residuals(task, moved.poses, cost_poses(base.poses)).ravel()
-    assert np.linalg.norm(change - J @ dz) < 0.3 * np.linalg.norm(change), np.linalg.norm(change)
+    designs = [truth] + [design.with_z(truth, design.z_scores(truth) + dz) for dz in moves]
+    runs = simulate_batch(task.model, designs, task.driver, prepared=task.prepared)
+    base = cost_poses(runs[0].poses)
+    misses = []
+    for dz, moved in zip(moves, runs[1:]):
+        change = posterior.residuals(task, moved.poses, base).ravel()
+        misses.append(np.linalg.norm(change - J @ dz) / np.linalg.norm(change))
+    assert np.median(misses) < 0.3, misses
 
 
 def test_the_command_writes_tables_and_a_figure(tmp_path, capsys):
