@@ -13,7 +13,9 @@ and prior refresh, and on the model's trials at the default 1,200 steps too, ~2.
 `leaderboards/posterior/steps1200/`; SMC on the model's trials; where the built-in trials' model error comes from,
 `experiments/model_error.py`, and the truth's standing under other likelihoods,
 `experiments/capitate_likelihood.py`). The studies' run logs go to a fresh
-folder `runs/regenerate-<commit>/` (a killed run resumes there when rerun at the same commit).
+folder `runs/regenerate-<commit>/` (a killed run resumes there when rerun at the same commit: the steps
+already done, listed in its `steps_done.txt`, are skipped, and the interrupted study resumes from its
+run log; `--runs DIR` resumes a folder made at another commit that simulates the same model).
 
 Run: `python experiments/regenerate.py` (~6 h on a 2-core machine); `--figures-only` skips the
 studies (~6 min).
@@ -107,13 +109,20 @@ def _require_extras() -> None:
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--figures-only", action="store_true", help="skip the benchmark and the Monte Carlo study")
+    parser.add_argument("--runs", type=Path, help="the run folder to resume (default runs/regenerate-<commit>)")
     args = parser.parse_args(argv)
     if not args.figures_only:
         _require_extras()
-    runs = ROOT / "runs" / f"regenerate-{_commit()}"
+    runs = args.runs.resolve() if args.runs else ROOT / "runs" / f"regenerate-{_commit()}"
+    runs.mkdir(parents=True, exist_ok=True)
+    log = runs / "steps_done.txt"
+    done_before = set(log.read_text().splitlines()) if log.exists() else set()
     for step in steps(runs, args.figures_only):
         script = step[0] == "python"
         shown = " ".join(step) if script else "wrist-bench " + " ".join(step)
+        if shown in done_before:
+            print(f"$ {shown}  (done before, skipped)", flush=True)
+            continue
         print(f"$ {shown}", flush=True)
         start = time.perf_counter()
         command = [sys.executable, *step[1:]] if script else [sys.executable, "-m", "wrist_env.cli", *step]
@@ -122,6 +131,8 @@ def main(argv=None) -> None:
         if done.returncode not in (0, 1) or (done.returncode == 1 and step[0] != "validate"):
             sys.exit(f"`{shown}` failed (exit status {done.returncode})")
         print(f"  {time.perf_counter() - start:.0f} s", flush=True)
+        with log.open("a") as f:
+            f.write(shown + "\n")
 
 
 if __name__ == "__main__":
