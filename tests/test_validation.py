@@ -123,7 +123,7 @@ def test_a_failed_run_fails_its_check_and_says_why():
 
 
 @pytest.mark.xfail(
-    reason="the load path (RS/RL, the midcarpal and ulnar shares) needs a radial column and the TFCC: issue 33",
+    reason="issue 33: the load path misses RS/RL (0.90-0.96), the LC and TH shares, the column's turn; README: The load path",
     strict=True,
     raises=AssertionError,
 )
