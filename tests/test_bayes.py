@@ -104,7 +104,7 @@ def test_the_command_samples_p1_and_writes_coverage_and_figures(built, tmp_path,
     assert (tmp_path / "posterior_predictive_P1.png").stat().st_size > 10_000
     post = bayes.Posterior.load(tmp_path / "posterior_P1_seed0.npz")
     assert post.samples.shape == (4 * 48, design.N_MATERIAL) and post.predictive.shape[:3] == (2, 3, 2)
-    assert json.loads((tmp_path / "posterior_P1_seed0.json").read_text())["evaluations"] == post.evaluations
+    assert json.loads((tmp_path / "posterior_P1_seed0.json").read_text())["fields"]["evaluations"] == post.evaluations
     assert post.settings == {"walkers": 48, "steps": 8, "map_starts": 2, "prior_refresh": bayes.PRIOR_REFRESH}
     capsys.readouterr()
     assert main(args) == 0

@@ -32,10 +32,9 @@ calibration and the held-out trial, 5/50/95 % of each DOF at each frame.
 
 from __future__ import annotations
 
-import json
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -44,6 +43,8 @@ from wrist_env import design, posterior
 from wrist_env.envs.task import Task, cost_poses, task
 from wrist_env.errors import StoreError
 from wrist_env.frames import pose_to_dof
+from wrist_env.io import load_dataclass, save_dataclass
+from wrist_env.trial import TRIAL_MOTIONS
 
 WALKERS = 48
 STEPS = 1200
@@ -129,25 +130,15 @@ class Posterior:
         return (z_true >= lo) & (z_true <= hi)
 
     def save(self, path: str | Path) -> Path:
-        """`<path>.npz` (arrays) and `<path>.json` (scalars and the summary)."""
+        """`<path>.npz` (arrays; the samples as float32: 1e-7 SD, half the file) and `<path>.json`
+        (the other fields), atomically (`io.save_dataclass`)."""
         path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        arrays = {k: getattr(self, k) for k in self.ARRAYS}
-        arrays["samples"] = arrays["samples"].astype(np.float32)  # 1e-7 SD: plenty, half the file
-        np.savez_compressed(path.with_suffix(".npz"), **arrays)
-        scalars = {k: v for k, v in asdict(self).items() if k not in self.ARRAYS}
-        scalars["materials"] = list(design.NAMES[: design.N_MATERIAL])
-        path.with_suffix(".json").write_text(json.dumps(scalars, indent=1) + "\n")
+        save_dataclass(replace(self, samples=self.samples.astype(np.float32)), path)
         return path.with_suffix(".npz")
 
     @classmethod
     def load(cls, path: str | Path) -> Posterior:
-        path = Path(path)
-        scalars = json.loads(path.with_suffix(".json").read_text())
-        scalars.pop("materials", None)
-        with np.load(path.with_suffix(".npz")) as data:
-            arrays = {k: data[k] for k in cls.ARRAYS}
-        return cls(**scalars, **arrays)
+        return load_dataclass(cls, path)
 
 
 def map_estimate(
@@ -387,7 +378,7 @@ def model_trials(t: Task, seed: int) -> Task:
     run = t.evaluate(builtin.truth(t.participant))
     if run.failed:
         raise RuntimeError(f"{t.participant} {t.motion}: the hidden truth's run failed ({run.result.message})")
-    rng = np.random.default_rng([seed, ("calibrate", "validate").index(t.motion)])
+    rng = np.random.default_rng([seed, TRIAL_MOTIONS.index(t.motion)])
     poses = cost_poses(run.result.poses)
     out = copy.copy(t)
     out.reference = np.stack(

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, DTypeLike
 
 from wrist_env.errors import DesignError
 
@@ -228,6 +228,31 @@ def to_action(design: Design) -> np.ndarray:
     a[:N_MATERIAL] = (v[:N_MATERIAL] - MEAN[:N_MATERIAL]) / (SPAN_SD * SD[:N_MATERIAL])
     a[N_MATERIAL:] = np.clip(v[N_MATERIAL:], -1.0, 1.0)
     return a
+
+
+def split_variables(frozen: dict | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(free indices, frozen indices, frozen values) of the 27 design variables.
+
+    frozen: {variable name (`NAMES`) or index: normalized value in [-1, 1]}; default the
+    five injury scalars at +1 (ligaments intact), as calibration does.
+    """
+    frozen = INTACT_INJURY if frozen is None else frozen
+    index = {(NAMES.index(k) if isinstance(k, str) else int(k)): float(v) for k, v in frozen.items()}
+    frozen_index = np.array(sorted(index), dtype=np.int64)
+    free_index = np.setdiff1d(np.arange(N_DESIGN), frozen_index)
+    return free_index, frozen_index, np.array([index[i] for i in frozen_index])
+
+
+def full_action(free: ArrayLike, frozen: dict | None = None, dtype: DTypeLike = np.float64) -> np.ndarray:
+    """The 27-variable action(s), shape (..., 27), of the free variables' values (..., n_free) with
+    the `frozen` ones (see `split_variables`) filled in: by default the 22 materials → 27 with the
+    injury scalars intact."""
+    free_index, frozen_index, frozen_value = split_variables(frozen)
+    free = np.asarray(free)
+    full = np.empty(free.shape[:-1] + (N_DESIGN,), dtype=dtype)
+    full[..., free_index] = free
+    full[..., frozen_index] = frozen_value
+    return full
 
 
 def population() -> Design:

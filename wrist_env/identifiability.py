@@ -22,10 +22,11 @@ from wrist_env.envs.task import Task, cost_poses
 from wrist_env.participants import builtin
 from wrist_env.posterior import residuals
 from wrist_env.solver.arrays import SolverSettings
+from wrist_env.trial import TRIAL_MOTIONS
 
 STEP_Z = 0.25  # central-difference step, SD units
 SETTINGS = SolverSettings(tolerance=1e-4, force_floor_n=1e-3, max_hold_steps=6400)
-TRIALS = ("calibrate", "validate")
+TRIALS = TRIAL_MOTIONS
 
 
 @dataclass(frozen=True)

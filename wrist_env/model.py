@@ -41,6 +41,8 @@ the trapezocapitate ligaments and joint (`design.FIXED_LIGAMENTS`)."""
 SUPPLIED = ("radius", "ulna", "scaphoid", "lunate", "capitate")
 """The bodies a participant folder supplies meshes of (the principal bones); the radial column and
 the other parts are carried from the template with the capitate (`anatomy.template.carry_parts`)."""
+CARPALS = ("scaphoid", "lunate", "capitate")
+"""The carpals a participant supplies meshes of and a trial tracks (the forearm bones are the radius and ulna)."""
 CARRIED_WITH = {"trapezium": "capitate"}
 """Bodies not in `SUPPLIED`, and the supplied body whose registration carries them."""
 PARTS = tuple(p for b in BONES for p in BODY_PARTS[b])

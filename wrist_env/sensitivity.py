@@ -25,11 +25,11 @@ from tqdm import tqdm
 
 from wrist_env import design
 from wrist_env.cost import COST_BONES, DOF_NAMES
+from wrist_env.design import full_action
 from wrist_env.envs import env_id, register_ids
-from wrist_env.envs.wrappers import full_action
+from wrist_env.trial import MOTIONS
 
 METHODS = ("morris", "sobol")
-MOTIONS = ("calibrate", "validate", "idealized")
 MATERIALS = design.NAMES[: design.N_MATERIAL]
 OUTPUTS = ("cost",) + tuple(f"{bone}.{dof}" for bone in COST_BONES for dof in DOF_NAMES)
 """The outputs: the cost, then the 75th-percentile error of each DOF of the scaphoid and lunate."""

@@ -457,9 +457,6 @@ def format_table(report: Report) -> str:
 def validation_figure(report: Report, out: Path | None = None) -> Path:
     """Left: scaphoid and lunate flexion against the capitate's, with the model's slopes and Rainbow 2013's
     ratios; right: the SL gap over the sweep, intact and with all SLIL bundles torn, and the 3 mm line."""
-    import matplotlib
-
-    matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     from wrist_env.figures.draw import FIGURES

@@ -29,9 +29,8 @@ from numpy.typing import ArrayLike
 from wrist_env.anatomy.midcarpal import DISTAL_ROW, read_seat
 from wrist_env.anatomy.myosim import load_myosim_anatomy
 from wrist_env.anatomy.radius_cap import build_radius_cap
-from wrist_env.model import BODY_PARTS, BONES, CARRIED_WITH, PARTS, SUPPLIED
+from wrist_env.model import BODY_PARTS, BONES, CARPALS, CARRIED_WITH, PARTS, SUPPLIED
 
-CARPALS = ("scaphoid", "lunate", "capitate")
 ROW = ("scaphoid", "lunate")  # the proximal row bones that articulate with the radius
 JOINT_SPACE_MM = 1.5  # radiocarpal bone-to-bone joint space of the rebuilt fossae
 SHAFT_LENGTH_MM = 20.0

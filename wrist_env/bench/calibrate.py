@@ -33,6 +33,7 @@ from wrist_env import design as design_vars
 from wrist_env.bench.log import X_COLUMNS, RunKey, RunLog
 from wrist_env.cost import COST_BONES
 from wrist_env.design import N_MATERIAL, Design
+from wrist_env.errors import WristEnvError
 from wrist_env.frames import DOF_NAMES
 from wrist_env.posterior import map_objective
 
@@ -45,15 +46,13 @@ REPLAY_TOLERANCE = 1e-9
 """Largest |asked − logged| (normalized units) accepted when replaying a logged batch."""
 
 
-class ResumeError(RuntimeError):
+class ResumeError(WristEnvError, RuntimeError):
     """A calibrator did not ask again for the points it asked before (it is not deterministic)."""
 
 
 def action(x: ArrayLike) -> np.ndarray:
     """The 27-variable action(s) of 22 normalized materials (..., 22), injury scalars intact (+1)."""
-    from wrist_env.envs.wrappers import full_action
-
-    return full_action(x)
+    return design_vars.full_action(x)
 
 
 def rmse_vector(info: dict) -> np.ndarray:

@@ -41,10 +41,11 @@ from numpy.typing import ArrayLike
 
 from wrist_env.cost import COST_BONES
 from wrist_env.design import N_MATERIAL, NAMES
-from wrist_env.errors import StoreError
+from wrist_env.errors import StoreError, WristEnvError
 from wrist_env.frames import DOF_NAMES
 from wrist_env.limits import MAX_BUDGET, MAX_SEED, check_int
 from wrist_env.runs.store import RunStore, read_parquet, remove_file, write_parquet
+from wrist_env.trial import TRIAL_MOTIONS
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -106,7 +107,7 @@ def _check_summary(path: Path, summary) -> None:
     if not isinstance(summary, dict):
         raise StoreError(f"{path}: not a cell summary (a JSON {type(summary).__name__}); {RERUN}")
     missing = [k for k in SUMMARY_KEYS if k not in summary]
-    for t in ("calibrate", "validate"):
+    for t in TRIAL_MOTIONS:
         if t in summary:
             missing += [f"{t}.{k}" for k in SCORE_KEYS if not isinstance(summary[t], dict) or k not in summary[t]]
     nfev = summary.get("nfev")
@@ -116,7 +117,7 @@ def _check_summary(path: Path, summary) -> None:
         raise StoreError(f"{path}: not a whole cell summary (no {', '.join(missing)}); {RERUN}")
 
 
-class DuplicateEvaluationError(RuntimeError):
+class DuplicateEvaluationError(WristEnvError, RuntimeError):
     """An attempt to log an evaluation that is already in the log."""
 
 

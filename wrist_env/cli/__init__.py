@@ -34,6 +34,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run one `wrist-bench` command; returns the exit status (2 for a project or file-system error: one line on
     stderr)."""
     args = parser().parse_args(argv)
+    os.environ.setdefault("MPLBACKEND", "Agg")  # the commands save figures; none is shown
     from wrist_env.errors import WristEnvError
 
     try:

@@ -6,6 +6,7 @@ import time
 from collections.abc import Callable
 
 from wrist_env.errors import UsageError
+from wrist_env.trial import MOTIONS
 
 
 def _sensitivity(args) -> int:
@@ -134,8 +135,8 @@ def add_commands(command: Callable[..., object]) -> None:
     s.add_argument(
         "--motions",
         nargs="+",
-        choices=("calibrate", "validate", "idealized"),
-        default=["calibrate", "validate", "idealized"],
+        choices=MOTIONS,
+        default=list(MOTIONS),
         help="default: all three",
     )
     s.add_argument("--seed", type=int, default=0, help="sampling seed (default 0)")

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 from wrist_env.errors import UsageError
 from wrist_env.solver.simulate import DEFAULT_LOADS, LOAD_DIRECTIONS
+from wrist_env.trial import MOTIONS
 
 if TYPE_CHECKING:
     from wrist_env.design import Design
@@ -360,7 +361,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     s.add_argument("participant", help=PARTICIPANT_HELP)
     s.add_argument(
         "--motion",
-        choices=["calibrate", "validate", "idealized"],
+        choices=MOTIONS,
         default="calibrate",
         help="calibrate: the trial with role calibrate (default); validate: the trial with role "
         "validate; idealized: the flexion-extension sweep",

@@ -12,6 +12,7 @@ from pathlib import Path
 from wrist_env.cli.participant_commands import PARTICIPANT_HELP
 from wrist_env.errors import UsageError
 from wrist_env.solver.simulate import DEFAULT_LOADS, LOAD_DIRECTIONS
+from wrist_env.trial import TRIAL_MOTIONS
 
 
 def _calibrate(args) -> int:
@@ -28,8 +29,8 @@ def _calibrate(args) -> int:
     ref = reference(args.participant)
     out = run.to_dict(history=True)
     out["wall_seconds"] = round(wall, 3)
-    out["population"] = {m: ref.population[m]["cost"] for m in ("calibrate", "validate")}
-    out["truth"] = None if ref.truth is None else {m: ref.truth[m]["cost"] for m in ("calibrate", "validate")}
+    out["population"] = {m: ref.population[m]["cost"] for m in TRIAL_MOTIONS}
+    out["truth"] = None if ref.truth is None else {m: ref.truth[m]["cost"] for m in TRIAL_MOTIONS}
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         Path(args.out).write_text(json.dumps(out, indent=1, allow_nan=False))

@@ -9,16 +9,17 @@ from typing import TYPE_CHECKING
 import gymnasium as gym
 
 from wrist_env.participants import builtin, registry
+from wrist_env.trial import MOTIONS
 
 if TYPE_CHECKING:
     from pathlib import Path
 
 NAMESPACE = "wrist_env"
-MOTION_PREFIX = {"calibrate": "Calibrate", "validate": "Validate", "idealized": "Idealized"}
+MOTION_PREFIX = {m: m.capitalize() for m in MOTIONS}
 
 
 def env_id(participant: str, motion: str) -> str:
-    """The Gymnasium id of a participant's motion ("calibrate", "validate" or "idealized")."""
+    """The Gymnasium id of a participant's motion (`trial.MOTIONS`)."""
     return f"{NAMESPACE}/{MOTION_PREFIX[motion]}-{participant}-v0"
 
 

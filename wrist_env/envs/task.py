@@ -32,8 +32,7 @@ from wrist_env.solver.simulate import (
     simulate,
     simulate_batch,
 )
-
-MOTIONS = ("calibrate", "validate", "idealized")
+from wrist_env.trial import MOTIONS
 
 
 @dataclass(frozen=True)

@@ -7,14 +7,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+from numpy.typing import ArrayLike
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
-from numpy.typing import ArrayLike  # noqa: E402
-
-from wrist_env.design import ALL_LIGAMENT_NAMES  # noqa: E402
+from wrist_env.design import ALL_LIGAMENT_NAMES
 
 if TYPE_CHECKING:
     from matplotlib.typing import ColorType

@@ -5,14 +5,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-
-from wrist_env.figures.draw import save  # noqa: E402
+from wrist_env.figures.draw import save
 
 COLOURS = {"calibrate": "tab:blue", "validate": "tab:orange", "both": "tab:green"}
 

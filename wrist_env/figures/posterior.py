@@ -5,16 +5,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from wrist_env import design  # noqa: E402
-from wrist_env.cost import COST_BONES  # noqa: E402
-from wrist_env.figures.draw import save  # noqa: E402
-from wrist_env.frames import DOF_NAMES, DOF_UNITS  # noqa: E402
+from wrist_env import design
+from wrist_env.cost import COST_BONES
+from wrist_env.figures.draw import save
+from wrist_env.frames import DOF_NAMES, DOF_UNITS
 
 PRIOR_90 = 1.645  # the N(0, 1) prior's 90 % interval, z units
 

@@ -17,15 +17,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-
-from wrist_env.design import INJURABLE  # noqa: E402
-from wrist_env.montecarlo import stats  # noqa: E402
+from wrist_env.design import INJURABLE
+from wrist_env.montecarlo import stats
 
 INTACT_COLOR, INJURED_COLOR = "#d6609a", "#3b6fb6"  # the preprint's pink and blue
 BUNDLE_COLORS = {"SLIL_v": "#2a9d8f", "SLIL_p": "#e9a23b", "SLIL_d": "#6a4c93"}

@@ -28,7 +28,7 @@ import trimesh
 
 from wrist_env.builder.cartilage import closed_face_mask
 from wrist_env.errors import MeshError, ParticipantError
-from wrist_env.model import SUPPLIED
+from wrist_env.model import CARPALS, SUPPLIED
 from wrist_env.trial import ROLES, Trial, mirror_trial, read_trial_csv, write_trial_csv
 
 PARTICIPANT_FILE = "participant.toml"
@@ -38,7 +38,6 @@ SIDES = ("right", "left")
 NAME_PATTERN = r"[A-Za-z0-9_]{1,64}"
 TRIAL_NAME_PATTERN = r"[A-Za-z0-9_-]{1,64}"
 """Names become parts of file names (the model cache, run logs): 64 characters at most."""
-CARPALS = ("scaphoid", "lunate", "capitate")
 METRES_DIAGONAL_MM = 1.0  # a bounding-box diagonal below this is a bone in metres
 CARPAL_DIAGONAL_MM = (5.0, 100.0)  # plausible bounding-box diagonal of a carpal bone
 FOREARM_DIAGONAL_MM = (10.0, 600.0)  # ... of the radius or ulna (distal part or whole)

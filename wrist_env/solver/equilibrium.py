@@ -21,7 +21,7 @@ from wrist_env.design import Design
 from wrist_env.model import CAPITATE, FREE, Model
 from wrist_env.solver import arrays, kernel, preconditioner
 from wrist_env.solver.kernel import LEVER_MM
-from wrist_env.solver.rigid import rotate_in_place
+from wrist_env.solver.rigid import pose_state, pose_translation, rotate_in_place
 from wrist_env.solver.simulate import prepare, stiffness
 
 JACOBIAN_STEP = 1e-6  # finite-difference step of the Jacobian (rad, mm)
@@ -135,8 +135,7 @@ def _unknowns(model: Model, driver) -> tuple[np.ndarray, int]:
 
 def _frame_args(p, design_stiffness, free_nodes, driver, result, f: int) -> tuple:
     """`_residual`'s arguments after q for frame f of `result`: its state and the kernel arrays."""
-    R0 = np.ascontiguousarray(result.poses[f, :, :3, :3])
-    x0 = np.ascontiguousarray(np.einsum("bij,bj->bi", R0, p.bodies.com0) + result.poses[f, :, :3, 3])
+    R0, x0 = pose_state(result.poses[f], p.bodies.com0)
     nodes0 = np.ascontiguousarray(result.membrane_nodes[f])
     return (
         R0,
@@ -182,7 +181,7 @@ def nearest(model: Model, design: Design, driver, result, settings: arrays.Solve
         r = fun(q)
         R, x, _ = moved_state(q, R0, x0, nodes0, free_nodes, loaded)
         poses[f, :, :3, :3] = R
-        poses[f, :, :3, 3] = x - np.einsum("bij,bj->bi", R, com0)
+        poses[f, :, :3, 3] = pose_translation(R, x, com0)
         residual[f] = (
             max(np.linalg.norm(r[0:3]), np.linalg.norm(r[6:9])),
             LEVER_MM * max(np.linalg.norm(r[3:6]), np.linalg.norm(r[9:12])),

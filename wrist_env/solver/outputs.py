@@ -16,6 +16,7 @@ from wrist_env.design import ALL_LIGAMENT_NAMES
 from wrist_env.model import ARTICULATIONS, BODY_PARTS, BONES, PAIR_BONES, PAIRS, ULNA, Model
 from wrist_env.solver import arrays, forces
 from wrist_env.solver.forces import CONTACT_FIELDS
+from wrist_env.solver.rigid import pose_state
 
 if TYPE_CHECKING:
     from wrist_env.solver.simulate import Result
@@ -26,9 +27,7 @@ def _state(model: Model, pose_frame):
     P = np.asarray(pose_frame, dtype=np.float64)
     if P.shape != (len(BONES), 4, 4):
         raise ValueError(f"pose_frame must have shape ({len(BONES)}, 4, 4), but got {P.shape}")
-    R = np.ascontiguousarray(P[:, :3, :3])
-    x = np.ascontiguousarray(np.einsum("bij,bj->bi", R, model.com) + P[:, :3, 3])
-    return R, x
+    return pose_state(P, model.com)
 
 
 def pressure_map(model: Model, pose_frame: ArrayLike) -> np.ndarray:

@@ -10,6 +10,18 @@ LEVER_MM = 10.0
 × this lever, and a bone's or the capitate's move counts its rotation so."""
 
 
+def pose_state(poses: np.ndarray, com0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The kernels' state (R (n, 3, 3), x (n, 3) centres of mass, mm) of one frame's poses (n, 4, 4),
+    neutral → frame, of bodies whose neutral centres of mass are com0 (n, 3) mm: x = R·com0 + t."""
+    R = np.ascontiguousarray(poses[:, :3, :3], dtype=np.float64)
+    return R, np.ascontiguousarray(np.einsum("bij,bj->bi", R, com0) + poses[:, :3, 3])
+
+
+def pose_translation(R: np.ndarray, x: np.ndarray, com0: np.ndarray) -> np.ndarray:
+    """The poses' translations t (n, 3) mm of the state (R, x): t = x − R·com0 (`pose_state`'s inverse)."""
+    return x - np.einsum("bij,bj->bi", R, com0)
+
+
 @njit(cache=True, error_model="numpy")
 def matrix_to_rotvec(R):
     """Rotation vector (3,), radians, of a rotation matrix (3, 3)."""

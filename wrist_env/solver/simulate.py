@@ -21,6 +21,7 @@ from scipy.spatial.transform import Rotation
 from wrist_env.design import ALL_LIGAMENT_NAMES, Design
 from wrist_env.model import CAPITATE, N_BODIES, PAIRS, Model
 from wrist_env.solver import arrays, kernel
+from wrist_env.solver.rigid import pose_state
 
 IDEALIZED_LOAD_N = 10.0  # compressive load that keeps the joint in contact (N)
 AXIAL = (0.0, 1.0, 0.0)  # the load along the radius' long axis, proximal (RCS +y)
@@ -344,8 +345,7 @@ def simulate_frame(
         angle_deg=driver.angle_deg[pair],
         load_n=driver.load_n[pair],
     )
-    R = np.ascontiguousarray(poses[:, :3, :3], dtype=np.float64)
-    x = np.ascontiguousarray(np.einsum("bij,bj->bi", R, model.com) + poses[:, :3, 3])
+    R, x = pose_state(poses, model.com)
     out = _outputs(0, 2, len(model.membrane_nodes))
     frames = _frames(two)
     kernel.run_from(

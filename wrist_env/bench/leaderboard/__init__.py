@@ -40,9 +40,6 @@ def write_leaderboard(
     """Write the leaderboards of the run log in `runs` into the folder `out`; returns out/README.md.
 
     references: {participant: `Reference`} already simulated (the others are simulated here)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     board = build(runs, references)

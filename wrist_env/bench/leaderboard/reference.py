@@ -8,6 +8,7 @@ import numpy as np
 
 from wrist_env.cost import COST_BONES
 from wrist_env.frames import DOF_NAMES
+from wrist_env.trial import TRIAL_MOTIONS
 
 
 @dataclass
@@ -32,10 +33,7 @@ def reference(participant: str) -> Reference:
     designs = {"population": design.population()}
     if participant in builtin.BUILTIN:
         designs["truth"] = builtin.truth(participant)
-    scores = {
-        name: {m: _score(task(participant, m).evaluate(d)) for m in ("calibrate", "validate")}
-        for name, d in designs.items()
-    }
+    scores = {name: {m: _score(task(participant, m).evaluate(d)) for m in TRIAL_MOTIONS} for name, d in designs.items()}
     return Reference(participant, scores["population"], scores.get("truth"))
 
 

@@ -14,6 +14,7 @@ from wrist_env.bench.leaderboard.reference import Reference, reference, rmse_arr
 from wrist_env.bench.log import RunLog
 from wrist_env.cost import COST_BONES
 from wrist_env.frames import DOF_NAMES, DOF_UNITS
+from wrist_env.trial import TRIAL_MOTIONS
 
 TARGETS = (("pop×0.75", "population", 0.75), ("pop×0.5", "population", 0.5), ("truth×1.1", "truth", 1.1))
 """Cost targets (name, reference, factor): a target is factor × the reference design's cost on the
@@ -289,7 +290,7 @@ def dof_improved(
             t: share_improved(
                 [(rmse_array(refs[p].population[t]["rmse"]), rmse_array(chosen[p][t]["rmse"])) for p in participants]
             )
-            for t in ("calibrate", "validate")
+            for t in TRIAL_MOTIONS
         },
         len(participants),
     )
