@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy.stats import qmc
 
 from optimizers.base import Optimizer
 from optimizers.registry import register
@@ -23,6 +22,8 @@ class LatinHypercube(Optimizer):
 
     def _ask(self, n_max: int) -> np.ndarray:
         if not hasattr(self, "_design"):
+            from scipy.stats import qmc  # scipy.stats takes 0.5 s to import: only when a design is drawn
+
             sampler = qmc.LatinHypercube(
                 self.dim,
                 scramble=bool(self.options.get("scramble", True)),

@@ -23,11 +23,11 @@ from wrist_env.builder.warp import Warp
 from wrist_env.design import Design
 from wrist_env.errors import ParticipantError
 from wrist_env.model import SUPPLIED
+from wrist_env.participants import BUILTIN
 
 if TYPE_CHECKING:
     from wrist_env.participants.folder import ParticipantSource
 
-BUILTIN = ("P1", "P2", "P3")
 TRACKING_NOISE_MM, TRACKING_NOISE_DEG = 0.2, 0.5
 """RMS of the synthetic trials' 4DCT tracking noise: a rigid perturbation of each bone per frame."""
 
