@@ -35,7 +35,7 @@ from wrist_env.participants.registry import load_model
 from wrist_env.solver import arrays
 from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.forces import pair_transform, rebuild_active, sample_lookup, sample_lookup_smooth
-from wrist_env.solver.simulate import experimental, idealized, simulate, simulate_batch
+from wrist_env.solver.simulate import idealized, simulate, simulate_batch, static, trial_driver
 
 PREPRINT_SECONDS = 45.0  # one Abaqus simulation
 PREPRINT_STUDY_DAYS = 13  # the preprint's Monte Carlo study
@@ -51,9 +51,10 @@ def median_seconds(fn, repeats: int = 9) -> float:
     return float(np.median(times))
 
 
-def trial_driver(name: str, model):
-    """The participant's 15-frame calibration trial: the capitate's 6 DOF prescribed."""
-    return experimental(model, registry.trial(name, "calibrate").pose("capitate"))
+def calibration_trial(name: str, model):
+    """The participant's 15-frame calibration trial as a `Task` drives it: the capitate's 6 DOF
+    prescribed, the radial column free under the lines at the trial's recorded load."""
+    return trial_driver(model, registry.trial(name, "calibrate"))
 
 
 def monte_carlo_designs(n: int, seed: int = 0):
@@ -94,7 +95,7 @@ def bare_lookups(repeats, R, x, com0, grids, active, n_active, smooth):
 def efficiency(model, steps_per_sim: float, seconds_per_sim: float) -> tuple[float, float, int]:
     """(bare look-up µs per step, full µs per step, active samples) at the settled neutral pose."""
     s = arrays.SolverSettings()
-    settled = simulate(model, design.population(), experimental(model, np.tile(np.eye(4), (2, 1, 1))))
+    settled = simulate(model, design.population(), static(model, 2))
     pose = settled.poses[-1]
     R = np.ascontiguousarray(pose[:, :3, :3])
     x = np.ascontiguousarray(np.einsum("bij,bj->bi", R, model.com) + pose[:, :3, 3])
@@ -139,7 +140,7 @@ def main(name: str, params=None, load_n=None) -> None:
     model = load_model(name, params)
     motions = {
         "idealized sweep, 17 frames": idealized(model) if load_n is None else idealized(model, load_n=load_n),
-        "15-frame trial": trial_driver(name, model),
+        "15-frame trial": calibration_trial(name, model),
     }
     designs = monte_carlo_designs(64)
     rows = {}

@@ -45,7 +45,7 @@ from wrist_env.participants import registry
 from wrist_env.participants.registry import load_model
 from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.equilibrium import distance, nearest
-from wrist_env.solver.simulate import experimental, idealized, prepare, simulate_batch, simulate_frame
+from wrist_env.solver.simulate import idealized, prepare, simulate_batch, simulate_frame, trial_driver
 
 CACHE = Path(__file__).resolve().parent.parent / "runs" / "solver_accuracy"  # the repository root's runs/, git-ignored
 TOLERANCE = (0.1, 0.5)  # mm, degrees: issue 13's "answer unchanged"
@@ -75,7 +75,7 @@ def largest_distance(a: np.ndarray, b: np.ndarray, com0: np.ndarray) -> tuple[fl
 def drivers(name: str, model):
     return {
         "sweep": idealized(model),
-        "trial": experimental(model, registry.trial(name, "calibrate").pose("capitate")),
+        "trial": trial_driver(model, registry.trial(name, "calibrate")),
     }
 
 

@@ -27,7 +27,7 @@ from wrist_env.participants import registry
 from wrist_env.participants.registry import load_model
 from wrist_env.solver import arrays
 from wrist_env.solver.equilibrium import block_mass, tangent_stiffness
-from wrist_env.solver.simulate import experimental, idealized, prepare, simulate, stiffness
+from wrist_env.solver.simulate import idealized, prepare, simulate, stiffness, trial_driver
 
 
 def node_courant(model, dsg, driver, settings: arrays.SolverSettings) -> float:
@@ -43,7 +43,7 @@ def report(name: str, settings: arrays.SolverSettings) -> None:
     dsg = design.population()
     motions = {
         "sweep": idealized(model),
-        "trial": experimental(model, registry.trial(name, "calibrate").pose("capitate")),
+        "trial": trial_driver(model, registry.trial(name, "calibrate")),
     }
     for motion, driver in motions.items():
         result = simulate(model, dsg, driver, settings)

@@ -26,11 +26,11 @@ from wrist_env.solver.simulate import (
     LOAD_DIRECTIONS,
     Driver,
     Result,
-    experimental,
     idealized,
     prepare,
     simulate,
     simulate_batch,
+    trial_driver,
 )
 from wrist_env.trial import MOTIONS
 
@@ -81,8 +81,7 @@ class Task:
             truth = simulate(self.model, builtin.truth(self.participant), driver, self.settings)
             return driver, cost_poses(truth.poses)
         trial = registry.trial(self.participant, "calibrate" if self.motion == "calibrate" else "validate")
-        load_n = 0.0 if trial.load_n is None else trial.load_n
-        driver = experimental(self.model, trial.pose("capitate"), load_n, self.load_direction)
+        driver = trial_driver(self.model, trial, self.load_direction)
         return driver, np.stack([trial.pose(b) for b in COST_BONES])
 
     def evaluate(self, design: Design) -> Evaluation:

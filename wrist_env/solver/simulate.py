@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numba
 import numpy as np
@@ -22,6 +23,9 @@ from wrist_env.design import ALL_LIGAMENT_NAMES, Design
 from wrist_env.model import CAPITATE, N_BODIES, PAIRS, Model
 from wrist_env.solver import arrays, kernel
 from wrist_env.solver.rigid import pose_state
+
+if TYPE_CHECKING:
+    from wrist_env.trial import Trial
 
 IDEALIZED_LOAD_N = 10.0  # compressive load that keeps the joint in contact (N)
 AXIAL = (0.0, 1.0, 0.0)  # the load along the radius' long axis, proximal (RCS +y)
@@ -129,6 +133,13 @@ def experimental(
         np.broadcast_to(np.asarray(load_n, dtype=np.float64), (n,)).copy(),
         loads(model, direction),
     )
+
+
+def trial_driver(model: Model, trial: Trial, direction: str | ArrayLike = DEFAULT_LOADS) -> Driver:
+    """The experimental driver of a `Trial`: its capitate's poses, the free bodies under its recorded
+    total load per frame (`Trial.load_n`; none if it has none) on the lines of `direction`."""
+    load_n = 0.0 if trial.load_n is None else trial.load_n
+    return experimental(model, trial.pose("capitate"), load_n, direction)
 
 
 def loaded(
