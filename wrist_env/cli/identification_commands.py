@@ -5,6 +5,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
+from wrist_env.cli.options import out_option
 from wrist_env.errors import UsageError
 from wrist_env.trial import MOTIONS
 
@@ -140,7 +141,7 @@ def add_commands(command: Callable[..., object]) -> None:
         help="default: all three",
     )
     s.add_argument("--seed", type=int, default=0, help="sampling seed (default 0)")
-    s.add_argument("--out", default="runs/sensitivity", help="output folder (default runs/sensitivity)")
+    out_option(s, "runs/sensitivity")
     s.set_defaults(run=_sensitivity)
 
     s = command(
@@ -152,7 +153,7 @@ def add_commands(command: Callable[..., object]) -> None:
         "population prior, for the calibration trial, the held-out trial and both; CSV and a PNG per participant.",
     )
     s.add_argument("participants", nargs="+", help="built-in participants (they have a hidden truth)")
-    s.add_argument("--out", default="runs/identifiability", help="output folder (default runs/identifiability)")
+    out_option(s, "runs/identifiability")
     s.set_defaults(run=_identifiability)
 
     s = command(
@@ -198,7 +199,7 @@ def add_commands(command: Callable[..., object]) -> None:
         default=bayes.PRIOR_REFRESH,
         help="emcee's share of moves that redraw one material from its prior (default %(default)s)",
     )
-    s.add_argument("--out", default="runs/posterior", help="output folder (default runs/posterior)")
+    out_option(s, "runs/posterior")
     s.add_argument("--report", help="folder of coverage.csv and the figures (default: --out)")
     s.add_argument(
         "--model-trials",

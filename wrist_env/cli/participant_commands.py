@@ -9,6 +9,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from wrist_env.cli.options import out_option
 from wrist_env.errors import UsageError
 from wrist_env.solver.simulate import DEFAULT_LOADS, LOAD_DIRECTIONS
 from wrist_env.trial import MOTIONS
@@ -381,7 +382,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     )
     s.add_argument("participant", help=PARTICIPANT_HELP)
     s.add_argument("--json", action="store_true", help="print the checks and series as JSON")
-    s.add_argument("--out", help=f"figure folder (default {FIGURES_HELP})")
+    out_option(s, what=f"figure folder (default {FIGURES_HELP})")
     add_anatomy_arguments(s)
     s.add_argument(
         "--load",
@@ -409,7 +410,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     )
     s.add_argument("kind", choices=["model", "annotations", "pressure", "kinematics", "animation"])
     s.add_argument("participant", nargs="?", help=PARTICIPANT_HELP + " (default P1)")
-    s.add_argument("--out", help=f"output PNG path (default: a file named after the figure in {FIGURES_HELP})")
+    out_option(s, what=f"output PNG path (default: a file named after the figure in {FIGURES_HELP})")
     s.add_argument(
         "--static",
         action="store_true",

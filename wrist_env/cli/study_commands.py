@@ -9,6 +9,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+from wrist_env.cli.options import out_option, scheduler_option
 from wrist_env.cli.participant_commands import PARTICIPANT_HELP
 from wrist_env.errors import UsageError
 from wrist_env.solver.simulate import DEFAULT_LOADS, LOAD_DIRECTIONS
@@ -186,7 +187,7 @@ def _montecarlo_report(args) -> int:
 def _run_log_arguments(s: argparse.ArgumentParser, *, out: str) -> None:
     """--runs (a benchmark run log) and --out (an output folder, default `out`) of a command that reads a log."""
     s.add_argument("--runs", default="runs/benchmark", help="run-log folder (default runs/benchmark)")
-    s.add_argument("--out", default=out, help=f"output folder (default {out})")
+    out_option(s, out)
 
 
 def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
@@ -218,7 +219,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         help="minimize the MAP objective (kinematic misfit over the 4DCT noise + the Table 2 prior) instead of "
         "the cost; the same as the calibrator name with '+prior' appended",
     )
-    s.add_argument("--out", help="also write the JSON result to this file (usable as --design elsewhere)")
+    out_option(s, what="also write the JSON result to this file (usable as --design elsewhere)")
     s.add_argument("--json", action="store_true", help="print the result, design and held-out cost as JSON")
     s.set_defaults(run=_calibrate)
 
@@ -239,8 +240,8 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     )
     s.add_argument("--seeds", type=int, default=5, help="seeds 0 .. N-1 per participant and calibrator (default 5)")
     s.add_argument("--budget", type=int, default=300, help="simulations per run (default 300)")
-    s.add_argument("--out", default="runs/benchmark", help="run-log folder (default runs/benchmark)")
-    s.add_argument("--scheduler", help="dask.distributed scheduler address (e.g. tcp://host:8786); one task per cell")
+    out_option(s, "runs/benchmark", "run-log folder")
+    scheduler_option(s, "cell")
     s.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
     s.add_argument("--threads", type=int, help="Numba threads per local worker (default: cores / workers)")
     s.add_argument(
@@ -298,8 +299,8 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         default=DEFAULT_LOADS,
         help="the sweeps' load: along the radius (default), or a tendon rig's resultant (see validate)",
     )
-    s.add_argument("--out", default="runs/montecarlo", help="run-log folder (default runs/montecarlo)")
-    s.add_argument("--scheduler", help="dask.distributed scheduler address (e.g. tcp://host:8786); one task per batch")
+    out_option(s, "runs/montecarlo", "run-log folder")
+    scheduler_option(s, "batch")
     s.add_argument(
         "--batch", type=int, default=64, help="runs per batch: one vector-env step, one log part (default 64)"
     )
@@ -323,6 +324,6 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "as PNG, summary.json and report.md.",
     )
     s.add_argument("--runs", default="runs/montecarlo", help="run-log folder (default runs/montecarlo)")
-    s.add_argument("--out", default="runs/montecarlo-report", help="output folder (default runs/montecarlo-report)")
+    out_option(s, "runs/montecarlo-report")
     s.add_argument("--max-runs", type=int, help="fit on a seeded random subset of this many runs (default: all)")
     s.set_defaults(run=_montecarlo_report)
