@@ -2,10 +2,10 @@
 
 On the built-in trials the hidden truth fits worse than the MAP (`experiments/model_error.py`: the
 calibration model is driven by the trial's noisy capitate poses). This script measures, for P1–P3,
-the log posterior of the truth minus that of the MAP (the best of `bayes.MAP_STARTS` Gauss–Newton
+the log posterior of the truth minus that of the MAP (the best of `map.MAP_STARTS` Gauss–Newton
 runs, seed 0) under:
 
-- jeffreys: the Bayesian calibrator's likelihood (`posterior.log_likelihood`: Gaussian, the noise
+- jeffreys: the Bayesian calibrator's likelihood (`likelihood.log_likelihood`: Gaussian, the noise
   scales of translations and rotations integrated out under Jeffreys' prior);
 - gaussian: Gaussian with the trials' own tracking noise per DOF (0.2 mm / √3, 0.5° / √3) known;
 - frame_t: a frame's 12 residuals multivariate Student-t (a per-frame scale mixture: a frame may be
@@ -42,8 +42,10 @@ from scipy.spatial.transform import Rotation
 from scipy.special import gammaln, logsumexp
 from scipy.stats import gamma
 
-from wrist_env import bayes, design, posterior
+from wrist_env import design
 from wrist_env.envs.task import Task, task
+from wrist_env.identification import likelihood
+from wrist_env.identification.map import map_estimate
 from wrist_env.model import BONES
 from wrist_env.participants import builtin, registry
 from wrist_env.participants.builtin import TRACKING_NOISE_DEG, TRACKING_NOISE_MM
@@ -54,8 +56,8 @@ from wrist_env.solver.simulate import experimental, simulate, stiffness
 OUT = Path(__file__).resolve().parents[1] / "leaderboards" / "posterior"
 AXIS_SD = np.r_[np.full(3, TRACKING_NOISE_MM), np.radians(np.full(3, TRACKING_NOISE_DEG))] / np.sqrt(3)
 """The tracking noise per axis (mm, rad): `builtin.tracking_noise` is isotropic with these RMS totals."""
-TRACKING_SD = np.r_[TRACKING_NOISE_MM / posterior.NOISE[:3], TRACKING_NOISE_DEG / posterior.NOISE[3:]] / np.sqrt(3)
-"""The same per DOF residual, in `posterior.NOISE` units (both 1/√3)."""
+TRACKING_SD = np.r_[TRACKING_NOISE_MM / likelihood.NOISE[:3], TRACKING_NOISE_DEG / likelihood.NOISE[3:]] / np.sqrt(3)
+"""The same per DOF residual, in `likelihood.NOISE` units (both 1/√3)."""
 LOG_S = np.linspace(np.log(0.05), np.log(50.0), 120)
 NU = np.exp(np.linspace(0.0, np.log(300.0), 40))
 LOG_W_NU = gamma(2.0, scale=10.0).logpdf(NU) + np.log(NU) + np.log(np.diff(np.log(NU)).mean())
@@ -72,12 +74,12 @@ def moved(R0: np.ndarray, x0: np.ndarray, centroid: np.ndarray, dc: np.ndarray) 
 
 
 def response(t: Task, d: design.Design, result) -> np.ndarray:
-    """D (n_frames, 12, 6): the residuals' (`posterior.residuals`, frame-major: bone, DOF) linear response
+    """D (n_frames, 12, 6): the residuals' (`likelihood.residuals`, frame-major: bone, DOF) linear response
     to one SD of the capitate's tracking noise per axis, from the tangent at each frame."""
     p, cap = t.prepared, BONES.index("capitate")
     free, n = equilibrium._unknowns(t.model, t.driver)
     k_design = stiffness(p, d)
-    base = posterior.residuals(t, result.poses)
+    base = likelihood.residuals(t, result.poses)
     D, out, h, eps = np.zeros((t.driver.n_frames, 12, 6)), np.zeros(n), 1e-6, 1e-3
     for f in range(t.driver.n_frames):
         args = equilibrium._frame_args(p, k_design, free, t.driver, result, f)
@@ -96,7 +98,7 @@ def response(t: Task, d: design.Design, result) -> np.ndarray:
             poses = result.poses.copy()
             poses[f, :, :3, :3] = R
             poses[f, :, :3, 3] = x - np.einsum("bij,bj->bi", R, p.bodies.com0)
-            D[f, :, k] = ((posterior.residuals(t, poses)[:, f] - base[:, f]) / eps).ravel()
+            D[f, :, k] = ((likelihood.residuals(t, poses)[:, f] - base[:, f]) / eps).ravel()
     return D
 
 
@@ -114,7 +116,7 @@ def simulated_response(t: Task, d: design.Design, k: int) -> np.ndarray:
         com = np.einsum("ij,fj->fi", turn, drv.com - centroid) + centroid + dc[:3]
         poses[:, :3, 3] = com - np.einsum("fij,j->fi", poses[:, :3, :3], com0)
         run = simulate(t.model, d, experimental(t.model, poses), prepared=t.prepared)
-        runs.append(posterior.residuals(t, run.poses))
+        runs.append(likelihood.residuals(t, run.poses))
     return np.transpose((runs[0] - runs[1]) / 2.0, (1, 0, 2)).reshape(drv.n_frames, 12)
 
 
@@ -169,7 +171,7 @@ def marginal(t: Task, d: design.Design, drivers: list) -> dict[str, float]:
         if not run.ok:
             per_run.append(np.full(driver.n_frames, -np.inf))
             continue
-        r = _frames(posterior.residuals(t, run.poses))
+        r = _frames(likelihood.residuals(t, run.poses))
         per_run.append(-0.5 * np.sum(r**2 / var + np.log(2 * np.pi * var), axis=1))
     L = np.array(per_run)
     return {f"marginal_{k}": float(np.sum(logsumexp(L[:k], axis=0) - np.log(k))) for k in MARGINAL_DRAWS}
@@ -178,15 +180,15 @@ def marginal(t: Task, d: design.Design, drivers: list) -> dict[str, float]:
 def rows(name: str) -> tuple[list[dict], list[dict]]:
     t = task(name, "calibrate")
     z_truth = design.z_scores(builtin.truth(name))
-    map_z, *_ = bayes.map_estimate(t)
+    map_z, *_ = map_estimate(t)
     values, check, drivers = {}, [], noisy_drivers(t, max(MARGINAL_DRAWS))
     for label, z in (("truth", z_truth), ("MAP", map_z)):
         d = design.with_z(design.population(), z)
         run = t.evaluate(d).result
-        r, D = posterior.residuals(t, run.poses), response(t, d, run)
-        prior = float(posterior.log_prior(z))
+        r, D = likelihood.residuals(t, run.poses), response(t, d, run)
+        prior = float(likelihood.log_prior(z))
         values[label] = {
-            "jeffreys": posterior.log_likelihood(r) + prior,
+            "jeffreys": likelihood.log_likelihood(r) + prior,
             "gaussian": gaussian(r) + prior,
             "frame_t": frame_t(r) + prior,
             "eiv": gaussian(r, D) + prior,

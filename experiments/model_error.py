@@ -13,8 +13,8 @@ trial's making without the noise:
   draws; translation or rotation only as well): the noise the driver passes to the proximal row;
 - trial: against the built-in trial itself (its own noise draws on all three bones).
 
-Each at the hidden truth and at the MAP (`bayes.map_estimate`, its default 24 starts): sums of squared
-residuals in 4DCT-noise units (`posterior.residuals`, 180 of them; tracking noise alone gives ~60)
+Each at the hidden truth and at the MAP (`map_estimate`, its default 24 starts): sums of squared
+residuals in 4DCT-noise units (`likelihood.residuals`, 180 of them; tracking noise alone gives ~60)
 and, for the gap and the trial, their RMS in mm and deg. Writes `leaderboards/posterior/model_error.csv`.
 
 Run: `python experiments/model_error.py [P1 P2 P3]` (~8 min; builds the high-fidelity models first).
@@ -31,9 +31,11 @@ import pandas as pd
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from make_trials import HIGH_FIDELITY_BUILD, HIGH_FIDELITY_SOLVER, capitate_motion  # noqa: E402
 
-from wrist_env import bayes, design, posterior  # noqa: E402
+from wrist_env import design  # noqa: E402
 from wrist_env.envs.task import cost_poses, task  # noqa: E402
 from wrist_env.frames import cardan_rotation  # noqa: E402
+from wrist_env.identification import likelihood  # noqa: E402
+from wrist_env.identification.map import map_estimate  # noqa: E402
 from wrist_env.model import BONES  # noqa: E402
 from wrist_env.participants import builtin  # noqa: E402
 from wrist_env.participants.registry import load_model  # noqa: E402
@@ -63,18 +65,18 @@ def rows(name: str) -> list[dict]:
     angles, load = capitate_motion(builtin.info(name).task, "unresisted")
     run = simulate(fine, builtin.truth(name), loaded(fine, cardan_rotation(angles), load), HIGH_FIDELITY_SOLVER)
     capitate, clean = run.poses[:, CAPITATE], cost_poses(run.poses)
-    map_z, *_ = bayes.map_estimate(calibration)
+    map_z, *_ = map_estimate(calibration)
     out = []
     for label, z in (("truth", design.z_scores(builtin.truth(name))), ("MAP", map_z)):
         d = design.with_z(design.population(), z)
 
         def residuals(driven: np.ndarray) -> np.ndarray:
-            return posterior.residuals(
+            return likelihood.residuals(
                 calibration, simulate(calibration.model, d, experimental(calibration.model, driven)).poses, clean
             )
 
         gap = residuals(capitate)
-        trial = posterior.residuals(calibration, calibration.evaluate(d).result.poses)
+        trial = likelihood.residuals(calibration, calibration.evaluate(d).result.poses)
         row = {"participant": name, "design": label, "gap_ss": float(np.sum(gap**2))}
         for part in ("all", "translation", "rotation"):
             rng = np.random.default_rng(7)
@@ -87,8 +89,8 @@ def rows(name: str) -> list[dict]:
                 row["capitate_noise_ss_min"], row["capitate_noise_ss_max"] = min(ss), max(ss)
         row["trial_ss"] = float(np.sum(trial**2))
         (row["gap_mm"], row["gap_deg"]), (row["trial_mm"], row["trial_deg"]) = (
-            posterior.noise_scale(gap),
-            posterior.noise_scale(trial),
+            likelihood.noise_scale(gap),
+            likelihood.noise_scale(trial),
         )
         out.append(row)
         print(

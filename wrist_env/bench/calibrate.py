@@ -35,7 +35,7 @@ from wrist_env.cost import COST_BONES
 from wrist_env.design import N_MATERIAL, Design
 from wrist_env.errors import WristEnvError
 from wrist_env.frames import DOF_NAMES
-from wrist_env.posterior import map_objective
+from wrist_env.identification.likelihood import map_objective
 
 if TYPE_CHECKING:
     from optuna.storages import BaseStorage, RDBStorage

@@ -11,7 +11,7 @@ from wrist_env.trial import MOTIONS
 
 
 def _sensitivity(args) -> int:
-    from wrist_env import sensitivity
+    from wrist_env.identification import sensitivity
     from wrist_env.participants import registry
 
     registry.require(*args.participants)
@@ -32,13 +32,13 @@ def _sensitivity(args) -> int:
 
 
 def _identifiability(args) -> int:
-    from wrist_env import identifiability
+    from wrist_env.identification import fisher
     from wrist_env.participants import builtin
 
     unknown = [p for p in args.participants if p not in builtin.BUILTIN]
     if unknown:
         raise UsageError(f"{unknown} have no hidden truth; built-ins: {list(builtin.BUILTIN)}")
-    materials, spectra = identifiability.study(args.participants, args.out)
+    materials, spectra = fisher.study(args.participants, args.out)
     for (participant, trials), rows in materials.groupby(["participant", "trials"], sort=False):
         s = spectra[(spectra["participant"] == participant) & (spectra["trials"] == trials)]
         pinned = rows[rows["posterior_sd"] < 0.5]["material"].tolist()
@@ -53,7 +53,7 @@ def _identifiability(args) -> int:
 def _posterior(args) -> int:
     import numpy as np
 
-    from wrist_env import bayes
+    from wrist_env.identification.study import study
     from wrist_env.participants import registry
 
     registry.require(*args.participants)
@@ -88,7 +88,7 @@ def _posterior(args) -> int:
             flush=True,
         )
 
-    table = bayes.study(
+    table = study(
         args.participants,
         args.seeds,
         args.out,
@@ -120,7 +120,7 @@ def _posterior(args) -> int:
 
 
 def add_commands(command: Callable[..., object]) -> None:
-    from wrist_env import bayes  # the sampler's defaults have one owner (its import adds ~0.1 s to wrist_env's)
+    from wrist_env.identification import bayes  # the sampler's defaults have one owner
 
     s = command(
         "sensitivity",

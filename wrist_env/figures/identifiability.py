@@ -1,4 +1,4 @@
-"""Figure of what a trial identifies (`wrist_env.identifiability`): the Fisher spectrum and the
+"""Figure of what a trial identifies (`wrist_env.identification.fisher`): the Fisher spectrum and the
 per-material posterior SD for the calibration trial, the held-out trial and both (PNG)."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Figures of a Bayesian calibration (`wrist_env.bayes`): credible intervals of the 22 materials
+"""Figures of a Bayesian calibration (`wrist_env.identification.bayes`): credible intervals of the 22 materials
 against the hidden truth, and the posterior predictive kinematics of both trials (PNG)."""
 
 from __future__ import annotations

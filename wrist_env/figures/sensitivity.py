@@ -1,4 +1,4 @@
-"""Figure of a sensitivity study (`wrist_env.sensitivity`): materials × outputs, a panel per motion (PNG)."""
+"""Figure of a sensitivity study (`wrist_env.identification.sensitivity`): materials × outputs, a panel per motion (PNG)."""
 
 from __future__ import annotations
 

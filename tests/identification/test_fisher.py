@@ -1,12 +1,13 @@
-"""What a trial identifies (`wrist_env.identifiability`): the algebra on a planted Fisher matrix, the
+"""What a trial identifies (`wrist_env.identification.fisher`): the algebra on a planted Fisher matrix, the
 finite-difference Jacobian against the simulator itself, and the command."""
 
 import numpy as np
 import pytest
 
-from wrist_env import design, identifiability, posterior
+from wrist_env import design
 from wrist_env.cli import main
 from wrist_env.envs.task import Task, cost_poses
+from wrist_env.identification import fisher, likelihood
 from wrist_env.participants import builtin
 
 
@@ -15,17 +16,17 @@ def test_spectrum_and_posterior_of_a_planted_fisher_matrix():
     posterior SD of each coordinate is sqrt(diag(Q diag(1/101, 1/1.81, 1) Qᵀ))."""
     Q, _ = np.linalg.qr(np.random.default_rng(0).normal(size=(3, 3)))
     F = Q @ np.diag([100.0, 0.81, 0.0]) @ Q.T
-    s = identifiability.spectrum(F)
+    s = fisher.spectrum(F)
     np.testing.assert_allclose(s.sd[:2], [0.1, 1 / 0.9], rtol=1e-9)
     assert s.sd[2] > 1e6 and s.identified(1.0) == 1 and s.identified(2.0) == 2
     np.testing.assert_allclose(np.abs(s.eigenvectors[:, 0] @ Q[:, 0]), 1.0, rtol=1e-9)
     expected = np.sqrt(np.diag(Q @ np.diag([1 / 101, 1 / 1.81, 1.0]) @ Q.T))
-    np.testing.assert_allclose(identifiability.posterior_sd(F), expected, rtol=1e-9)
+    np.testing.assert_allclose(fisher.posterior_sd(F), expected, rtol=1e-9)
 
 
 @pytest.fixture(scope="module")
 def p1_calibrate():
-    return Task("P1", "calibrate", settings=identifiability.SETTINGS)
+    return Task("P1", "calibrate", settings=fisher.SETTINGS)
 
 
 def test_the_jacobian_predicts_the_simulated_change(p1_calibrate):
@@ -35,8 +36,8 @@ def test_the_jacobian_predicts_the_simulated_change(p1_calibrate):
     0.05-SD move still misses by 10–40 %, the settled state's own tolerance); halving the step changes
     the Jacobian by < 25 % (measured 15 %)."""
     task, truth = p1_calibrate, builtin.truth("P1")
-    J = identifiability.jacobian(task, truth)
-    J_half = identifiability.jacobian(task, truth, step=identifiability.STEP_Z / 2)
+    J = fisher.jacobian(task, truth)
+    J_half = fisher.jacobian(task, truth, step=fisher.STEP_Z / 2)
     assert np.linalg.norm(J - J_half) < 0.25 * np.linalg.norm(J)
     moves = []
     for seed in range(5):
@@ -49,7 +50,7 @@ def test_the_jacobian_predicts_the_simulated_change(p1_calibrate):
     base = cost_poses(runs[0].poses)
     misses = []
     for dz, moved in zip(moves, runs[1:]):
-        change = posterior.residuals(task, moved.poses, base).ravel()
+        change = likelihood.residuals(task, moved.poses, base).ravel()
         misses.append(np.linalg.norm(change - J @ dz) / np.linalg.norm(change))
     assert np.median(misses) < 0.3, misses
 

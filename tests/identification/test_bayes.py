@@ -1,4 +1,4 @@
-"""The Bayesian calibrator (`wrist_env.bayes`): the sampler against a closed-form posterior, its
+"""The Bayesian calibrator (`wrist_env.identification`): the sampler against a closed-form posterior, its
 diagnostics, and a short run on P1 through the command."""
 
 import json
@@ -6,8 +6,11 @@ import json
 import numpy as np
 import pytest
 
-from wrist_env import bayes, design
+from wrist_env import design
 from wrist_env.cli import main
+from wrist_env.identification import bayes, mcmc, posterior, smc
+from wrist_env.identification import map as map_
+from wrist_env.identification import study as study_
 
 
 def _linear_gaussian():
@@ -32,7 +35,7 @@ def test_the_sampler_recovers_a_linear_gaussian_posterior():
     """emcee on the closed-form posterior: the sampled mean is within 0.1 posterior SD of m and each
     SD within 10 % of √diag C; R̂ < 1.05."""
     log_like, m, C, _ = _linear_gaussian()
-    out = bayes.sample(
+    out = mcmc.sample(
         lambda Z: log_like(Z) - 0.5 * np.sum(Z**2, axis=1), np.random.default_rng(0).normal(size=(32, 4)), 4000, seed=0
     )
     samples = out["chain"].reshape(-1, 4)
@@ -46,7 +49,7 @@ def test_smc_recovers_a_linear_gaussian_posterior_and_its_evidence():
     """SMC from the prior (truncated at |z| ≤ 3, which holds 99.7 % of each N(0, 1)) on the same
     posterior: mean within 0.15 posterior SD, SDs within 15 %, log evidence within 0.3 of the closed form."""
     log_like, m, C, log_evidence = _linear_gaussian()
-    out = bayes.sample_smc(log_like, 4, particles=2000, mcmc_steps=10, seed=0)
+    out = smc.sample_smc(log_like, 4, particles=2000, mcmc_steps=10, seed=0)
     sd = np.sqrt(np.diag(C))
     samples = out["samples"]
     assert samples.shape == (2000, 4) and out["phi"][0] == 0 and out["phi"][-1] == 1
@@ -71,7 +74,7 @@ def test_emcee_with_the_prior_refresh_keeps_a_hinges_exact_marginal():
         return np.where(inside, value, -np.inf)
 
     start = np.array([0.5, 1.0]) + 0.01 * np.random.default_rng(0).normal(size=(32, 2))
-    samples = bayes.sample(log_prob, start, 3000, seed=0)["chain"].reshape(-1, 2)
+    samples = mcmc.sample(log_prob, start, 3000, seed=0)["chain"].reshape(-1, 2)
     x = np.linspace(-3, 3, 60_001)
     density = norm.pdf(x) * np.exp(-50.0 * np.clip(x - 0.5, 0.0, None) ** 2)
     cdf = np.cumsum(density) / density.sum()
@@ -83,8 +86,8 @@ def test_split_rhat_flags_chains_that_disagree():
     rng = np.random.default_rng(0)
     mixed = rng.normal(size=(500, 8, 2))
     stuck = mixed + np.array([0.0, 2.0])[None, None, :] * (np.arange(8) % 2)[None, :, None]
-    assert np.all(bayes.split_rhat(mixed) < 1.02)
-    r = bayes.split_rhat(stuck)
+    assert np.all(mcmc.split_rhat(mixed) < 1.02)
+    r = mcmc.split_rhat(stuck)
     assert r[0] < 1.02 and r[1] > 1.3
 
 
@@ -102,10 +105,10 @@ def test_the_command_samples_p1_and_writes_coverage_and_figures(built, tmp_path,
     assert len(table) == 1 and table.coverage_90.between(0, 1).all() and table.coverage_90[0] >= table.coverage_50[0]
     assert (tmp_path / "posterior_intervals_P1.png").stat().st_size > 10_000
     assert (tmp_path / "posterior_predictive_P1.png").stat().st_size > 10_000
-    post = bayes.Posterior.load(tmp_path / "posterior_P1_seed0.npz")
+    post = posterior.Posterior.load(tmp_path / "posterior_P1_seed0.npz")
     assert post.samples.shape == (4 * 48, design.N_MATERIAL) and post.predictive.shape[:3] == (2, 3, 2)
     assert json.loads((tmp_path / "posterior_P1_seed0.json").read_text())["fields"]["evaluations"] == post.evaluations
-    assert post.settings == {"walkers": 48, "steps": 8, "map_starts": 2, "prior_refresh": bayes.PRIOR_REFRESH}
+    assert post.settings == {"walkers": 48, "steps": 8, "map_starts": 2, "prior_refresh": mcmc.PRIOR_REFRESH}
     capsys.readouterr()
     assert main(args) == 0
     assert "loaded" in capsys.readouterr().out
@@ -118,7 +121,7 @@ def test_smc_from_a_defensive_start_off_the_mode_recovers_the_same_posterior():
     covariance: the same closed-form posterior and evidence as from the prior."""
     log_like, m, C, log_evidence = _linear_gaussian()
     sd = np.sqrt(np.diag(C))
-    out = bayes.sample_smc(log_like, 4, 2000, 10, seed=0, start=bayes.DefensiveStart(m + sd, 0.5 * C))
+    out = smc.sample_smc(log_like, 4, 2000, 10, seed=0, start=smc.DefensiveStart(m + sd, 0.5 * C))
     samples = out["samples"]
     assert np.all(np.abs(samples.mean(axis=0) - m) < 0.15 * sd), (samples.mean(axis=0) - m) / sd
     np.testing.assert_allclose(samples.std(axis=0), sd, rtol=0.15)
@@ -128,7 +131,7 @@ def test_smc_from_a_defensive_start_off_the_mode_recovers_the_same_posterior():
 def test_the_defensive_start_is_a_normalized_density_on_the_prior_box():
     """Its density integrates to 1 over |z| ≤ 3 (a 2-D grid; the t is centred near the edge, so its
     truncation matters), its draws stay in the box, and 20 % of them follow the prior."""
-    start = bayes.DefensiveStart(np.array([2.5, -1.0]), np.array([[0.3, 0.1], [0.1, 0.2]]))
+    start = smc.DefensiveStart(np.array([2.5, -1.0]), np.array([[0.3, 0.1], [0.1, 0.2]]))
     g = np.linspace(-3, 3, 601)
     grid = np.stack(np.meshgrid(g, g), axis=-1).reshape(-1, 2)
     assert np.exp(start.logpdf(grid)).sum() * (g[1] - g[0]) ** 2 == pytest.approx(1.0, abs=0.01)
@@ -136,7 +139,7 @@ def test_the_defensive_start_is_a_normalized_density_on_the_prior_box():
     draws = start.rvs(100_000, random_state=1)
     assert draws.shape == (100_000, 2) and np.all(np.abs(draws) <= 3)
     # the t puts almost nothing below z₀ = −2 (its centre 2.5, SD ≈ 0.8); the prior puts 2.15 % there
-    assert np.mean(draws[:, 0] < -2) == pytest.approx(bayes.PRIOR_SHARE * 0.02146, abs=0.0008)
+    assert np.mean(draws[:, 0] < -2) == pytest.approx(smc.PRIOR_SHARE * 0.02146, abs=0.0008)
 
 
 @pytest.mark.slow
@@ -148,7 +151,7 @@ def test_the_command_runs_smc_and_keeps_its_own_files(built, tmp_path, capsys):
     args = ["posterior", "P1", "--sampler", "smc", "--particles", "44", "--mcmc-steps", "1", "--map-starts", "2"]
     args += ["--out", str(tmp_path)]
     assert main(args) == 0
-    post = bayes.Posterior.load(tmp_path / "posterior_P1_seed0_smc.npz")
+    post = posterior.Posterior.load(tmp_path / "posterior_P1_seed0_smc.npz")
     assert post.sampler == "smc" and post.samples.shape == (44, design.N_MATERIAL)
     assert np.all(np.abs(post.samples) <= 3) and post.stages >= 1 and np.isfinite(post.log_evidence)
     assert post.evaluations >= 44 * (post.stages + 1) and np.all(np.isnan(post.rhat))
@@ -156,7 +159,7 @@ def test_the_command_runs_smc_and_keeps_its_own_files(built, tmp_path, capsys):
     # stored in float32 and the solver's stopping rule makes the likelihood rough at that scale (README)
     best = post.samples[np.argmax(post.log_prob)]
     assert post.log_prob.max() == pytest.approx(
-        float(bayes.log_probability(bayes._tasks("P1", "built-in", 0)[0])(best[None])[0]), abs=1.0
+        float(mcmc.log_probability(bayes._tasks("P1", "built-in", 0)[0])(best[None])[0]), abs=1.0
     )
     import pandas as pd
 
@@ -173,7 +176,7 @@ def test_the_laplace_covariance_takes_the_noise_the_fit_implies():
     translation = np.arange(60) % 6 < 3
     r = np.where(translation, 2.0, 1.0) * rng.choice([-1.0, 1.0], 60)
     expected = np.linalg.inv(J[translation].T @ J[translation] / 4 + J[~translation].T @ J[~translation] + np.eye(5))
-    np.testing.assert_allclose(bayes.laplace_covariance(r, J), expected, rtol=1e-12)
+    np.testing.assert_allclose(map_.laplace_covariance(r, J), expected, rtol=1e-12)
 
 
 def test_model_trials_carry_the_tracking_noise_and_no_model_error(built):
@@ -181,16 +184,16 @@ def test_model_trials_carry_the_tracking_noise_and_no_model_error(built):
     noise alone (0.2 mm and 0.5° RMS rigid, so ~0.12 mm and ~0.29° per DOF at the centroid: about 0.6
     noise units each), below the built-in trial's (noise plus the fidelity gap); the noise follows the
     seed, the held-out trial gets its own draw, and a participant without a truth is refused."""
-    from wrist_env import posterior
     from wrist_env.envs.task import task
+    from wrist_env.identification import likelihood
     from wrist_env.participants import builtin
 
     built("P1")
     trial = task("P1", "calibrate")
     model = bayes.model_trials(trial, seed=0)
     truth = builtin.truth("P1")
-    r_model = posterior.residuals(model, trial.evaluate(truth).result.poses)
-    r_trial = posterior.residuals(trial, trial.evaluate(truth).result.poses)
+    r_model = likelihood.residuals(model, trial.evaluate(truth).result.poses)
+    r_trial = likelihood.residuals(trial, trial.evaluate(truth).result.poses)
     rms = np.sqrt(np.mean(r_model[..., :3] ** 2)), np.sqrt(np.mean(r_model[..., 3:] ** 2))
     assert 0.4 < rms[0] < 0.85 and 0.4 < rms[1] < 0.85, rms
     assert np.sum(r_model**2) < 0.6 * np.sum(r_trial**2)
@@ -231,21 +234,21 @@ def test_a_model_trials_study_keeps_its_own_files_and_says_so(built, tmp_path, m
         asked.append(trials)
         rng = np.random.default_rng(seed)
         zeros = np.zeros(design.N_MATERIAL)
-        return bayes.Posterior(
+        return posterior.Posterior(
             participant, seed, rng.normal(size=(96, design.N_MATERIAL)), np.zeros(96), zeros, zeros + 1,
             zeros + 96, zeros + 1, 0.3, np.array([0.1, 0.3]), 10, 1.0,
             np.zeros((2, 3, 2, n_frames, 6)), np.zeros((2, 2, n_frames, 6)), trials,
         )  # fmt: skip
 
     monkeypatch.setattr(bayes, "calibrate", fake)
-    table = bayes.study(["P1"], 2, tmp_path, progress=False, trials="model")
+    table = study_.study(["P1"], 2, tmp_path, progress=False, trials="model")
     assert asked == ["model", "model"] and (table.trials == "model").all()
     # the stand-in's samples all have log posterior 0, above any real design's: the truth ranks 0
     assert (
         np.isfinite(table.truth_log_prob).all() and (table.truth_log_prob < 0).all() and (table.truth_rank == 0).all()
     )
     assert (tmp_path / "coverage_model.csv").exists() and not (tmp_path / "coverage.csv").exists()
-    assert bayes.Posterior.load(tmp_path / "posterior_P1_seed1_model.npz").trials == "model"
+    assert posterior.Posterior.load(tmp_path / "posterior_P1_seed1_model.npz").trials == "model"
     assert (tmp_path / "posterior_intervals_P1_model.png").exists()
 
 
@@ -261,4 +264,4 @@ def test_the_commands_defaults_are_the_samplers_own(capsys):
     text = " ".join(capsys.readouterr().out.split())
     for flag, value in [("--steps", bayes.STEPS), ("--map-starts", bayes.MAP_STARTS)]:
         assert f"{flag.upper().lstrip('-').replace('-', '_')} " in text and f"default {value}" in text
-    assert f"(default {bayes.PRIOR_REFRESH})" in text
+    assert f"(default {mcmc.PRIOR_REFRESH})" in text

@@ -1,13 +1,14 @@
-"""The likelihood and the prior (`wrist_env.posterior`) and the `+prior` (MAP) calibrators."""
+"""The likelihood and the prior (`wrist_env.identification.likelihood`) and the `+prior` (MAP) calibrators."""
 
 import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from wrist_env import design, posterior
+from wrist_env import design
 from wrist_env.bench import RunLog, calibrate
 from wrist_env.envs.task import task
 from wrist_env.frames import error_dof
+from wrist_env.identification import likelihood
 from wrist_env.model import BONES
 
 
@@ -27,14 +28,14 @@ def test_the_scale_free_likelihood_is_the_gaussian_one_integrated_over_jeffreys_
         return total
 
     expected = log_marginal(a) - log_marginal(b)
-    assert posterior.log_likelihood(a) - posterior.log_likelihood(b) == pytest.approx(expected, rel=1e-6)
+    assert likelihood.log_likelihood(a) - likelihood.log_likelihood(b) == pytest.approx(expected, rel=1e-6)
 
 
 def test_the_prior_is_table_2_truncated_to_the_action_box():
     z = np.zeros((3, design.N_MATERIAL))
     z[1, 4] = 2.0
     z[2, 7] = 3.01
-    lp = posterior.log_prior(z)
+    lp = likelihood.log_prior(z)
     assert lp[0] == 0.0 and lp[1] == pytest.approx(-2.0) and lp[2] == -np.inf
 
 
@@ -50,8 +51,8 @@ def test_map_objective_is_the_misfit_over_the_noise_plus_the_prior(built):
     for b, bone in enumerate(("scaphoid", "lunate")):
         i = BONES.index(bone)
         err = error_dof(e.result.poses[:, i], t.reference[b], t.model.centroid[i])
-        misfit += 0.5 * np.sum((err / posterior.NOISE) ** 2)
-    assert posterior.map_objective(t, e, z) == pytest.approx(misfit + 0.5 * np.sum(z**2), rel=1e-9)
+        misfit += 0.5 * np.sum((err / likelihood.NOISE) ** 2)
+    assert likelihood.map_objective(t, e, z) == pytest.approx(misfit + 0.5 * np.sum(z**2), rel=1e-9)
     assert misfit > 10  # the population design does not fit P1 within the noise
 
 

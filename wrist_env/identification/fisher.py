@@ -19,8 +19,8 @@ import numpy as np
 
 from wrist_env import design
 from wrist_env.envs.task import Task, cost_poses
+from wrist_env.identification.likelihood import residuals
 from wrist_env.participants import builtin
-from wrist_env.posterior import residuals
 from wrist_env.solver.arrays import SolverSettings
 from wrist_env.trial import TRIAL_MOTIONS
 

@@ -1,11 +1,11 @@
-"""Global sensitivity (`wrist_env.sensitivity`): SALib's indices on functions whose indices are known,
+"""Global sensitivity (`wrist_env.identification.sensitivity`): SALib's indices on functions whose indices are known,
 then a small study of P1 through the vector environment."""
 
 import numpy as np
 import pytest
 
-from wrist_env import sensitivity
 from wrist_env.cli import main
+from wrist_env.identification import sensitivity
 
 
 def ishigami(X, a=7.0, b=0.1):

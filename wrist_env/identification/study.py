@@ -1,0 +1,130 @@
+"""The Bayesian calibrator's study: a run per participant and seed (saved; a saved run is loaded), the
+coverage table against the hidden truths and the figures."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from wrist_env import design
+from wrist_env.errors import StoreError
+from wrist_env.figures.posterior import plot_intervals, plot_predictive
+from wrist_env.identification.bayes import _tasks, calibrate, sampler_settings
+from wrist_env.identification.map import MAP_STARTS
+from wrist_env.identification.mcmc import PRIOR_REFRESH, STEPS, WALKERS, log_probability
+from wrist_env.identification.posterior import Posterior
+from wrist_env.identification.smc import MCMC_STEPS, PARTICLES
+from wrist_env.participants import builtin
+
+LEVELS = (0.5, 0.9)
+
+
+def study(
+    participants,
+    seeds,
+    out,
+    *,
+    walkers: int = WALKERS,
+    steps: int = STEPS,
+    progress: bool = True,
+    on_run: Callable[[Posterior, bool], object] | None = None,
+    report: str | Path | None = None,
+    trials: str = "built-in",
+    sampler: str = "emcee",
+    particles: int = PARTICLES,
+    mcmc_steps: int = MCMC_STEPS,
+    map_starts: int = MAP_STARTS,
+    prior_refresh_share: float = PRIOR_REFRESH,
+):
+    """A Bayesian calibration per participant and seed (`out/posterior_<P>_seed<s>.npz/.json`; a run
+    already saved is loaded, not rerun), then the coverage table (one row per run: share of the 22 true
+    z inside the 50 % and 90 % intervals, `truth_rank`, recovery of the posterior mean, the MAP and the
+    population design, diagnostics) as `out/coverage.csv` and the figures; returns the table.
+    on_run(posterior, loaded) is called after each run; report: the folder of the table and figures
+    (default `out`); a saved run sampled with other settings is an error; trials: "built-in" or "model"
+    (`model_trials`; files and figures get a `_model` suffix); sampler: "emcee" (walkers, steps) or
+    "smc" (particles, mcmc_steps; suffix `_smc`); map_starts: Gauss–Newton starts of the MAP search; prior_refresh_share: emcee's share of
+    `prior_refresh` moves."""
+    out = Path(out)
+    suffix = ("" if trials == "built-in" else f"_{trials}") + ("" if sampler == "emcee" else f"_{sampler}")
+    settings = sampler_settings(sampler, walkers, steps, particles, mcmc_steps, map_starts, prior_refresh_share)
+    rows, posteriors = [], {}
+    for participant in participants:
+        truth = design.z_scores(builtin.truth(participant)) if participant in builtin.BUILTIN else None
+        for seed in range(seeds) if isinstance(seeds, int) else seeds:
+            path = out / f"posterior_{participant}_seed{seed}{suffix}.npz"
+            loaded = path.exists()
+            if loaded:
+                post = Posterior.load(path)
+                if post.settings is not None and post.settings != settings:
+                    raise StoreError(
+                        f"{path} was sampled with {post.settings}, not the {settings} asked for: "
+                        "delete it or choose another output folder"
+                    )
+            else:
+                post = calibrate(
+                    participant,
+                    seed,
+                    progress=progress,
+                    trials=trials,
+                    sampler=sampler,
+                    walkers=walkers,
+                    steps=steps,
+                    particles=particles,
+                    mcmc_steps=mcmc_steps,
+                    map_starts=map_starts,
+                    prior_refresh_share=prior_refresh_share,
+                )
+                post.save(path)
+            if on_run is not None:
+                on_run(post, loaded)
+            posteriors.setdefault(participant, []).append(post)
+            row = {
+                "participant": participant,
+                "trials": post.trials,
+                "seed": seed,
+                "sampler": post.sampler,
+                **settings,
+                "evaluations": post.evaluations,
+                "wall_seconds": round(post.wall_seconds, 1),
+                "acceptance": post.acceptance,
+                "ess_min": float(np.nanmin(post.ess)),
+                "rhat_max": float(np.nanmax(post.rhat)) if post.sampler == "emcee" else np.nan,
+                "noise_mm": post.noise[0],
+                "noise_deg": post.noise[1],
+                **({"stages": post.stages, "log_evidence": post.log_evidence} if post.sampler == "smc" else {}),
+            }
+            if truth is not None:
+                for level in LEVELS:
+                    row[f"coverage_{int(level * 100)}"] = float(post.covers(truth, level).mean())
+                row.update(truth_rank(post, truth))
+                row["recovery_mean"] = _rms(post.mean - truth)
+                row["recovery_map"] = _rms(post.map_z - truth)
+                row["recovery_population"] = _rms(truth)
+            rows.append(row)
+    table = pd.DataFrame(rows)
+    report = out if report is None else Path(report)
+    report.mkdir(parents=True, exist_ok=True)
+    table.to_csv(report / f"coverage{suffix}.csv", index=False)
+    for participant, posts in posteriors.items():
+        truth = design.z_scores(builtin.truth(participant)) if participant in builtin.BUILTIN else None
+        plot_intervals(posts, truth, report / f"posterior_intervals_{participant}{suffix}.png")
+        plot_predictive(posts[0], report / f"posterior_predictive_{participant}{suffix}.png")
+    return table
+
+
+def truth_rank(post: Posterior, z_true: np.ndarray) -> dict:
+    """{"truth_log_prob": the log posterior of the hidden truth on the run's calibration task,
+    "truth_rank": the share of the kept samples whose log posterior is lower}. A rank near 1 says
+    the chains missed the truth's region although it is as probable as any they visited (a mode
+    the sampler did not find), not that the truth is implausible."""
+    calibration, _ = _tasks(post.participant, post.trials, post.seed)
+    value = float(log_probability(calibration)(z_true[None])[0])
+    return {"truth_log_prob": value, "truth_rank": float(np.mean(post.log_prob < value))}
+
+
+def _rms(v: np.ndarray) -> float:
+    return float(np.sqrt(np.mean(np.square(v))))
