@@ -240,7 +240,7 @@ def test_a_model_trials_study_keeps_its_own_files_and_says_so(built, tmp_path, m
             np.zeros((2, 3, 2, n_frames, 6)), np.zeros((2, 2, n_frames, 6)), trials,
         )  # fmt: skip
 
-    monkeypatch.setattr(bayes, "calibrate", fake)
+    monkeypatch.setattr(study_, "calibrate", fake)
     table = study_.study(["P1"], 2, tmp_path, progress=False, trials="model")
     assert asked == ["model", "model"] and (table.trials == "model").all()
     # the stand-in's samples all have log posterior 0, above any real design's: the truth ranks 0
