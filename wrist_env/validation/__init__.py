@@ -1,0 +1,40 @@
+"""The model checked against published wrist measurements (`wrist-bench validate`).
+
+`validate(name)` runs three simulations of the population-mean design — an
+intact idealized ±40° flexion–extension sweep and the same sweep with all
+three SLIL bundles torn (one batched call), and the capitate held at neutral
+under the idealized compressive load — and compares twelve outputs with bands
+drawn from cadaveric and in-vivo studies. Each row says where its band comes
+from. A check whose simulation failed has value NaN (None in JSON), fails,
+and names the solver's status in its description.
+"""
+
+from wrist_env.validation.bands import (
+    EXTENSION_30_DEG,
+    NEUTRAL_LOAD_N,
+    RAINBOW_LUNATE,
+    RAINBOW_SCAPHOID,
+    SL_DISSOCIATION_MM,
+    SLIL,
+    SOURCES,
+    ULNAR_SHARE_PCT,
+    VIEGAS_1993,
+)
+from wrist_env.validation.checks import validate
+from wrist_env.validation.measures import (
+    at_angle,
+    column_rotation_deg,
+    load_shares_pct,
+    sl_gap_mm,
+    slope,
+    surface_gap_mm,
+    with_tears,
+)
+from wrist_env.validation.report import Check, Report, _row, format_table, validation_figure
+
+__all__ = [
+    "EXTENSION_30_DEG", "NEUTRAL_LOAD_N", "RAINBOW_LUNATE", "RAINBOW_SCAPHOID", "SL_DISSOCIATION_MM", "SLIL",
+    "SOURCES", "ULNAR_SHARE_PCT", "VIEGAS_1993", "Check", "Report", "_row", "at_angle", "column_rotation_deg",
+    "format_table", "load_shares_pct", "sl_gap_mm", "slope", "surface_gap_mm", "validate", "validation_figure",
+    "with_tears",
+]  # fmt: skip

@@ -1,0 +1,102 @@
+"""What `validate` measures on a run: slopes, the SL gap, load shares, the radial column's turn."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Iterable
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from wrist_env import design as design_mod
+from wrist_env.model import BONES, CAPITATE, MIDCARPAL, TRAPEZIUM, Model
+from wrist_env.solver.outputs import articulation_forces
+
+
+def column_rotation_deg(poses: np.ndarray) -> float:
+    """The radial column's largest rotation (deg) relative to the capitate over a run's poses (n, 6, 4, 4)."""
+    relative = np.einsum("fij,fkj->fik", poses[:, TRAPEZIUM, :3, :3], poses[:, CAPITATE, :3, :3])
+    cos = np.clip((np.trace(relative, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+    return float(np.degrees(np.arccos(cos)).max())
+
+
+def slope(x: ArrayLike, y: ArrayLike) -> float:
+    """Least-squares slope of y against x over the finite pairs; NaN if x does not vary."""
+    x, y = np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64)
+    ok = np.isfinite(x) & np.isfinite(y)
+    x, y = x[ok], y[ok]
+    if len(x) < 2 or np.ptp(x) == 0:
+        return float("nan")
+    dx = x - x.mean()
+    return float(dx @ (y - y.mean()) / (dx @ dx))
+
+
+def surface_gap_mm(
+    a_mesh: tuple[ArrayLike, ArrayLike], b_mesh: tuple[ArrayLike, ArrayLike], a_poses: ArrayLike, b_poses: ArrayLike
+) -> np.ndarray:
+    """Minimum distance (mm) between two posed triangle surfaces at each frame.
+
+    a_mesh, b_mesh: (vertices (n, 3), faces (m, 3)) at the neutral pose; a_poses, b_poses (n_frames, 4, 4)
+    neutral → frame. Each surface's vertices are taken into the other's neutral frame and their closest
+    points on the other's triangles found (libigl's point–mesh distance); the smaller of both directions.
+    0 where the surfaces touch; NaN where a pose is not finite.
+    """
+    import igl
+
+    meshes = [
+        (np.ascontiguousarray(v, dtype=np.float64), np.ascontiguousarray(f, dtype=np.int64))
+        for v, f in (a_mesh, b_mesh)
+    ]
+    a_poses, b_poses = np.asarray(a_poses, dtype=np.float64), np.asarray(b_poses, dtype=np.float64)
+    out = np.full(len(a_poses), np.nan)
+    for k, (Ta, Tb) in enumerate(zip(a_poses, b_poses)):
+        if not (np.isfinite(Ta).all() and np.isfinite(Tb).all()):
+            continue
+        best = np.inf
+        for (pv, _), (qv, qf), rel in (
+            (meshes[0], meshes[1], np.linalg.solve(Tb, Ta)),
+            (meshes[1], meshes[0], np.linalg.solve(Ta, Tb)),
+        ):
+            points = np.ascontiguousarray(pv @ rel[:3, :3].T + rel[:3, 3])
+            sq, _, _ = igl.point_mesh_squared_distance(points, qv, qf)
+            best = min(best, float(np.sqrt(sq.min())))
+        out[k] = best
+    return out
+
+
+def sl_gap_mm(model: Model, poses: np.ndarray) -> np.ndarray:
+    """Scapholunate gap (mm) per frame of a Result's poses (n_frames, 5, 4, 4): bone surface to bone surface."""
+    s, l = BONES.index("scaphoid"), BONES.index("lunate")
+    return surface_gap_mm(model.part_mesh("scaphoid"), model.part_mesh("lunate"), poses[:, s], poses[:, l])
+
+
+def with_tears(d: design_mod.Design, names: Iterable[str]) -> design_mod.Design:
+    """A copy of the design with the named injurable ligaments torn (injury scalar −1)."""
+    injury = np.array(d.injury, dtype=np.float64)
+    for n in names:
+        injury[design_mod.INJURABLE.index(n)] = -1.0
+    return dataclasses.replace(d, injury=injury)
+
+
+def at_angle(angle_deg: ArrayLike, values: ArrayLike, target_deg: float) -> float:
+    """`values` at the capitate angle `target_deg`, linear between the sweep's frames (NaN outside)."""
+    a, v = np.asarray(angle_deg, dtype=np.float64), np.asarray(values, dtype=np.float64)
+    order = np.argsort(a)
+    a, v = a[order], v[order]
+    if not (a[0] <= target_deg <= a[-1]):
+        return float("nan")
+    return float(np.interp(target_deg, a, v))
+
+
+def load_shares_pct(model: Model, result) -> dict[str, float]:
+    """Load shares (%) at a run's first frame: each midcarpal articulation's (`model.MIDCARPAL`) of their
+    sum, and "ulnocarpal": the ulnar path's of radiocarpal + ulnocarpal (NaN for a failed run)."""
+    if not result.ok:
+        return {name: math.nan for name in (*MIDCARPAL, "ulnocarpal")}
+    f = articulation_forces(model, result.poses[0])
+    midcarpal = sum(f[name] for name in MIDCARPAL)
+    proximal = f["radioscaphoid"] + f["radiolunate"] + f["ulnocarpal"]
+    out = {name: 100.0 * f[name] / midcarpal if midcarpal > 0 else math.nan for name in MIDCARPAL}
+    out["ulnocarpal"] = 100.0 * f["ulnocarpal"] / proximal if proximal > 0 else math.nan
+    return out
