@@ -113,9 +113,10 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
     if not args.figures_only:
         _require_extras()
-    runs = args.runs.resolve() if args.runs else ROOT / "runs" / f"regenerate-{_commit()}"
-    runs.mkdir(parents=True, exist_ok=True)
-    log = runs / "steps_done.txt"
+    # relative to the repository root, where every step runs: the logs and reports name it so
+    runs = args.runs.resolve().relative_to(ROOT) if args.runs else Path("runs") / f"regenerate-{_commit()}"
+    (ROOT / runs).mkdir(parents=True, exist_ok=True)
+    log = ROOT / runs / "steps_done.txt"
     done_before = set(log.read_text().splitlines()) if log.exists() else set()
     for step in steps(runs, args.figures_only):
         script = step[0] == "python"
