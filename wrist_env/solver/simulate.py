@@ -35,7 +35,7 @@ DEFAULT_LOADS = "erhart2020"
 STATUS = {
     kernel.OK: "ok",
     kernel.FAILED_NAN: "failed: NaN in the state",
-    kernel.FAILED_DIVERGED: "failed: a free bone dislocated (moved beyond max_disp_mm or turned beyond max_rot_deg from the capitate)",
+    kernel.FAILED_DIVERGED: "failed: a free bone dislocated (moved beyond max_disp_mm from its place or turned beyond max_rot_deg from the capitate)",
 }
 
 
