@@ -3,7 +3,7 @@
 For each participant, the population design intact and with each injury scalar of the Monte Carlo
 study torn (`montecarlo.sampler.TORN_ACTION`, one at a time), simulated on the study's driver (the
 idealized ±40° sweep under its load on the default lines), this prints the sweep's means of the
-radioscaphoid mean pressure (MPa, the study's response), the contact forces (N) of the radioscaphoid,
+radioscaphoid mean pressure (MPa, the study's response) and contact area (mm²), the contact forces (N) of the radioscaphoid,
 radiolunate, STT, scaphocapitate, lunocapitate and ulnocarpal pairs, and the scaphoid's and lunate's
 flexion slopes, each as the change from intact. Table 5 compares the study's estimates with the
 preprint's; this says through which joints an injury's estimate arises.
@@ -21,7 +21,7 @@ from wrist_env import design
 from wrist_env.model import BONES, PAIRS
 from wrist_env.montecarlo.sampler import INTACT_ACTION, TORN_ACTION
 from wrist_env.participants.registry import load_model
-from wrist_env.solver.forces import R_FORCE, R_MEAN
+from wrist_env.solver.forces import R_AREA, R_FORCE, R_MEAN
 from wrist_env.solver.outputs import cardan_deg
 from wrist_env.solver.simulate import idealized, simulate_batch
 from wrist_env.validation import slope
@@ -58,10 +58,17 @@ def main(names) -> None:
                 rows[case] = None
                 continue
             rs_pressure = float(np.nanmean(r.contact[:, PAIRS.index("radioscaphoid"), R_MEAN]))
+            rs_area = float(np.mean(r.contact[:, PAIRS.index("radioscaphoid"), R_AREA]))
             forces = [float(np.mean(r.contact[:, PAIRS.index(p), R_FORCE])) for p in SHOWN]
-            rows[case] = [rs_pressure, *forces, *flexion_slopes(r.poses)]
+            rows[case] = [rs_pressure, rs_area, *forces, *flexion_slopes(r.poses)]
         base = rows["intact"]
-        head = ["RS mean pressure (MPa)", *(f"{p} (N)" for p in SHOWN), "scaphoid slope", "lunate slope"]
+        head = [
+            "RS mean pressure (MPa)",
+            "RS area (mm²)",
+            *(f"{p} (N)" for p in SHOWN),
+            "scaphoid slope",
+            "lunate slope",
+        ]
         print(f"{name}, population design, the Monte Carlo sweep; intact, then each injury's change")
         print("| | " + " | ".join(head) + " |\n|---|" + "---|" * len(head))
         for case, row in rows.items():
