@@ -48,6 +48,14 @@ def save(fig, out: str | Path, dpi: int = 110, **kwargs) -> Path:
     return out
 
 
+def note_box(ax, lines: list[str], y: float, va: str, **text) -> None:
+    """`lines` in a rounded white box at the right edge of `ax`, at height `y` (axes fraction)."""
+    ax.text(
+        0.98, y, "\n".join(lines), transform=ax.transAxes, ha="right", va=va, fontsize=9,
+        bbox=dict(boxstyle="round", fc="white", ec="0.8"), **text,
+    )  # fmt: skip
+
+
 def to_plot(p: ArrayLike) -> np.ndarray:
     """RCS (x volar, y proximal, z radial) to plot axes (radial right, volar towards the viewer, proximal up)."""
     p = np.asarray(p)

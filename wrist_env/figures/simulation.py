@@ -265,17 +265,7 @@ def kinematics_figure(name: str, out: Path | None = None, *, n_frames: int = 17)
     main.set_aspect("equal")
     main.legend(loc="upper left", fontsize=9)
     if ends:
-        main.text(
-            0.98,
-            0.03,
-            "\n".join(ends),
-            transform=main.transAxes,
-            ha="right",
-            va="bottom",
-            fontsize=9,
-            family="monospace",
-            bbox=dict(boxstyle="round", fc="white", ec="0.8"),
-        )
+        draw.note_box(main, ends, 0.03, "bottom", family="monospace")
     for ax, k in zip(small, (1, 2)):
         ax.set_title(KINEMATIC_ANGLES[k], fontsize=10)
         ax.set_ylabel("deg")

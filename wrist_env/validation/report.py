@@ -121,7 +121,7 @@ def validation_figure(report: Report, out: Path | None = None) -> Path:
     ratios; right: the SL gap over the sweep, intact and with all SLIL bundles torn, and the 3 mm line."""
     import matplotlib.pyplot as plt
 
-    from wrist_env.figures.draw import FIGURES
+    from wrist_env.figures.draw import FIGURES, note_box
 
     out = Path(out) if out else FIGURES / f"validation_{report.participant}.png"
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -170,16 +170,7 @@ def validation_figure(report: Report, out: Path | None = None) -> Path:
         f"(band > {_fmt(growth.band[0])} mm): {'pass' if growth.passed else 'FAIL'}"
     ]
     notes += [f"{k}: {s[k]}" for k in ("intact_status", "slil_torn_status") if s.get(k) != "ok"]
-    right.text(
-        0.98,
-        0.37,
-        "\n".join(notes),
-        transform=right.transAxes,
-        ha="right",
-        va="center",
-        fontsize=9,
-        bbox=dict(boxstyle="round", fc="white", ec="0.8"),
-    )
+    note_box(right, notes, 0.37, "center")
     right.set_xlim(lim, -lim)  # flexion on the left, extension on the right: the sweep's direction
     top = np.nanmax(np.concatenate([g_i, g_t, [9.5]]))
     right.set_ylim(0, float(top) * 1.12)
