@@ -13,10 +13,8 @@ from wrist_env import design
 from wrist_env.errors import StoreError
 from wrist_env.figures.posterior import plot_intervals, plot_predictive
 from wrist_env.identification.bayes import _tasks, calibrate, sampler_settings
-from wrist_env.identification.map import MAP_STARTS
-from wrist_env.identification.mcmc import PRIOR_REFRESH, STEPS, WALKERS, log_probability
+from wrist_env.identification.mcmc import log_probability
 from wrist_env.identification.posterior import Posterior
-from wrist_env.identification.smc import MCMC_STEPS, PARTICLES
 from wrist_env.participants import builtin
 
 LEVELS = (0.5, 0.9)
@@ -27,17 +25,12 @@ def study(
     seeds,
     out,
     *,
-    walkers: int = WALKERS,
-    steps: int = STEPS,
     progress: bool = True,
     on_run: Callable[[Posterior, bool], object] | None = None,
     report: str | Path | None = None,
     trials: str = "built-in",
     sampler: str = "emcee",
-    particles: int = PARTICLES,
-    mcmc_steps: int = MCMC_STEPS,
-    map_starts: int = MAP_STARTS,
-    prior_refresh_share: float = PRIOR_REFRESH,
+    **options,
 ):
     """A Bayesian calibration per participant and seed (`out/posterior_<P>_seed<s>.npz/.json`; a run
     already saved is loaded, not rerun), then the coverage table (one row per run: share of the 22 true
@@ -46,11 +39,11 @@ def study(
     on_run(posterior, loaded) is called after each run; report: the folder of the table and figures
     (default `out`); a saved run sampled with other settings is an error; trials: "built-in" or "model"
     (`model_trials`; files and figures get a `_model` suffix); sampler: "emcee" (walkers, steps) or
-    "smc" (particles, mcmc_steps; suffix `_smc`); map_starts: Gauss–Newton starts of the MAP search; prior_refresh_share: emcee's share of
-    `prior_refresh` moves."""
+    "smc" (particles, mcmc_steps; suffix `_smc`); options: the sampler's settings, as `bayes.calibrate` takes
+    them (walkers, steps, particles, mcmc_steps, map_starts, prior_refresh_share)."""
     out = Path(out)
     suffix = ("" if trials == "built-in" else f"_{trials}") + ("" if sampler == "emcee" else f"_{sampler}")
-    settings = sampler_settings(sampler, walkers, steps, particles, mcmc_steps, map_starts, prior_refresh_share)
+    settings = sampler_settings(sampler, **options)
     rows, posteriors = [], {}
     for participant in participants:
         truth = design.z_scores(builtin.truth(participant)) if participant in builtin.BUILTIN else None
@@ -65,19 +58,7 @@ def study(
                         "delete it or choose another output folder"
                     )
             else:
-                post = calibrate(
-                    participant,
-                    seed,
-                    progress=progress,
-                    trials=trials,
-                    sampler=sampler,
-                    walkers=walkers,
-                    steps=steps,
-                    particles=particles,
-                    mcmc_steps=mcmc_steps,
-                    map_starts=map_starts,
-                    prior_refresh_share=prior_refresh_share,
-                )
+                post = calibrate(participant, seed, progress=progress, trials=trials, sampler=sampler, **options)
                 post.save(path)
             if on_run is not None:
                 on_run(post, loaded)
