@@ -2,7 +2,7 @@
 and `leaderboards/montecarlo/` (the maintainer's one command after a model change).
 
 Runs, from the repository root, each step as the README documents it and prints its wall time:
-the built-in models shipped with the package (`experiments/ship_models.py`), the figures (`wrist-bench figure ...`, `wrist-bench validate P1`, the scaling benchmark `experiments/bench_scaling.py`), the full default benchmark
+the built-in models shipped with the package (`experiments/ship_models.py`), the figures (`wrist-bench figure ...`, `wrist-bench validate P1` … `P3`, whose JSON records the docs' validation page renders, the scaling benchmark `experiments/bench_scaling.py`), the full default benchmark
 and its leaderboard (3 participants × 11 calibrators × 5 seeds × 300 evaluations; Nevergrad's four
 need the `[nevergrad]` extra) with its IOHanalyzer files (`[ioh]`), and the full
 Monte Carlo study (P1 + P2, 2 × 12,500) with its report, what a trial identifies (Morris and Sobol
@@ -47,7 +47,7 @@ def steps(runs: Path, figures_only: bool) -> list[list[str]]:
         ["figure", "pressure", "P1", "--out", f"{FIGURES}/pressure_P1.png"],
         ["figure", "kinematics", "P1", "--out", f"{FIGURES}/kinematics_P1.png"],
         ["figure", "animation", "P1", "--out", f"{FIGURES}/animation_P1.gif"],
-        ["validate", "P1", "--out", FIGURES],
+        *(["validate", p, "--out", FIGURES] for p in ("P1", "P2", "P3")),
         ["python", "experiments/bench_scaling.py", "P1", "--out", f"{FIGURES}/scaling_P1.png"],
     ]
     if figures_only:

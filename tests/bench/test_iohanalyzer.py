@@ -89,13 +89,14 @@ def test_an_empty_run_log_is_named(tmp_path):
         iohanalyzer.export(tmp_path / "runs", tmp_path / "out")
 
 
-def test_the_readme_example_runs(built, tmp_path, monkeypatch, capsys):
-    """The README's ioh snippet, as printed there, from a fresh working directory."""
+def test_the_docs_example_runs(built, tmp_path, monkeypatch, capsys):
+    """The docs' ioh snippet (docs/benchmark.md), as printed there, from a fresh working directory."""
     built("P1")
-    blocks = (Path(wrist_env.__file__).resolve().parent.parent / "README.md").read_text().split("```python\n")[1:]
+    page = Path(wrist_env.__file__).resolve().parent.parent / "docs" / "benchmark.md"
+    blocks = page.read_text().split("```python\n")[1:]
     (code,) = [b.split("```")[0] for b in blocks if "wrist_env.bench.iohanalyzer import problem" in b]
     monkeypatch.chdir(tmp_path)
-    exec(compile(code, "README.md", "exec"), {})
+    exec(compile(code, str(page), "exec"), {})
     assert float(capsys.readouterr().out.split()[-1]) > 0
     assert len(list((tmp_path / "runs" / "ioh").rglob("IOHprofiler_f*_DIM22.dat"))) == 1
 

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 from wrist_env.cli.options import out_option
 from wrist_env.errors import UsageError
+from wrist_env.io import write_json
 from wrist_env.solver.simulate import DEFAULT_LOADS, LOAD_DIRECTIONS
 from wrist_env.trial import MOTIONS
 
@@ -258,11 +259,12 @@ def _validate(args) -> int:
 
     out = Path(args.out or figures_dir) / f"validation_{report.participant}{variant}.png"
     figure = validation.validation_figure(report, out)
+    write_json(out.with_suffix(".json"), report.to_dict())  # the record the docs' validation page renders
     if args.json:
         print(json.dumps(dict(report.to_dict(), figure=str(figure)), indent=1, allow_nan=False))
     else:
         print(validation.format_table(report))
-        print(f"figure: {figure}")
+        print(f"figure: {figure} (and its record, {out.with_suffix('.json').name})")
     return 0 if report.passed else 1
 
 
@@ -377,7 +379,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         description="Simulate the population design (idealized +-40 deg sweep intact and with all three SLIL bundles "
         "torn, and the capitate held at neutral) and compare carpal kinematics, radiocarpal load share, "
         "SL gap after SLIL tear, radioscaphoid pressure and SLIL force with published bands (each row "
-        "cites its source). Prints the table (or JSON) and writes a figure; exit status 1 if any check "
+        "cites its source). Prints the table (or JSON) and writes a figure and its JSON record; exit status 1 if any check "
         "fails.",
     )
     s.add_argument("participant", help=PARTICIPANT_HELP)

@@ -1,4 +1,4 @@
-"""Every `wrist-bench` command the README shows parses, and what it writes, run from the repository root,
+"""Every `wrist-bench` command the README and the docs show parses, and what it writes, run from the repository root,
 is ignored by git (so following the README leaves `git status` clean; only `experiments/regenerate.py`,
 the maintainer's command, rewrites committed results)."""
 
@@ -12,14 +12,14 @@ import wrist_env
 from wrist_env.cli import parser
 
 ROOT = Path(wrist_env.__file__).resolve().parent.parent
-README = ROOT / "README.md"
+PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]  # the hand-written pages (results/ is rendered)
 OUTPUTS = ("out", "out_folder", "leaderboard", "report")  # the options through which a command writes files
 
 
 def readme_commands() -> list[list[str]]:
-    """The `wrist-bench` lines of the README's bash blocks (after `&&` too), comments stripped, as argv lists."""
+    """The `wrist-bench` lines of the pages' bash blocks (after `&&` too), comments stripped, as argv lists."""
     commands, in_bash = [], False
-    for line in README.read_text().splitlines():
+    for line in (line for page in PAGES for line in page.read_text().splitlines()):
         if line.startswith("```"):
             in_bash = line.strip() == "```bash"
             continue
@@ -47,7 +47,7 @@ def ignored_by_git(path: Path) -> bool:
     return done.returncode == 0
 
 
-def test_the_readme_shows_the_commands():
+def test_the_docs_show_the_commands():
     commands = readme_commands()
     assert len(commands) >= 20
     assert {c[0] for c in commands} >= {"benchmark", "export", "build", "evaluate", "figure", "validate", "montecarlo"}

@@ -1,0 +1,42 @@
+"""Sphinx configuration of the wrist-env docs (MyST Markdown, autodoc API pages).
+
+Build: `sphinx-build -W -b html docs docs/_build/html` (warnings are errors; the tests run it).
+The results pages are rendered from the committed results files at build time (`_ext/results.py`).
+"""
+
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).parent / "_ext"))
+
+project = "wrist-env"
+author = "the wrist-env developers"
+copyright = "2026, the wrist-env developers"
+extensions = ["myst_parser", "sphinx.ext.autodoc", "sphinx.ext.napoleon", "sphinx.ext.viewcode", "results"]
+source_suffix = {".md": "markdown"}
+exclude_patterns = ["_build"]
+myst_heading_anchors = 4
+myst_enable_extensions = ["dollarmath"]
+autodoc_member_order = "bysource"
+autodoc_typehints = "description"
+autodoc_default_options = {"members": True, "undoc-members": False}
+html_theme = "alabaster"
+html_title = "wrist-env"
+html_theme_options = {"description": "Participant-specific wrist models as a Gymnasium environment and a benchmark"}
+
+
+def plain_docstrings(app, what, name, obj, options, lines):
+    """The code's docstrings are plain text (shapes, units, field lists), not reST: the summary line is
+    shown as a paragraph and the rest verbatim, so `|z|`, `(V, 3) mm` and indented fields read as written."""
+    if not lines:
+        return
+    end = next((i for i, line in enumerate(lines) if not line.strip()), len(lines))
+    summary = [line.replace("\\", "\\\\").replace("|", "\\|").replace("*", "\\*") for line in lines[:end]]
+    rest = lines[end:]
+    while rest and not rest[0].strip():
+        rest = rest[1:]
+    lines[:] = summary + (["", "::", ""] + ["    " + line for line in rest] + [""] if rest else [])
+
+
+def setup(app):
+    app.connect("autodoc-process-docstring", plain_docstrings)
