@@ -14,8 +14,6 @@ import functools
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.optimize import Bounds
-from scipy.optimize import minimize as scipy_minimize
 
 from optimizers.base import Optimizer
 from optimizers.bridge import Bridge, Stop
@@ -51,6 +49,9 @@ def _runs(request, budget, lower, upper, x0, rng, scale, restart, perturb, optio
         if y < best_f:
             best_x, best_f = x, y
         return y
+
+    from scipy.optimize import Bounds  # here: 0.35 s to import
+    from scipy.optimize import minimize as scipy_minimize
 
     bounds = Bounds(lower, upper)
     start = x0

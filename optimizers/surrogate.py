@@ -56,9 +56,6 @@ import functools
 import math
 
 import numpy as np
-from scipy.interpolate import RBFInterpolator
-from scipy.optimize import minimize as scipy_minimize
-from scipy.spatial import cKDTree
 
 from optimizers.base import Optimizer
 from optimizers.bridge import Bridge, Stop
@@ -182,6 +179,8 @@ class Surrogate(Optimizer):
             return self.rng.uniform(0.0, 1.0, (k, self.dim))
         s = model(cand)
         s = (s - s.min()) / (np.ptp(s) or 1.0)
+        from scipy.spatial import cKDTree  # SciPy's modules here: `import optimizers` stays light
+
         dist = cKDTree(U).query(cand)[0]
         too_close = 1e-6 * math.sqrt(self.dim)
         chosen = []
@@ -201,6 +200,8 @@ class Surrogate(Optimizer):
         return np.array(chosen)
 
     def _fit(self, U: np.ndarray, y: np.ndarray):
+        from scipy.interpolate import RBFInterpolator
+
         for smoothing in (self.smoothing, 1e-6, 1e-3):
             try:
                 return RBFInterpolator(U, y, kernel="cubic", degree=1, smoothing=smoothing)
@@ -274,6 +275,8 @@ class Surrogate(Optimizer):
                 return 1e300, np.zeros(d)  # a failed centre: make the line search back off
             g = np.where(np.isfinite(values), (values - f0) / steps, 0.0)
             return float(f0), g
+
+        from scipy.optimize import minimize as scipy_minimize
 
         res = scipy_minimize(
             value_and_gradient,

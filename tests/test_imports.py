@@ -6,7 +6,7 @@ import sys
 
 import pytest
 
-HEAVY = ("gymnasium", "wrist_env.builder.pipeline", "trimesh", "igl", "numba")
+HEAVY = ("gymnasium", "wrist_env.builder.pipeline", "trimesh", "igl", "numba", "scipy.optimize", "scipy.spatial")
 
 
 def _run(code: str) -> str:

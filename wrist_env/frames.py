@@ -34,7 +34,6 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.spatial.transform import Rotation
 
 from wrist_env.errors import InputError
 
@@ -118,6 +117,8 @@ def cardan_angles(rotations: ArrayLike) -> np.ndarray:
     flat = r.reshape(-1, 3, 3)
     if flat.shape[0] == 0:
         return np.zeros(lead + (3,))
+    from scipy.spatial.transform import Rotation  # here: scipy.spatial costs 0.2 s to import
+
     return Rotation.from_matrix(flat).as_euler(CARDAN_SEQUENCE, degrees=True).reshape(lead + (3,))
 
 
@@ -134,6 +135,8 @@ def cardan_rotation(angles: ArrayLike) -> np.ndarray:
     flat = a.reshape(-1, 3)
     if flat.shape[0] == 0:
         return np.zeros(lead + (3, 3))
+    from scipy.spatial.transform import Rotation  # here: scipy.spatial costs 0.2 s to import
+
     return Rotation.from_euler(CARDAN_SEQUENCE, flat, degrees=True).as_matrix().reshape(lead + (3, 3))
 
 
