@@ -2,7 +2,7 @@
 and `leaderboards/montecarlo/` (the maintainer's one command after a model change).
 
 Runs, from the repository root, each step as the README documents it and prints its wall time:
-the built-in models shipped with the package (`experiments/ship_models.py`), the figures (`wrist-bench figure ...`, `wrist-bench validate P1` … `P3`, whose JSON records the docs' validation page renders, the scaling benchmark `experiments/bench_scaling.py`), the full default benchmark
+the built-in models shipped with the package (`experiments/authoring/ship_models.py`), the figures (`wrist-bench figure ...`, `wrist-bench validate P1` … `P3`, whose JSON records the docs' validation page renders, the scaling benchmark `experiments/benchmarks/bench_scaling.py`), the full default benchmark
 and its leaderboard (3 participants × 11 calibrators × 5 seeds × 300 evaluations; Nevergrad's four
 need the `[nevergrad]` extra) with its IOHanalyzer files (`[ioh]`), and the full
 Monte Carlo study (P1 + P2, 2 × 12,500) with its report, what a trial identifies (Morris and Sobol
@@ -11,8 +11,8 @@ the prior (`leaderboards/prior/`) and the Bayesian calibrator's coverage on the 
 model's own trials (`leaderboards/posterior/`: emcee at 300 steps with the default 24 MAP starts
 and prior refresh, and on the model's trials at the default 1,200 steps too, ~2.3 h, in
 `leaderboards/posterior/steps1200/`; SMC on the model's trials; where the built-in trials' model error comes from,
-`experiments/model_error.py`, and the truth's standing under other likelihoods,
-`experiments/capitate_likelihood.py`). The studies' run logs go to a fresh
+`experiments/research/model_error.py`, and the truth's standing under other likelihoods,
+`experiments/research/capitate_likelihood.py`). The studies' run logs go to a fresh
 folder `runs/regenerate-<commit>/` (a killed run resumes there when rerun at the same commit: the steps
 already done, listed in its `steps_done.txt`, are skipped, and the interrupted study resumes from its
 run log; `--runs DIR` resumes a folder made at another commit that simulates the same model).
@@ -41,14 +41,14 @@ def _commit() -> str:
 def steps(runs: Path, figures_only: bool) -> list[list[str]]:
     """The commands, in order: `wrist-bench` argv lists, and the model-shipping script first."""
     figures = [
-        ["python", "experiments/ship_models.py"],
+        ["python", "experiments/authoring/ship_models.py"],
         ["figure", "annotations", "--out", f"{FIGURES}/template_annotations.png"],
         ["figure", "model", "P1", "--out", f"{FIGURES}/model_P1.png"],
         ["figure", "pressure", "P1", "--out", f"{FIGURES}/pressure_P1.png"],
         ["figure", "kinematics", "P1", "--out", f"{FIGURES}/kinematics_P1.png"],
         ["figure", "animation", "P1", "--out", f"{FIGURES}/animation_P1.gif"],
         *(["validate", p, "--out", FIGURES] for p in ("P1", "P2", "P3")),
-        ["python", "experiments/bench_scaling.py", "P1", "--out", f"{FIGURES}/scaling_P1.png"],
+        ["python", "experiments/benchmarks/bench_scaling.py", "P1", "--out", f"{FIGURES}/scaling_P1.png"],
     ]
     if figures_only:
         return figures
@@ -89,8 +89,8 @@ def steps(runs: Path, figures_only: bool) -> list[list[str]]:
             *("P1", "P2", "P3", "--seeds", "3", "--sampler", "smc", "--model-trials"),
             *("--out", str(runs / "posterior"), "--report", "leaderboards/posterior"),
         ],
-        ["python", "experiments/model_error.py"],
-        ["python", "experiments/capitate_likelihood.py"],
+        ["python", "experiments/research/model_error.py"],
+        ["python", "experiments/research/capitate_likelihood.py"],
     ]
 
 

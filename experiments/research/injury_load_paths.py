@@ -8,7 +8,7 @@ radiolunate, STT, scaphocapitate, lunocapitate and ulnocarpal pairs, and the sca
 flexion slopes, each as the change from intact. Table 5 compares the study's estimates with the
 preprint's; this says through which joints an injury's estimate arises.
 
-Run: `python experiments/injury_load_paths.py [P1 P2]`
+Run: `python experiments/research/injury_load_paths.py [P1 P2]`
 """
 
 from __future__ import annotations

@@ -12,7 +12,7 @@ Also printed per frame: the bones' span and spread under the block mass
 (`SolverSettings().preconditioned()`, the membrane condensed) and the membrane's free nodes' own span
 at their mass with the bones held (what the block mass leaves slowest).
 
-Run: `python experiments/stiffness_spectrum.py [P1 P2 P3]` (~10 s per participant).
+Run: `python experiments/verification/stiffness_spectrum.py [P1 P2 P3]` (~10 s per participant).
 """
 
 from __future__ import annotations

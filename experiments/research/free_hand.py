@@ -8,7 +8,7 @@ K = −∂M/∂θ (N·mm/rad, central differences of ±`STEP_RAD` about each RCS
 equilibrium): a hand free in rotation has an equilibrium near neutral only if K is positive definite
 and K⁻¹M is small.
 
-Run: `python experiments/free_hand.py P1 [P2 ...] [--load-direction erhart2020]`.
+Run: `python experiments/research/free_hand.py P1 [P2 ...] [--load-direction erhart2020]`.
 """
 
 from __future__ import annotations

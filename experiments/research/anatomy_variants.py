@@ -10,7 +10,7 @@ Prints, on this machine (each model built or read from the cache):
 4. the contact force each bone of the distal row carries at neutral under
    the validation's 100 N, P1 population design (how little reaches the STT).
 
-Run: `python experiments/anatomy_variants.py` (a few minutes; two extra builds on first use).
+Run: `python experiments/research/anatomy_variants.py` (a few minutes; two extra builds on first use).
 """
 
 from __future__ import annotations

@@ -17,7 +17,7 @@ side by side in one run — today's defaults and the block mass
   sets, and does the ligaments, the membrane and the integration);
 - the ratio to the preprint's 45 s per Abaqus simulation.
 
-Run: `python experiments/bench_solver.py [P1] [--fossa-sweep F D] [--no-distal-row] [--no-fixed-ligaments]
+Run: `python experiments/benchmarks/bench_solver.py [P1] [--fossa-sweep F D] [--no-distal-row] [--no-fixed-ligaments]
 [--load N]` (the flags pick an anatomy variant and the idealized load, as for `wrist-bench validate`).
 Timings are medians of repeated runs on a shared machine; expect ±10 %.
 """

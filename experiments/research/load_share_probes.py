@@ -11,7 +11,7 @@ For each participant (population design, capitate held at neutral, translations 
 - the RSC three times stiffer (30 N/mm against Table 2's 10): the scaphoid's volar sling.
 
 Each probe changes only the built model's arrays or the design (nothing in the solver). Run:
-`python experiments/load_share_probes.py P1 P2`.
+`python experiments/research/load_share_probes.py P1 P2`.
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 The kernel is replaced by a copy of a stored run's outputs, so what is timed is the Python around
 it: the action's checks, the design, the kernel arrays, the cost and the info dict. Prints that
 overhead for `WristEnv.step` and for a bare `simulate` call, in ms, and as a share of one real
-simulation. Run on a quiet machine: `python experiments/bench_env_overhead.py`.
+simulation. Run on a quiet machine: `python experiments/benchmarks/bench_env_overhead.py`.
 """
 
 from __future__ import annotations

@@ -21,7 +21,7 @@ answer to the equilibrium nearest it, and the net force left there.
 With --frame-local, instead: each frame of each path-independent design run alone from the
 reference's previous frame, by the settings under test and by the defaults (`frame_local`).
 
-Run: `python experiments/solver_accuracy.py [P1 P2 P3] [--designs 100] [--newton 3] [--preconditioned] [--frame-local] [--set dt_s=9e-5 ...]`
+Run: `python experiments/verification/solver_accuracy.py [P1 P2 P3] [--designs 100] [--newton 3] [--preconditioned] [--frame-local] [--set dt_s=9e-5 ...]`
 (--set changes the settings under test; the reference stays the default's, with the same
 `smooth_normals`, which changes the answer, not only the path to it).
 References are cached in runs/solver_accuracy/ under a hash of their settings.
@@ -33,12 +33,15 @@ from __future__ import annotations
 import argparse
 import ast
 import hashlib
+import sys
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-from bench_solver import monte_carlo_designs  # this folder's script (on sys.path when run)
 from tqdm import tqdm
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+from bench_solver import monte_carlo_designs  # noqa: E402  (experiments/benchmarks/bench_solver.py)
 
 from wrist_env import design
 from wrist_env.participants import registry
@@ -47,7 +50,7 @@ from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.equilibrium import distance, nearest
 from wrist_env.solver.simulate import idealized, prepare, simulate_batch, simulate_frame, trial_driver
 
-CACHE = Path(__file__).resolve().parent.parent / "runs" / "solver_accuracy"  # the repository root's runs/, git-ignored
+CACHE = Path(__file__).resolve().parents[2] / "runs" / "solver_accuracy"  # the repository root's runs/, git-ignored
 TOLERANCE = (0.1, 0.5)  # mm, degrees: issue 13's "answer unchanged"
 
 

@@ -15,7 +15,7 @@ from pathlib import Path
 from wrist_env.participants import builtin
 from wrist_env.participants.registry import load_model
 
-DATA = Path(__file__).resolve().parents[1] / "wrist_env" / "participants" / "data"
+DATA = Path(__file__).resolve().parents[2] / "wrist_env" / "participants" / "data"
 
 
 def main() -> None:

@@ -6,7 +6,7 @@ triquetrum with the lunate) with the neutral gaps of those samples to the opposi
 the force and share of each articulation (`model.ARTICULATIONS`: the midcarpal shares against
 Viegas 1993, the ulnar share against Palmer & Werner 1984) as `wrist-bench validate` checks them,
 and the space a TFCC would fill (`ulnocarpal_space`).
-Run: `python experiments/load_paths.py P1 [P2 ...] [--load-direction erhart2020]` (the load along the
+Run: `python experiments/research/load_paths.py P1 [P2 ...] [--load-direction erhart2020]` (the load along the
 radius by default, or the tendon rig's resultant: `simulate.LOAD_DIRECTIONS`).
 """
 

@@ -11,7 +11,7 @@ Writes runs/figures/scaling_<name>.png (both panels; `experiments/regenerate.py`
 run it on a quiet machine (nothing else on its cores). Builds the coarser and finer P1 variants
 on first use (~1 min each, cached).
 
-Run: `python experiments/bench_scaling.py [P1] [--out PATH]`
+Run: `python experiments/benchmarks/bench_scaling.py [P1] [--out PATH]`
 """
 
 from __future__ import annotations

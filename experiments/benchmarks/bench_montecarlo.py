@@ -11,7 +11,7 @@ after a warm-up chunk that loads the model and Numba's cache, and prints:
   (attempts = 25,000 / (1 - exclusion rate - failure rate), at this rate),
   beside the preprint's 13 days.
 
-Run: `python experiments/bench_montecarlo.py [--n 500] [--batch 64] [--workers 0]
+Run: `python experiments/benchmarks/bench_montecarlo.py [--n 500] [--batch 64] [--workers 0]
 [--participants P1] [--scheduler ADDRESS]`. Compare `--workers 0` (one process, Numba's prange
 on every core) with `--workers 2` (two processes, one thread each). On a shared machine expect
 ±15 %.

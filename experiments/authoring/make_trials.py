@@ -20,7 +20,7 @@ transforms per bone per frame (RCS, mm):
 
 So the default model never fits a trial exactly: the fidelity gap and the
 noise are real. Deterministic (seeded by the participant's truth seed).
-Run: `python experiments/make_trials.py` (a few minutes: it builds the
+Run: `python experiments/authoring/make_trials.py` (a few minutes: it builds the
 higher-fidelity models first).
 """
 
@@ -41,7 +41,7 @@ from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.simulate import loaded, simulate
 from wrist_env.trial import Trial, write_trial_csv
 
-DATA = Path(__file__).resolve().parents[1] / "wrist_env" / "participants" / "data"
+DATA = Path(__file__).resolve().parents[2] / "wrist_env" / "participants" / "data"
 N_FRAMES = 15
 HIGH_FIDELITY_BUILD = BuildParams(contact_spacing_mm=0.7)
 HIGH_FIDELITY_SOLVER = replace(SolverSettings().halved(), tolerance=1e-4, force_floor_n=1e-3, max_hold_steps=6400)

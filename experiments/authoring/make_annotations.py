@@ -10,7 +10,7 @@ picks the extreme vertex of a bone region along an anatomical direction; the pat
 Cartilage coverage is the part of each bone facing its partner within a gap.
 
 The output is plain data, reviewed in `experiments/figures/template_annotations.png`
-(`wrist-bench figure annotations`). Run: `python experiments/make_annotations.py`.
+(`wrist-bench figure annotations`). Run: `python experiments/authoring/make_annotations.py`.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from wrist_env.anatomy import midcarpal
 from wrist_env.anatomy.template import JOINT_SPACE_MM, load_template, oriented_parts
 from wrist_env.design import LIGAMENTS
 
-DATA = Path(__file__).resolve().parents[1] / "wrist_env" / "anatomy" / "data"
+DATA = Path(__file__).resolve().parents[2] / "wrist_env" / "anatomy" / "data"
 OUT = DATA / "annotations.json"
 SEAT = DATA / midcarpal.SEAT_FILE
 
@@ -226,7 +226,7 @@ def main() -> None:
         "ulnocarpal": {"bones": ["ulna", "lunate"], "max_gap_mm": 10.5},
     }
     data = {
-        "about": "wrist-env template annotations in the template RCS (mm); written by experiments/make_annotations.py",
+        "about": "wrist-env template annotations in the template RCS (mm); written by experiments/authoring/make_annotations.py",
         "cartilage": cartilage,
         "ligaments": ligaments,
     }

@@ -8,7 +8,7 @@ the flexion (z) and deviation (x) axes, by Newton steps on the held moment's Jac
 tensions (finite differences, each a loaded run to equilibrium); then the tensions per tendon, the
 moment left, and the load shares (`validation.load_shares_pct`) and RS/RL at the balanced rig.
 
-Run: `python experiments/balanced_rig.py P1 [P2 ...] [--rig erhart2020]`.
+Run: `python experiments/research/balanced_rig.py P1 [P2 ...] [--rig erhart2020]`.
 """
 
 from __future__ import annotations

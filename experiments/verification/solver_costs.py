@@ -7,7 +7,7 @@ on the participant's calibration trial with today's default solver and with the 
 Kendall's τ of the two costs, the median and largest |Δ cost|, the share of designs whose cost moves
 by more than 1 %, and the simulations that failed under one solver only.
 
-Run: `python experiments/solver_costs.py [P1 P2 P3]` (about a minute per participant on 2 cores).
+Run: `python experiments/verification/solver_costs.py [P1 P2 P3]` (about a minute per participant on 2 cores).
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from wrist_env.bench.calibrate import action
 from wrist_env.envs.task import Task
 from wrist_env.solver.arrays import SolverSettings
 
-LOGS = Path(__file__).resolve().parent.parent / "leaderboards" / "iohanalyzer"
+LOGS = Path(__file__).resolve().parents[2] / "leaderboards" / "iohanalyzer"
 
 
 def logged_designs(participant: str) -> np.ndarray:

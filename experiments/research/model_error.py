@@ -1,6 +1,6 @@
 """Where the built-in trials' model error comes from: the fidelity gap or the capitate's tracking noise.
 
-The built-in trials (`experiments/make_trials.py`) are a higher-fidelity run of the hidden truth
+The built-in trials (`experiments/authoring/make_trials.py`) are a higher-fidelity run of the hidden truth
 (finer contact, half the time step, tighter tolerance) with the capitate's rotations prescribed and
 its translations free under load, and then 4DCT-like tracking noise on every bone. The calibration
 model is driven by the trial's capitate poses, noise included. So the residuals of the scaphoid and
@@ -17,7 +17,7 @@ Each at the hidden truth and at the MAP (`map_estimate`, its default 24 starts):
 residuals in 4DCT-noise units (`likelihood.residuals`, 180 of them; tracking noise alone gives ~60)
 and, for the gap and the trial, their RMS in mm and deg. Writes `leaderboards/posterior/model_error.csv`.
 
-Run: `python experiments/model_error.py [P1 P2 P3]` (~8 min; builds the high-fidelity models first).
+Run: `python experiments/research/model_error.py [P1 P2 P3]` (~8 min; builds the high-fidelity models first).
 """
 
 from __future__ import annotations
@@ -28,8 +28,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from make_trials import HIGH_FIDELITY_BUILD, HIGH_FIDELITY_SOLVER, capitate_motion  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "authoring"))
+from make_trials import HIGH_FIDELITY_BUILD, HIGH_FIDELITY_SOLVER, capitate_motion  # noqa: E402  (experiments/authoring/)
 
 from wrist_env import design  # noqa: E402
 from wrist_env.envs.task import cost_poses, task  # noqa: E402
@@ -42,7 +42,7 @@ from wrist_env.participants.registry import load_model  # noqa: E402
 from wrist_env.solver.simulate import experimental, loaded, simulate  # noqa: E402
 
 DRAWS = 16
-OUT = Path(__file__).resolve().parents[1] / "leaderboards" / "posterior" / "model_error.csv"
+OUT = Path(__file__).resolve().parents[2] / "leaderboards" / "posterior" / "model_error.csv"
 CAPITATE = BONES.index("capitate")
 
 

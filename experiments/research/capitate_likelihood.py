@@ -1,6 +1,6 @@
 """Can a likelihood carry the capitate's tracking noise? The truth's deficit under four likelihoods.
 
-On the built-in trials the hidden truth fits worse than the MAP (`experiments/model_error.py`: the
+On the built-in trials the hidden truth fits worse than the MAP (`experiments/research/model_error.py`: the
 calibration model is driven by the trial's noisy capitate poses). This script measures, for P1–P3,
 the log posterior of the truth minus that of the MAP (the best of `map.MAP_STARTS` Gauss–Newton
 runs, seed 0) under:
@@ -27,7 +27,7 @@ A likelihood that accounts for the model error would put the truth where a poste
 log density ~11 ± 3 nats below the mode in 22 dimensions (χ²₂₂ / 2). Writes
 `leaderboards/posterior/capitate_likelihood.csv` (deficits) and `capitate_response.csv` (the check).
 
-Run: `python experiments/capitate_likelihood.py [P1 P2 P3]` (~4 min a participant: the MAP search
+Run: `python experiments/research/capitate_likelihood.py [P1 P2 P3]` (~4 min a participant: the MAP search
 and 1,024 runs).
 """
 
@@ -53,7 +53,7 @@ from wrist_env.solver import equilibrium
 from wrist_env.solver.kernel import CAPITATE
 from wrist_env.solver.simulate import experimental, simulate, stiffness
 
-OUT = Path(__file__).resolve().parents[1] / "leaderboards" / "posterior"
+OUT = Path(__file__).resolve().parents[2] / "leaderboards" / "posterior"
 AXIS_SD = np.r_[np.full(3, TRACKING_NOISE_MM), np.radians(np.full(3, TRACKING_NOISE_DEG))] / np.sqrt(3)
 """The tracking noise per axis (mm, rad): `builtin.tracking_noise` is isotropic with these RMS totals."""
 TRACKING_SD = np.r_[TRACKING_NOISE_MM / likelihood.NOISE[:3], TRACKING_NOISE_DEG / likelihood.NOISE[3:]] / np.sqrt(3)

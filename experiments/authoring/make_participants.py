@@ -4,7 +4,7 @@ The participants are synthetic and say so: each is the anatomy template under
 a smooth participant-specific warp and an isotropic scale (women smaller than
 the template, the man larger), with ground-truth ligament properties drawn
 from Table 2's normal distributions truncated at ±3 SD (fixed seeds), all
-ligaments intact. Run: `python experiments/make_participants.py`.
+ligaments intact. Run: `python experiments/authoring/make_participants.py`.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import numpy as np
 from wrist_env import design
 from wrist_env.builder.warp import random_warp
 
-OUT = Path(__file__).resolve().parents[1] / "wrist_env" / "participants" / "data"
+OUT = Path(__file__).resolve().parents[2] / "wrist_env" / "participants" / "data"
 
 # Preprint Table 1 (all right wrists).
 TABLE_1 = {
