@@ -1,7 +1,7 @@
 """Template annotations: cartilage coverage and ligament attachment sites.
 
 The data file `data/annotations.json` (authored by
-`experiments/make_annotations.py`, reviewed in a figure) gives, in the
+`experiments/authoring/make_annotations.py`, reviewed in a figure) gives, in the
 template RCS (mm): for each articulation its two bones and the largest
 bone-to-bone gap that cartilage covers; for each Table 2 ligament the bone,
 centre and radius of its origin and insertion sites. This module resolves

@@ -9,7 +9,7 @@ So the template's distal row is moved rigidly to the pose that brings the
 closest approaches of its five midcarpal facets nearest, in least squares,
 to the joint space the radius fossae are rebuilt at (`template.JOINT_SPACE_MM`).
 The fit is authored data (`data/distal_row_seat.json`, written by
-`python experiments/make_annotations.py`), read by the template.
+`python experiments/authoring/make_annotations.py`), read by the template.
 """
 
 from __future__ import annotations
@@ -101,7 +101,7 @@ def seat_record(meshes: dict, joint_space_mm: float) -> dict:
     T = seat_distal_row(meshes, joint_space_mm, facets)
     return {
         "about": "the distal row's rigid seating at one midcarpal joint space (wrist_env.anatomy.midcarpal); "
-        "written by experiments/make_annotations.py",
+        "written by experiments/authoring/make_annotations.py",
         "joint_space_mm": joint_space_mm,
         "facets": [list(f) for f in FACETS],
         "facet_gaps_before_mm": np.round(facet_gaps(meshes, None, facets), 3).tolist(),

@@ -8,13 +8,13 @@ from pathlib import Path
 from typing import Any
 
 from wrist_env.bench.calibrate import CalibrationRun, ResumeError, calibrate
+from wrist_env.bench.leaderboard import write_leaderboard as write
 from wrist_env.bench.log import DuplicateEvaluationError, RunKey, RunLog
 from wrist_env.bench.runner import BenchmarkReport, benchmark
 
 
 def write_leaderboard(runs: str | Path, out: str | Path, **kwargs: Any) -> Path:
     """Write the leaderboards of the run log in `runs` to the folder `out` (see `leaderboard`)."""
-    from wrist_env.bench.leaderboard import write_leaderboard as write
 
     return write(runs, out, **kwargs)
 

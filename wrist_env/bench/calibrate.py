@@ -29,13 +29,16 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike
 
+import optimizers
 from wrist_env import design as design_vars
 from wrist_env.bench.log import X_COLUMNS, RunKey, RunLog
 from wrist_env.cost import COST_BONES
 from wrist_env.design import N_MATERIAL, Design
+from wrist_env.envs.task import task
 from wrist_env.errors import WristEnvError
 from wrist_env.frames import DOF_NAMES
 from wrist_env.identification.likelihood import map_objective
+from wrist_env.participants import builtin
 
 if TYPE_CHECKING:
     from optuna.storages import BaseStorage, RDBStorage
@@ -213,9 +216,6 @@ def calibrate(
     options: extra options for the calibrator (`optimizers.make(..., **options)`).
     callback(n_new, nfev): called after every batch with the number of new evaluations.
     """
-    import optimizers
-    from wrist_env.envs.task import task
-    from wrist_env.participants import builtin
 
     start_time = time.perf_counter()
     key = RunKey(participant, optimizer_name, int(seed), int(budget))

@@ -22,8 +22,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from wrist_env import design
+from wrist_env.bench.calibrate import action
 from wrist_env.bench.log import X_COLUMNS, RunLog
 from wrist_env.design import N_MATERIAL
+from wrist_env.envs.task import task
 from wrist_env.errors import InputError
 
 if TYPE_CHECKING:
@@ -48,9 +51,6 @@ def _wrap(participant: str, function) -> ioh.problem.RealSingleObjective:
 
 def problem(participant: str) -> ioh.problem.RealSingleObjective:
     """Participant's calibration as an `ioh` problem: x (22,) normalized materials in [-1, 1] → kinematic cost."""
-    from wrist_env import design
-    from wrist_env.bench.calibrate import action
-    from wrist_env.envs.task import task
 
     calibration = task(participant, "calibrate")
 

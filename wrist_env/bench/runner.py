@@ -25,9 +25,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import optimizers
+from wrist_env.bench.calibrate import accepts_storage, calibrate, open_storage, split_prior
 from wrist_env.bench.log import RunKey, RunLog
 from wrist_env.errors import InputError
 from wrist_env.limits import MAX_SEEDS, MAX_THREADS, MAX_WORKERS, check_int, check_unique
+from wrist_env.participants import registry
 from wrist_env.runs.executor import describe, executor, set_threads
 
 if TYPE_CHECKING:
@@ -105,8 +108,6 @@ def run_cell(
     cell's lock meanwhile, so a leftover process of a killed run and its
     restart never run the same cell at once.
     """
-    from wrist_env.bench.calibrate import calibrate, split_prior
-    from wrist_env.participants import registry
 
     set_threads(threads)
     for folder in folders:
@@ -204,13 +205,10 @@ def benchmark(
 
 
 def _check_names(cells, folders) -> None:
-    import optimizers
-    from wrist_env.participants import registry
 
     for folder in folders:
         registry.ensure_folder(folder)
     registry.require(*sorted({k.participant for k in cells}))
-    from wrist_env.bench.calibrate import split_prior
 
     for name in sorted({k.optimizer for k in cells}):
         optimizers.get(split_prior(name)[0])  # UnknownOptimizerError lists the registered ones
@@ -218,8 +216,6 @@ def _check_names(cells, folders) -> None:
 
 def _prepare_storage(cells, storage) -> None:
     """Create the Optuna storage's tables once, before parallel workers open it."""
-    import optimizers
-    from wrist_env.bench.calibrate import accepts_storage, open_storage, split_prior
 
     if (
         isinstance(storage, str)

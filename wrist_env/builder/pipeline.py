@@ -120,7 +120,6 @@ def source_hash(name: str, bones: dict, params: BuildParams) -> str:
     """Hash of everything a build depends on: bones, parameters, builder and annotation versions."""
     h = hashlib.sha256()
     h.update(json.dumps({"name": name, "params": asdict(params), "builder": BUILDER_VERSION}, sort_keys=True).encode())
-    from wrist_env.anatomy.annotations import read_annotation_data
 
     h.update(json.dumps(read_annotation_data(), sort_keys=True).encode())
     for bone in BONES:

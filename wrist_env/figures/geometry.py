@@ -9,8 +9,13 @@ import matplotlib.pyplot as plt
 import numpy as np
 from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
+from wrist_env.anatomy.annotations import ARTICULATIONS, template_annotations
+from wrist_env.anatomy.template import load_template
+from wrist_env.builder.pipeline import BuildParams
 from wrist_env.design import ALL_LIGAMENT_NAMES
 from wrist_env.figures import draw
+from wrist_env.model import BONES
+from wrist_env.participants.registry import load_model
 
 MODEL_PANELS = (("volar view", 0, 0), ("radial view", 0, 90), ("dorsal view", 0, 180))
 
@@ -29,8 +34,6 @@ def _display_faces(bone: str, vertices, faces, thickness):
 
 def model_figure(name: str, out: Path | None = None) -> Path:
     """Bones, cartilage coloured by thickness, ligament fibres and the RSC membrane of a model."""
-    from wrist_env.model import BONES
-    from wrist_env.participants.registry import load_model
 
     model = load_model(name)
     out = out or draw.FIGURES / f"model_{name}.png"
@@ -97,9 +100,6 @@ ANNOTATION_PANELS = (
 
 def annotations_figure(out: Path | None = None) -> Path:
     """The template with its cartilage coverage and ligament attachment sites, for review."""
-    from wrist_env.anatomy.annotations import ARTICULATIONS, template_annotations
-    from wrist_env.anatomy.template import load_template
-    from wrist_env.builder.pipeline import BuildParams
 
     anatomy = BuildParams().anatomy  # the default build's template: swept fossae, distal row
     bones = load_template(*anatomy).bones

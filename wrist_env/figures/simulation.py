@@ -8,7 +8,13 @@ import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
 
+from wrist_env import design
 from wrist_env.figures import draw
+from wrist_env.model import BONES, PAIR_BONES, PAIRS
+from wrist_env.participants import builtin
+from wrist_env.participants.registry import load_model
+from wrist_env.solver import simulate
+from wrist_env.solver.outputs import cardan_deg, pair_slice, pressure_map
 
 
 def _silhouette(ax, points_2d, colour, *, spacing=0.2, radius=1.0, filled=False, **kw):
@@ -64,12 +70,6 @@ def pressure_figure(name: str, out: Path | None = None, *, static: bool = False)
     (radial to the right, volar down: the view from distal, not mirrored).
     """
     from scipy.spatial import cKDTree
-
-    from wrist_env import design
-    from wrist_env.model import BONES, PAIR_BONES, PAIRS
-    from wrist_env.participants.registry import load_model
-    from wrist_env.solver import simulate
-    from wrist_env.solver.outputs import pair_slice, pressure_map
 
     model = load_model(name)
     out = out or draw.FIGURES / f"pressure_{name}.png"
@@ -216,12 +216,6 @@ KINEMATIC_ANGLES = (
 def kinematics_figure(name: str, out: Path | None = None, *, n_frames: int = 17) -> Path:
     """Scaphoid and lunate rotations (Cardan Z-X-Y) against the capitate angle over the idealized
     ±40° sweep: population design, and for built-in participants also the hidden truth."""
-    from wrist_env import design
-    from wrist_env.model import BONES
-    from wrist_env.participants import builtin
-    from wrist_env.participants.registry import load_model
-    from wrist_env.solver import simulate
-    from wrist_env.solver.outputs import cardan_deg
 
     model = load_model(name)
     out = out or draw.FIGURES / f"kinematics_{name}.png"

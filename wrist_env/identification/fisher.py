@@ -19,9 +19,11 @@ import numpy as np
 
 from wrist_env import design
 from wrist_env.envs.task import Task, cost_poses
+from wrist_env.figures.identifiability import plot
 from wrist_env.identification.likelihood import residuals
 from wrist_env.participants import builtin
 from wrist_env.solver.arrays import SolverSettings
+from wrist_env.solver.simulate import simulate_batch
 from wrist_env.trial import TRIAL_MOTIONS
 
 STEP_Z = 0.25  # central-difference step, SD units
@@ -59,7 +61,6 @@ def spectrum(fisher: np.ndarray) -> Spectrum:
 
 def jacobian(task: Task, center: design.Design, step: float = STEP_Z) -> np.ndarray:
     """∂(residuals)/∂z at `center`, shape (2 · n_frames · 6, 22), by central differences of `step` SD."""
-    from wrist_env.solver.simulate import simulate_batch
 
     z0 = design.z_scores(center)
     designs = [center]
@@ -120,8 +121,6 @@ def study(participants, out=None):
     tables = pd.DataFrame(materials), pd.DataFrame(spectra)
     if out is not None:
         from pathlib import Path
-
-        from wrist_env.figures.identifiability import plot
 
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)

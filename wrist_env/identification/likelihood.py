@@ -8,7 +8,7 @@ and the lunate at every frame of a trial, each over the 4DCT tracking noise of i
 (0.2 mm, 0.5°). The synthetic trials carry 0.2 mm and 0.5° RMS rigid noise (0.12 mm, 0.29° per
 axis); at the hidden truth the default model's residuals measure 0.12–0.19 mm and 0.5–0.8° RMS per
 DOF (P2's grip trial 0.2–0.4 mm, 1.1–2.7°: the model is driven by the trial's capitate poses, whose
-tracking noise moves the proximal row; `experiments/model_error.py`). So `NOISE` is the per-DOF noise
+tracking noise moves the proximal row; `experiments/research/model_error.py`). So `NOISE` is the per-DOF noise
 the model can be expected to reach; a design that fits much closer fits noise and model error.
 
 MAP objective (what `+prior` calibrators minimize): the negative log posterior under Gaussian
@@ -35,6 +35,7 @@ from numpy.typing import ArrayLike
 from wrist_env.cost import COST_BONES
 from wrist_env.design import SPAN_SD
 from wrist_env.frames import error_dof
+from wrist_env.model import BONES
 
 if TYPE_CHECKING:
     from wrist_env.envs.task import Evaluation, Task
@@ -53,7 +54,6 @@ def residuals(task: Task, poses: np.ndarray, reference: np.ndarray | None = None
     poses: a simulation's poses (n_frames, 5, 4, 4); reference: (2, n_frames, 4, 4) in
     `COST_BONES` order (default: the task's trial).
     """
-    from wrist_env.model import BONES
 
     reference = task.reference if reference is None else reference
     out = []

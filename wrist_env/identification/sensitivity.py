@@ -27,6 +27,7 @@ from wrist_env import design
 from wrist_env.cost import COST_BONES, DOF_NAMES
 from wrist_env.design import full_action
 from wrist_env.envs import env_id, register_ids
+from wrist_env.figures.sensitivity import plot
 from wrist_env.trial import MOTIONS
 
 METHODS = ("morris", "sobol")
@@ -121,7 +122,6 @@ def study(
         out.mkdir(parents=True, exist_ok=True)
         stem = out / f"sensitivity_{participant}_{method}"
         result.to_csv(stem.with_suffix(".csv"), index=False)
-        from wrist_env.figures.sensitivity import plot
 
         plot(result, method, stem.with_suffix(".png"))
     return result

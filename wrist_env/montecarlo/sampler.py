@@ -40,7 +40,9 @@ from numpy.typing import ArrayLike
 
 from wrist_env import design
 from wrist_env.design import INJURABLE, LIGAMENT_NAMES, N_DESIGN, N_MATERIAL, NAMES, SPAN_SD
+from wrist_env.envs import env_id, register_ids
 from wrist_env.errors import DesignError
+from wrist_env.participants import registry
 from wrist_env.solver.simulate import DEFAULT_LOADS
 
 if TYPE_CHECKING:
@@ -152,8 +154,6 @@ def vector_env(participant: str, num_envs: int, load_direction: str = DEFAULT_LO
     (`simulate.LOAD_DIRECTIONS`; one per process, size and direction)."""
     import gymnasium as gym
 
-    from wrist_env.envs import env_id, register_ids
-
     key = (participant, int(num_envs), load_direction)
     if key not in _ENVS:
         register_ids(participant, ("idealized",))
@@ -195,8 +195,6 @@ def run_chunk(
     load (`simulate.LOAD_DIRECTIONS`).
     """
     if folders:
-        from wrist_env.participants import registry
-
         for folder in folders:
             registry.ensure_folder(folder)
     actions = np.asarray(actions, dtype=np.float64)

@@ -45,6 +45,7 @@ from wrist_env.errors import StoreError, WristEnvError
 from wrist_env.io import read_json, write_json
 from wrist_env.limits import MAX_BATCH, MAX_RUNS, MAX_SEED, MAX_WORKERS, check_int, check_unique
 from wrist_env.montecarlo import sampler
+from wrist_env.participants import registry
 from wrist_env.runs.executor import executor
 from wrist_env.runs.store import RunStore
 from wrist_env.solver.simulate import DEFAULT_LOADS, LOAD_DIRECTIONS
@@ -410,8 +411,6 @@ def _run_locked(
     log = runs_log(out)
     outcomes = _logged_outcomes(out, config.participants)
     if folders:
-        from wrist_env.participants import registry
-
         for f in folders:
             registry.ensure_folder(f)
 

@@ -3,9 +3,9 @@
 No 4DCT ships, so each built-in participant is the anatomy template under a
 smooth participant-specific warp and isotropic scale, with hidden
 ground-truth ligament properties drawn from Table 2's distributions (fixed
-seed). `experiments/make_participants.py` writes the data files under
+seed). `experiments/authoring/make_participants.py` writes the data files under
 `participants/data/<name>/` (`participant.json`, `truth.json`);
-`experiments/make_trials.py` their trials (`trials.json`, `trials/*.csv`).
+`experiments/authoring/make_trials.py` their trials (`trials.json`, `trials/*.csv`).
 `source` gives one as a `ParticipantSource`, to write as a participant folder.
 """
 
@@ -19,11 +19,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from wrist_env.anatomy.template import BoneSurface, load_template
+from wrist_env.builder.pipeline import BuildParams
 from wrist_env.builder.warp import Warp
 from wrist_env.design import Design
 from wrist_env.errors import ParticipantError
 from wrist_env.model import SUPPLIED
 from wrist_env.participants import BUILTIN
+from wrist_env.participants.folder import ParticipantSource
+from wrist_env.trial import read_trial_csv
 
 if TYPE_CHECKING:
     from wrist_env.participants.folder import ParticipantSource
@@ -64,8 +67,7 @@ def truth(name: str) -> Design:
 
 @functools.lru_cache(maxsize=len(BUILTIN))
 def trials(name: str) -> dict:
-    """The participant's synthetic trials {name: Trial} (see `experiments/make_trials.py`)."""
-    from wrist_env.trial import read_trial_csv
+    """The participant's synthetic trials {name: Trial} (see `experiments/authoring/make_trials.py`)."""
 
     meta = _data(name, "trials.json")
     root = importlib.resources.files("wrist_env.participants") / "data" / name
@@ -92,7 +94,7 @@ def bones(name: str, fossa_sweep_deg: tuple = (0.0, 0.0), distal_row: bool = Fal
 
 SHIPPED_MODEL = "model"
 """The built model shipped beside a built-in participant's data (`model.npz` + `model.json`, written by
-`python experiments/ship_models.py`, a step of `experiments/regenerate.py`); `registry.load_model`
+`python experiments/authoring/ship_models.py`, a step of `experiments/regenerate.py`); `registry.load_model`
 uses it when its source hash is the one it would build, and builds otherwise (a changed builder, template or platform)."""
 
 
@@ -123,8 +125,6 @@ def source(name: str, fossa_sweep_deg: tuple | None = None) -> ParticipantSource
     shaft beside the closed articular solid, and its ulna is closed at the cut (`anatomy.template.closed`);
     the radial column is not a folder's: it comes with the capitate (`model.SUPPLIED`).
     """
-    from wrist_env.builder.pipeline import BuildParams
-    from wrist_env.participants.folder import ParticipantSource
 
     sweep = BuildParams().fossa_sweep_deg if fossa_sweep_deg is None else fossa_sweep_deg
     facts = info(name)

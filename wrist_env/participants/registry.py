@@ -17,6 +17,7 @@ from wrist_env.builder.pipeline import BuildParams, build_model, source_hash
 from wrist_env.errors import BuildError, ParticipantError, StoreError
 from wrist_env.model import BONES, Model
 from wrist_env.participants import builtin
+from wrist_env.participants.folder import load_participant_folder, solid_mask
 
 if TYPE_CHECKING:
     from wrist_env.trial import Trial
@@ -57,7 +58,6 @@ def add_folder(folder: str | Path) -> str:
     """Validate a participant folder and make it known by its name; returns the name.
 
     The folder is read and checked once, here: edit its files, then add it again."""
-    from wrist_env.participants.folder import load_participant_folder
 
     source = load_participant_folder(folder)
     if source.name in builtin.BUILTIN:
@@ -90,7 +90,6 @@ def bones(name: str, params: BuildParams | None = None) -> dict:
     if name in builtin.BUILTIN:
         return builtin.bones(name, *params.anatomy)
     require(name)
-    from wrist_env.participants.folder import solid_mask
 
     source = _SOURCES[name]
     principal = {b: BoneSurface(b, v, f, solid_mask(v, f)) for b, (v, f) in source.bones.items()}

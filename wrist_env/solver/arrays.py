@@ -52,7 +52,7 @@ class SolverSettings:
     smooth_normals: contact forces along the grids' nodal gradients
     interpolated trilinearly (continuous), instead of the derivative of the
     trilinear distance (which jumps at cell faces, so no state balances
-    exactly: `experiments/solver_accuracy.py`).
+    exactly: `experiments/verification/solver_accuracy.py`).
     block_mass: one 6×6 mass block per free bone (3×3 for the loaded capitate)
     from the force kernels' tangent (`preconditioner`), rebuilt every
     block_refresh_steps, at each stage and (block_refresh_restart) after each
@@ -115,7 +115,7 @@ class SolverSettings:
         term in seconds that the block mass's light directions cannot carry: dt·c/m = fibre_damping_s
         / dt_s · block_courant² > 2 at block_courant 1), the mass rebuilt every 20 steps and at each
         stage but not after FIRE's restarts (a rebuild costs ~3 steps; rebuilding at the restarts too
-        cost 1.15–1.7× the time for about the same steps). Measured in `experiments/bench_solver.py`
+        cost 1.15–1.7× the time for about the same steps). Measured in `experiments/benchmarks/bench_solver.py`
         and the README's solver section."""
         return replace(
             self,

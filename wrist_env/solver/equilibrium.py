@@ -6,7 +6,7 @@ loaded driver) and on the RSC membrane's free nodes, by SciPy's
 Levenberg–Marquardt (`least_squares`, finite-difference Jacobian), starting
 from the explicit answer. No masses, damping or time step enter: only the
 force kernels the explicit solver uses. How far the explicit answer is from
-this equilibrium is the explicit solver's error (`experiments/solver_accuracy.py`).
+this equilibrium is the explicit solver's error (`experiments/verification/solver_accuracy.py`).
 """
 
 from __future__ import annotations

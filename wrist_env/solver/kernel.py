@@ -482,7 +482,7 @@ def run_from(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes)
     """`run` from a given state at frame 0 instead of from rest: rotations R (5, 3, 3), centres of mass
     x (5, 3) mm (the capitate at frame 0's pose) and membrane nodes (M, 3) mm, at rest; no settling or
     move, frame 0's outputs left unfilled, each later frame as in `run` (for a frame-local comparison:
-    `experiments/solver_accuracy.py --frame-local`)."""
+    `experiments/verification/solver_accuracy.py --frame-local`)."""
     _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R.copy(), x.copy(), nodes.copy(), 1)
 
 

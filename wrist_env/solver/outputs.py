@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from wrist_env.design import ALL_LIGAMENT_NAMES
+from wrist_env.frames import cardan_angles
 from wrist_env.model import ARTICULATIONS, BODY_PARTS, BONES, PAIR_BONES, PAIRS, ULNA, Model
 from wrist_env.solver import arrays, forces
 from wrist_env.solver.forces import CONTACT_FIELDS
@@ -87,7 +88,6 @@ def articulation_forces(model: Model, pose_frame: ArrayLike) -> dict[str, float]
 def cardan_deg(poses: ArrayLike) -> np.ndarray:
     """Cardan Z-X-Y angles (deg, `wrist_env.frames.cardan_angles`) of poses (..., 4, 4) or rotations
     (..., 3, 3): Flex/Ext (about z, flexion +), UlnD/RadD (ulnar +), Pro/Sup; NaN where a pose is not finite."""
-    from wrist_env.frames import cardan_angles
 
     R = np.asarray(poses, dtype=np.float64)[..., :3, :3]
     flat = R.reshape(-1, 3, 3)

@@ -7,7 +7,7 @@ put where the line through the last two frames' equilibria says they will be (th
 of numerical continuation), their velocities zeroed, and the hold starts from there. The predictor
 only chooses the starting point of the hold: the frame still ends at equilibrium
 (`kernel._converged`), so a poor prediction costs steps, not accuracy, unless the path has more
-than one equilibrium (a design whose answer depends on its path; `experiments/solver_accuracy.py`).
+than one equilibrium (a design whose answer depends on its path; `experiments/verification/solver_accuracy.py`).
 """
 
 from __future__ import annotations

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
+from wrist_env.anatomy.tendons import model_lines
 from wrist_env.design import ALL_LIGAMENT_NAMES, Design
 from wrist_env.model import CAPITATE, N_BODIES, PAIRS, Model
 from wrist_env.solver import arrays, kernel
@@ -173,7 +174,6 @@ def loads(model: Model, direction: str | ArrayLike) -> Loads:
             raise ValueError(f"load_direction must be one of {LOAD_DIRECTIONS} or a (3,) vector, but got {direction!r}")
         if direction == "axial":
             return axial_load(model)
-        from wrist_env.anatomy.tendons import model_lines
 
         body, point, pull, share = model_lines(model, direction)
         return Loads(body, point, pull, share, direction)

@@ -8,7 +8,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from wrist_env import design as design_mod
+from wrist_env.builder.pipeline import BuildParams
 from wrist_env.model import BONES, MIDCARPAL, PAIRS, Model
+from wrist_env.participants.registry import load_model
+from wrist_env.solver import simulate as sim
+from wrist_env.solver.outputs import cardan_deg
 from wrist_env.solver.simulate import DEFAULT_LOADS, IDEALIZED_LOAD_N
 from wrist_env.validation.bands import (
     EXTENSION_30_DEG,
@@ -47,10 +51,6 @@ def validate(
     load_direction: the loads' direction in the sweeps and at neutral (`simulate.LOAD_DIRECTIONS`).
     settings: the solver's (`arrays.SolverSettings`), default its defaults.
     """
-    from wrist_env.builder.pipeline import BuildParams
-    from wrist_env.participants.registry import load_model
-    from wrist_env.solver import simulate as sim
-    from wrist_env.solver.outputs import cardan_deg
 
     start = time.perf_counter()
     params = params or BuildParams()

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from wrist_env.figures.draw import FIGURES, note_box
 from wrist_env.validation.bands import RAINBOW_LUNATE, RAINBOW_SCAPHOID, SL_DISSOCIATION_MM, SOURCES
 
 
@@ -120,8 +121,6 @@ def validation_figure(report: Report, out: Path | None = None) -> Path:
     """Left: scaphoid and lunate flexion against the capitate's, with the model's slopes and Rainbow 2013's
     ratios; right: the SL gap over the sweep, intact and with all SLIL bundles torn, and the 3 mm line."""
     import matplotlib.pyplot as plt
-
-    from wrist_env.figures.draw import FIGURES, note_box
 
     out = Path(out) if out else FIGURES / f"validation_{report.participant}.png"
     out.parent.mkdir(parents=True, exist_ok=True)

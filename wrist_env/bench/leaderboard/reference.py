@@ -6,8 +6,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from wrist_env import design
 from wrist_env.cost import COST_BONES
+from wrist_env.envs.task import task
 from wrist_env.frames import DOF_NAMES
+from wrist_env.participants import builtin
 from wrist_env.trial import TRIAL_MOTIONS
 
 
@@ -26,9 +29,6 @@ def _score(evaluation) -> dict:
 
 def reference(participant: str) -> Reference:
     """Simulate the population design (and the hidden truth) on the calibration and held-out trials."""
-    from wrist_env import design
-    from wrist_env.envs.task import task
-    from wrist_env.participants import builtin
 
     designs = {"population": design.population()}
     if participant in builtin.BUILTIN:
