@@ -8,6 +8,8 @@ import sys
 from collections.abc import Sequence
 
 from wrist_env.cli import identification_commands, participant_commands, study_commands
+from wrist_env.errors import WristEnvError
+from wrist_env.participants import registry
 
 
 def parser() -> argparse.ArgumentParser:
@@ -35,12 +37,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     stderr)."""
     args = parser().parse_args(argv)
     os.environ.setdefault("MPLBACKEND", "Agg")  # the commands save figures; none is shown
-    from wrist_env.errors import WristEnvError
 
     try:
         if getattr(args, "folder", None):
-            from wrist_env.participants import registry
-
             for folder in args.folder:
                 registry.add_folder(folder)
         return args.run(args)

@@ -5,14 +5,17 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
+import numpy as np
+
 from wrist_env.cli.options import out_option
 from wrist_env.errors import UsageError
+from wrist_env.identification import bayes, fisher, sensitivity
+from wrist_env.identification.study import study
+from wrist_env.participants import builtin, registry
 from wrist_env.trial import MOTIONS
 
 
 def _sensitivity(args) -> int:
-    from wrist_env.identification import sensitivity
-    from wrist_env.participants import registry
 
     registry.require(*args.participants)
     for participant in args.participants:
@@ -32,8 +35,6 @@ def _sensitivity(args) -> int:
 
 
 def _identifiability(args) -> int:
-    from wrist_env.identification import fisher
-    from wrist_env.participants import builtin
 
     unknown = [p for p in args.participants if p not in builtin.BUILTIN]
     if unknown:
@@ -51,10 +52,6 @@ def _identifiability(args) -> int:
 
 
 def _posterior(args) -> int:
-    import numpy as np
-
-    from wrist_env.identification.study import study
-    from wrist_env.participants import registry
 
     registry.require(*args.participants)
     if (
@@ -120,7 +117,6 @@ def _posterior(args) -> int:
 
 
 def add_commands(command: Callable[..., object]) -> None:
-    from wrist_env.identification import bayes  # the sampler's defaults have one owner
 
     s = command(
         "sensitivity",

@@ -3,16 +3,29 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
+import re
 import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from wrist_env import design, figures, validation
+from wrist_env.builder.pipeline import BuildParams, add_anatomy_arguments, anatomy_params
 from wrist_env.cli.options import out_option
-from wrist_env.errors import UsageError
+from wrist_env.envs.task import task
+from wrist_env.errors import DesignError, ParticipantError, UsageError
+from wrist_env.figures.draw import FIGURES as figures_dir
+from wrist_env.frames import DOF_NAMES, DOF_UNITS
 from wrist_env.io import write_json
-from wrist_env.solver.simulate import DEFAULT_LOADS, LOAD_DIRECTIONS
+from wrist_env.model import BONES, PAIRS
+from wrist_env.participants import builtin, registry
+from wrist_env.participants.folder import NAME_PATTERN, PARTICIPANT_FILE, write_participant_folder
+from wrist_env.solver import simulate
+from wrist_env.solver.arrays import SOLVERS, solver_settings
+from wrist_env.solver.outputs import cardan_deg, result_to_dict
+from wrist_env.solver.simulate import DEFAULT_LOADS, IDEALIZED_LOAD_N, LOAD_DIRECTIONS
 from wrist_env.trial import MOTIONS
 
 if TYPE_CHECKING:
@@ -20,7 +33,7 @@ if TYPE_CHECKING:
     from wrist_env.model import Model
     from wrist_env.solver.simulate import Driver
 
-FIGURES_HELP = "$WRIST_ENV_FIGURES or runs/figures"  # wrist_env.figures.draw.FIGURES (no matplotlib import here)
+FIGURES_HELP = "$WRIST_ENV_FIGURES or runs/figures"  # where wrist_env.figures.draw.FIGURES points
 DESIGN_HELP = (
     "'population' (Table 2 means, default), 'truth' (a built-in participant's hidden ground truth) "
     "or a JSON file of a design (Design.as_dict; calibrate --out writes one)"
@@ -29,7 +42,6 @@ PARTICIPANT_HELP = "participant: built-in P1, P2, P3 or a registered folder's na
 
 
 def _participants(args) -> int:
-    from wrist_env.participants import builtin, registry
 
     for name in registry.participants():
         if name in builtin.BUILTIN:
@@ -41,7 +53,6 @@ def _participants(args) -> int:
 
 
 def _build(args) -> int:
-    from wrist_env.participants import registry
 
     start = time.perf_counter()
     model = registry.load_model(args.participant, cache=not args.no_cache)
@@ -59,12 +70,6 @@ def _build(args) -> int:
 
 
 def _export(args: argparse.Namespace) -> int:
-    import dataclasses
-    import re
-
-    from wrist_env.errors import ParticipantError
-    from wrist_env.participants import builtin
-    from wrist_env.participants.folder import NAME_PATTERN, PARTICIPANT_FILE, write_participant_folder
 
     if args.participant not in builtin.BUILTIN:
         raise ParticipantError(
@@ -91,9 +96,6 @@ def _export(args: argparse.Namespace) -> int:
 
 def load_design(spec: str, participant: str) -> Design:
     """`population`, `truth` (a built-in participant's hidden ground truth) or a JSON file of a Design."""
-    from wrist_env import design
-    from wrist_env.errors import DesignError
-    from wrist_env.participants import builtin
 
     if spec == "population":
         return design.population()
@@ -112,7 +114,6 @@ def load_design(spec: str, participant: str) -> Design:
 
 def add_solver_argument(parser) -> None:
     """--solver: the named solver settings (`arrays.SOLVERS`)."""
-    from wrist_env.solver.arrays import SOLVERS
 
     parser.add_argument(
         "--solver",
@@ -125,7 +126,6 @@ def add_solver_argument(parser) -> None:
 
 def make_driver(model: Model, motion: str, frames: int | None, flexion: float, extension: float) -> Driver:
     """The capitate driver of `simulate`: an idealized sweep or the capitate held at neutral."""
-    from wrist_env.solver import simulate
 
     if motion == "idealized":
         return simulate.idealized(model, flexion_deg=flexion, extension_deg=extension, n_frames=frames or 17)
@@ -133,10 +133,6 @@ def make_driver(model: Model, motion: str, frames: int | None, flexion: float, e
 
 
 def _simulate(args) -> int:
-    from wrist_env.model import BONES, PAIRS
-    from wrist_env.participants import registry
-    from wrist_env.solver import simulate
-    from wrist_env.solver.outputs import cardan_deg, result_to_dict
 
     if args.frames is not None and args.frames < 1:
         raise UsageError("--frames must be at least 1")
@@ -146,7 +142,6 @@ def _simulate(args) -> int:
     d = load_design(args.design, args.participant)
     driver = make_driver(model, args.motion, args.frames, args.flexion, args.extension)
     compile_seconds = None
-    from wrist_env.solver.arrays import solver_settings
 
     settings = solver_settings(args.solver)
     if args.warm_up:
@@ -184,9 +179,6 @@ def _simulate(args) -> int:
 
 
 def _evaluate(args) -> int:
-    from wrist_env.envs.task import task
-    from wrist_env.frames import DOF_NAMES, DOF_UNITS
-    from wrist_env.participants import registry
 
     registry.require(args.participant)
     d = load_design(args.design, args.participant)
@@ -233,11 +225,6 @@ def _evaluate(args) -> int:
 
 
 def _validate(args) -> int:
-    from wrist_env import validation
-    from wrist_env.builder.pipeline import BuildParams, anatomy_params
-    from wrist_env.participants import registry
-    from wrist_env.solver.arrays import solver_settings
-    from wrist_env.solver.simulate import IDEALIZED_LOAD_N
 
     registry.require(args.participant)
     params = anatomy_params(args)
@@ -255,7 +242,6 @@ def _validate(args) -> int:
         and args.solver == "default"
     )
     variant = "" if default else "_variant"
-    from wrist_env.figures.draw import FIGURES as figures_dir
 
     out = Path(args.out or figures_dir) / f"validation_{report.participant}{variant}.png"
     figure = validation.validation_figure(report, out)
@@ -269,7 +255,6 @@ def _validate(args) -> int:
 
 
 def _figure(args) -> int:
-    from wrist_env import figures
 
     out = Path(args.out) if args.out else None
     if args.kind == "model":
@@ -290,7 +275,6 @@ def _figure(args) -> int:
 
 def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     """Add these commands; `command(name, **kwargs)` makes a subcommand's parser."""
-    from wrist_env.builder.pipeline import add_anatomy_arguments
 
     s = command(
         "participants",

@@ -3,24 +3,31 @@
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
 
+import optimizers
+from wrist_env.bench.calibrate import PRIOR_SUFFIX, calibrate
+from wrist_env.bench.iohanalyzer import export
+from wrist_env.bench.leaderboard import reference, write_leaderboard
+from wrist_env.bench.runner import benchmark, make_cells
 from wrist_env.cli.options import out_option, scheduler_option
 from wrist_env.cli.participant_commands import PARTICIPANT_HELP
+from wrist_env.design import INJURABLE, LIGAMENT_NAMES, SPAN_SD
 from wrist_env.errors import UsageError
+from wrist_env.montecarlo.report import write_report
+from wrist_env.montecarlo.sampler import EXCLUDE_ABOVE_MPA, TEAR_PROBABILITY
+from wrist_env.montecarlo.study import StudyConfig, run_study
+from wrist_env.participants import builtin, registry
 from wrist_env.solver.simulate import DEFAULT_LOADS, LOAD_DIRECTIONS
 from wrist_env.trial import TRIAL_MOTIONS
 
 
 def _calibrate(args) -> int:
-    from wrist_env.bench.calibrate import PRIOR_SUFFIX, calibrate
-    from wrist_env.bench.leaderboard import reference
-    from wrist_env.design import LIGAMENT_NAMES
-    from wrist_env.participants import registry
 
     registry.require(args.participant)
     start = time.perf_counter()
@@ -66,11 +73,6 @@ def _calibrate(args) -> int:
 
 
 def _benchmark(args) -> int:
-    import optimizers
-    from wrist_env.bench.calibrate import PRIOR_SUFFIX
-    from wrist_env.bench.leaderboard import write_leaderboard
-    from wrist_env.bench.runner import benchmark, make_cells
-    from wrist_env.participants import builtin
 
     participants = args.participants or list(builtin.BUILTIN)
     names = args.optimizers or list(optimizers.available())
@@ -113,7 +115,6 @@ def _benchmark(args) -> int:
 
 
 def _leaderboard(args) -> int:
-    from wrist_env.bench.leaderboard import write_leaderboard
 
     if not Path(args.runs).is_dir():
         raise UsageError(f"no run log at {args.runs}")
@@ -123,9 +124,6 @@ def _leaderboard(args) -> int:
 
 
 def _iohanalyzer(args) -> int:
-    import importlib.util
-
-    from wrist_env.bench.iohanalyzer import export
 
     if importlib.util.find_spec("ioh") is None:
         raise SystemExit('wrist-bench iohanalyzer needs ioh, which is not installed: pip install -e ".[ioh]"')
@@ -137,8 +135,6 @@ def _iohanalyzer(args) -> int:
 
 
 def _montecarlo(args) -> int:
-    from wrist_env.montecarlo.study import StudyConfig, run_study
-    from wrist_env.participants import registry
 
     registry.require(*args.participants)
     config = StudyConfig(
@@ -171,7 +167,6 @@ def _montecarlo(args) -> int:
 
 
 def _montecarlo_report(args) -> int:
-    from wrist_env.montecarlo.report import write_report
 
     if not Path(args.runs).is_dir():
         raise UsageError(f"no Monte Carlo run log at {args.runs}")
@@ -192,9 +187,6 @@ def _run_log_arguments(s: argparse.ArgumentParser, *, out: str) -> None:
 
 def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     """Add these commands; `command(name, **kwargs)` makes a subcommand's parser."""
-    import optimizers
-    from wrist_env.design import INJURABLE, SPAN_SD
-    from wrist_env.montecarlo.sampler import EXCLUDE_ABOVE_MPA, TEAR_PROBABILITY
 
     s = command(
         "calibrate",
