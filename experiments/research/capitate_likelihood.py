@@ -43,7 +43,6 @@ from scipy.special import gammaln, logsumexp
 from scipy.stats import gamma
 
 from wrist_env import design
-from wrist_env.envs.task import Task, task
 from wrist_env.identification import likelihood
 from wrist_env.identification.map import map_estimate
 from wrist_env.model import BONES
@@ -52,6 +51,7 @@ from wrist_env.participants.builtin import TRACKING_NOISE_DEG, TRACKING_NOISE_MM
 from wrist_env.solver import equilibrium
 from wrist_env.solver.kernel import CAPITATE
 from wrist_env.solver.simulate import experimental, simulate, stiffness
+from wrist_env.task import Task, task
 
 OUT = Path(__file__).resolve().parents[2] / "leaderboards" / "posterior"
 AXIS_SD = np.r_[np.full(3, TRACKING_NOISE_MM), np.radians(np.full(3, TRACKING_NOISE_DEG))] / np.sqrt(3)

@@ -31,7 +31,7 @@ def _dat_blocks(path):
 def test_problem_is_the_calibration_cost_and_takes_ioh_loggers(built, tmp_path):
     from wrist_env import design
     from wrist_env.bench.calibrate import action
-    from wrist_env.envs.task import task
+    from wrist_env.task import task
 
     built("P1")
     f = iohanalyzer.problem("P1")

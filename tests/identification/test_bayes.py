@@ -184,9 +184,9 @@ def test_model_trials_carry_the_tracking_noise_and_no_model_error(built):
     noise alone (0.2 mm and 0.5° RMS rigid, so ~0.12 mm and ~0.29° per DOF at the centroid: about 0.6
     noise units each), below the built-in trial's (noise plus the fidelity gap); the noise follows the
     seed, the held-out trial gets its own draw, and a participant without a truth is refused."""
-    from wrist_env.envs.task import task
     from wrist_env.identification import likelihood
     from wrist_env.participants import builtin
+    from wrist_env.task import task
 
     built("P1")
     trial = task("P1", "calibrate")

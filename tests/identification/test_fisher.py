@@ -6,9 +6,9 @@ import pytest
 
 from wrist_env import design
 from wrist_env.cli import main
-from wrist_env.envs.task import Task, cost_poses
 from wrist_env.identification import fisher, likelihood
 from wrist_env.participants import builtin
+from wrist_env.task import Task, cost_poses
 
 
 def test_spectrum_and_posterior_of_a_planted_fisher_matrix():

@@ -6,10 +6,10 @@ from scipy.integrate import quad
 
 from wrist_env import design
 from wrist_env.bench import RunLog, calibrate
-from wrist_env.envs.task import task
 from wrist_env.frames import error_dof
 from wrist_env.identification import likelihood
 from wrist_env.model import BONES
+from wrist_env.task import task
 
 
 def test_the_scale_free_likelihood_is_the_gaussian_one_integrated_over_jeffreys_noise():

@@ -34,11 +34,11 @@ from wrist_env import design as design_vars
 from wrist_env.bench.log import X_COLUMNS, RunKey, RunLog
 from wrist_env.cost import COST_BONES
 from wrist_env.design import N_MATERIAL, Design
-from wrist_env.envs.task import task
 from wrist_env.errors import WristEnvError
 from wrist_env.frames import DOF_NAMES
 from wrist_env.identification.likelihood import map_objective
 from wrist_env.participants import builtin
+from wrist_env.task import task
 
 if TYPE_CHECKING:
     from optuna.storages import BaseStorage, RDBStorage

@@ -26,8 +26,8 @@ from wrist_env import design
 from wrist_env.bench.calibrate import action
 from wrist_env.bench.log import X_COLUMNS, RunLog
 from wrist_env.design import N_MATERIAL
-from wrist_env.envs.task import task
 from wrist_env.errors import InputError
+from wrist_env.task import task
 
 if TYPE_CHECKING:
     import ioh

@@ -14,7 +14,6 @@ from typing import TYPE_CHECKING
 from wrist_env import design, figures, validation
 from wrist_env.builder.pipeline import BuildParams, add_anatomy_arguments, anatomy_params
 from wrist_env.cli.options import out_option
-from wrist_env.envs.task import task
 from wrist_env.errors import DesignError, ParticipantError, UsageError
 from wrist_env.figures.draw import FIGURES as figures_dir
 from wrist_env.frames import DOF_NAMES, DOF_UNITS
@@ -26,6 +25,7 @@ from wrist_env.solver import simulate
 from wrist_env.solver.arrays import SOLVERS, solver_settings
 from wrist_env.solver.outputs import cardan_deg, result_to_dict
 from wrist_env.solver.simulate import DEFAULT_LOADS, IDEALIZED_LOAD_N, LOAD_DIRECTIONS
+from wrist_env.task import task
 from wrist_env.trial import MOTIONS
 
 if TYPE_CHECKING:

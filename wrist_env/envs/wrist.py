@@ -15,10 +15,10 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from numpy.typing import ArrayLike
 
 from wrist_env import design
-from wrist_env.envs.task import task
 from wrist_env.errors import DesignError
 from wrist_env.limits import MAX_BATCH, check_int
 from wrist_env.solver.simulate import DEFAULT_LOADS
+from wrist_env.task import task
 
 OBSERVATION = np.zeros(design.N_DESIGN, dtype=np.float32)
 
@@ -29,7 +29,7 @@ def _spaces():
 
 
 class WristEnv(gym.Env):
-    """Calibrate, validate or sweep one participant (see `wrist_env.envs.task.Task`).
+    """Calibrate, validate or sweep one participant (see `wrist_env.task.Task`).
 
     participant: a registered participant name; motion: "calibrate",
     "validate" or "idealized"; load_direction: the idealized sweep's load

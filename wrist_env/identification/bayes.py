@@ -39,7 +39,6 @@ import numpy as np
 
 from wrist_env import design
 from wrist_env.cost import COST_BONES
-from wrist_env.envs.task import Task, cost_poses, task
 from wrist_env.frames import pose_to_dof
 from wrist_env.identification import likelihood
 from wrist_env.identification.map import MAP_STARTS, laplace_covariance, map_estimate
@@ -48,6 +47,7 @@ from wrist_env.identification.posterior import Posterior
 from wrist_env.identification.smc import MCMC_STEPS, PARTICLES, DefensiveStart, sample_smc
 from wrist_env.model import BONES
 from wrist_env.participants import builtin
+from wrist_env.task import Task, cost_poses, task
 from wrist_env.trial import TRIAL_MOTIONS
 
 PREDICTIVE_DRAWS = 32

@@ -38,7 +38,7 @@ from wrist_env.frames import error_dof
 from wrist_env.model import BONES
 
 if TYPE_CHECKING:
-    from wrist_env.envs.task import Evaluation, Task
+    from wrist_env.task import Evaluation, Task
 
 NOISE = np.array([0.2, 0.2, 0.2, 0.5, 0.5, 0.5])
 """4DCT tracking noise per DOF (mm, mm, mm, deg, deg, deg): the residuals' unit."""

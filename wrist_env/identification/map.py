@@ -7,8 +7,8 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from wrist_env import design
-from wrist_env.envs.task import Task
 from wrist_env.identification import likelihood
+from wrist_env.task import Task
 
 MAP_STARTS = 24
 """Gauss–Newton starts of the MAP search: on P1's model trials (seed 0) 10 of 24 random starts reached

@@ -10,8 +10,8 @@ import emcee
 import numpy as np
 
 from wrist_env import design
-from wrist_env.envs.task import Task
 from wrist_env.identification import likelihood
+from wrist_env.task import Task
 
 WALKERS = 48
 STEPS = 1200

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import gymnasium as gym
 import numpy as np
 import pandas as pd
 from SALib.analyze import morris as morris_analyze
@@ -26,8 +25,8 @@ from tqdm import tqdm
 from wrist_env import design
 from wrist_env.cost import COST_BONES, DOF_NAMES
 from wrist_env.design import full_action
-from wrist_env.envs import env_id, register_ids
 from wrist_env.figures.sensitivity import plot
+from wrist_env.task import task
 from wrist_env.trial import MOTIONS
 
 METHODS = ("morris", "sobol")
@@ -74,24 +73,21 @@ def indices(method: str, spec: dict, X: np.ndarray, Y: np.ndarray, seed: int = 0
 
 def evaluate(participant: str, motion: str, X: np.ndarray, batch: int = BATCH) -> tuple[np.ndarray, np.ndarray]:
     """Outputs (m, 13) (`OUTPUTS`) and failed (m,) of the material points X (m, 22), simulated by the
-    participant's vector environment `batch` designs per step; failed runs' outputs filled (module doc)."""
-    register_ids(participant, (motion,))
-    env = gym.make_vec(env_id(participant, motion), num_envs=batch, vectorization_mode="vector_entry_point")
-    env.reset(seed=0)
-    actions = full_action(X)
+    participant's task `batch` designs per call (`Task.evaluate_batch`, as the environments); failed runs'
+    outputs filled (module doc)."""
+    motion_task = task(participant, motion)
+    # the actions as the environments' float32 action space holds them (the committed indices were made so)
+    actions = full_action(X).astype(np.float32)
     Y = np.zeros((len(X), len(OUTPUTS)))
     failed = np.zeros(len(X), bool)
     for start in tqdm(range(0, len(X), batch), desc=f"{participant} {motion}", unit="batch", leave=False):
         chunk = actions[start : start + batch]
-        padded = np.concatenate([chunk, np.repeat(chunk[-1:], batch - len(chunk), axis=0)])
-        _, rewards, _, _, info = env.step(padded.astype(np.float32))
-        n = len(chunk)
-        Y[start : start + n, 0] = -rewards[:n]
-        for j, name in enumerate(OUTPUTS[1:], start=1):
-            bone, dof = name.split(".", 1)
-            Y[start : start + n, j] = np.asarray(info["error_p75"][bone][dof])[:n]
-        failed[start : start + n] = np.asarray(info["failed"])[:n]
-    env.close()
+        for i, e in enumerate(motion_task.evaluate_batch([design.from_action(a) for a in chunk]), start=start):
+            Y[i, 0] = e.cost
+            for j, name in enumerate(OUTPUTS[1:], start=1):
+                bone, dof = name.split(".", 1)
+                Y[i, j] = e.info["error_p75"][bone][dof]
+            failed[i] = e.info["failed"]
     if failed.all():
         raise RuntimeError(f"{participant} {motion}: every one of the {len(X)} runs failed; no indices")
     Y[failed] = Y[~failed].max(axis=0)

@@ -10,14 +10,13 @@ Materials come from Table 2's normals truncated at ±3 SD by inverse CDF;
 each injurable ligament is torn (action −0.5) with probability 0.3, else
 intact (+1), independently.
 
-Simulation: `run_chunk` steps the native vector env
-`gymnasium.make_vec("wrist_env/Idealized-<P>-v0", num_envs=k,
-vectorization_mode="vector_entry_point")` once with the chunk's k actions —
-no second path into the solver — and reads every per-run output from the
-step's `infos` (per-frame contact per pair, bundle forces, status). The
-wrist angle of each frame is the environment's driver's
-(`env.unwrapped.task.driver.angle_deg`: the capitate's prescribed flexion,
-flexion +, extension −), which `infos` do not carry.
+Simulation: `run_chunk` evaluates the chunk's k designs with the participant's
+Idealized task (`wrist_env.task.task(participant, "idealized")`), in one
+`Task.evaluate_batch` call — the one the environments, the benchmark and
+sensitivity make — and reads every per-run output from the evaluations'
+`info` (per-frame contact per pair, bundle forces, status). The wrist angle
+of each frame is the task's driver's (`task.driver.angle_deg`: the
+capitate's prescribed flexion, flexion +, extension −).
 
 Exclusion (preprint 2.3.2: "models with contact pressures exceeding 16.5 MPa
 yielded unrealistic simulations"): a run is excluded when its radioscaphoid
@@ -40,15 +39,14 @@ from numpy.typing import ArrayLike
 
 from wrist_env import design
 from wrist_env.design import INJURABLE, LIGAMENT_NAMES, N_DESIGN, N_MATERIAL, NAMES, SPAN_SD
-from wrist_env.envs import env_id, register_ids
 from wrist_env.errors import DesignError
 from wrist_env.participants import registry
 from wrist_env.solver.simulate import DEFAULT_LOADS
+from wrist_env.task import task
 
 if TYPE_CHECKING:
     from pathlib import Path
 
-    from gymnasium.vector import VectorEnv
 
 TEAR_PROBABILITY = 0.3
 """Chance that each injurable ligament is torn in a Monte Carlo run (preprint 2.3.2)."""
@@ -146,28 +144,6 @@ def block_actions(
     return monte_carlo_actions(size, block_seed(seed, participant, block), tear_probability=tear_probability)
 
 
-_ENVS: dict = {}
-
-
-def vector_env(participant: str, num_envs: int, load_direction: str = DEFAULT_LOADS) -> VectorEnv:
-    """The participant's Idealized vector env with `num_envs` slots under `load_direction`
-    (`simulate.LOAD_DIRECTIONS`; one per process, size and direction)."""
-    import gymnasium as gym
-
-    key = (participant, int(num_envs), load_direction)
-    if key not in _ENVS:
-        register_ids(participant, ("idealized",))
-        env = gym.make_vec(
-            env_id(participant, "idealized"),
-            num_envs=int(num_envs),
-            vectorization_mode="vector_entry_point",
-            load_direction=load_direction,
-        )
-        env.reset(seed=0)
-        _ENVS[key] = env
-    return _ENVS[key]
-
-
 def _frames(rows: np.ndarray, missing=None) -> pa.Array:
     """Rows (n, n_frames) as a list column; rows where `missing` is True are null."""
     rows = np.ascontiguousarray(rows, dtype=np.float64)
@@ -188,7 +164,7 @@ def run_chunk(
     folders: Iterable[str | Path] = (),
     load_direction: str = DEFAULT_LOADS,
 ) -> pa.Table:
-    """Simulate k runs (actions of shape (k, 27)) in one vector-env step; their log rows (`SCHEMA`).
+    """Simulate k runs (actions of shape (k, 27)) in one batched call; their log rows (`SCHEMA`).
 
     Runs wherever it is called: in this process, a local worker process or a dask worker
     (`folders`: user participant folders to register there first). load_direction: the sweep's
@@ -199,20 +175,22 @@ def run_chunk(
             registry.ensure_folder(folder)
     actions = np.asarray(actions, dtype=np.float64)
     k = len(actions)
-    env = vector_env(participant, k, load_direction)
-    _, _, _, _, infos = env.step(actions)
-    angle = np.asarray(env.unwrapped.task.driver.angle_deg, dtype=np.float64)
+    idealized = task(participant, "idealized", load_direction)
+    infos = [e.info for e in idealized.evaluate_batch([design.from_action(a) for a in actions])]
+    angle = np.asarray(idealized.driver.angle_deg, dtype=np.float64)
     n_frames = len(angle)
-    status = [str(s) for s in infos["status"]]
-    ok = ~np.asarray(infos["failed"], dtype=bool) & np.array([s == "ok" for s in status])
-    contact = infos["contact"][RS_PAIR]
+    status = [str(info["status"]) for info in infos]
+    ok = ~np.array([info["failed"] for info in infos], dtype=bool) & np.array([s == "ok" for s in status])
 
     def frames(values):
-        values = np.array(values, dtype=np.float64).reshape(k, n_frames)
+        values = np.array(list(values), dtype=np.float64).reshape(k, n_frames)
         values[~ok] = 0.0  # infos hold zeros for a failed run; the log holds null (below)
         return values
 
-    rs_mean = frames(contact["mean_pressure_mpa"])
+    def rs(field):
+        return frames(info["contact"][RS_PAIR][field] for info in infos)
+
+    rs_mean = rs("mean_pressure_mpa")
     excluded = ok & np.any(rs_mean > exclude_above_mpa, axis=1)
     physical = np.stack([design.from_action(a).vector for a in actions]) if k else np.zeros((0, len(NAMES)))
     columns = {
@@ -224,10 +202,10 @@ def run_chunk(
     columns.update({c: actions[:, design.N_MATERIAL + i] < 0 for i, c in enumerate(TEAR_COLUMNS)})
     columns["angle_deg"] = _frames(np.tile(angle, (k, 1)))
     columns["rs_mean_mpa"] = _frames(rs_mean, ~ok)
-    columns["rs_peak_mpa"] = _frames(frames(contact["peak_pressure_mpa"]), ~ok)
-    columns["rs_area_mm2"] = _frames(frames(contact["area_mm2"]), ~ok)
+    columns["rs_peak_mpa"] = _frames(rs("peak_pressure_mpa"), ~ok)
+    columns["rs_area_mm2"] = _frames(rs("area_mm2"), ~ok)
     for lig, c in zip(LIGAMENT_NAMES, FORCE_COLUMNS):
-        columns[c] = _frames(frames(infos["bundle_force_n"][lig]), ~ok)
+        columns[c] = _frames(frames(info["bundle_force_n"][lig] for info in infos), ~ok)
     columns["status"] = status
     columns["ok"] = ok
     columns["excluded"] = excluded
