@@ -7,7 +7,12 @@ from collections.abc import Callable
 
 import numpy as np
 
-from wrist_env.cli.options import out_option
+from wrist_env.cli.options import (
+    out_option,
+    participants_argument,
+    progress_option,
+    seed_option,
+)
 from wrist_env.errors import UsageError
 from wrist_env.identification import bayes, fisher, sensitivity
 from wrist_env.identification.study import study
@@ -126,7 +131,7 @@ def add_commands(command: Callable[..., object]) -> None:
         "scaphoid and lunate DOF errors to the 22 ligament materials over the action box (Table 2 mean "
         "+-3 SD), injuries intact, simulated through the vector environment; a CSV and a PNG per participant.",
     )
-    s.add_argument("participants", nargs="+", help="participant names (`wrist-bench participants` lists them)")
+    participants_argument(s)
     s.add_argument("--method", choices=("morris", "sobol"), default="morris", help="default morris")
     s.add_argument("--n", type=int, default=20, help="Morris trajectories or Sobol base size (default 20)")
     s.add_argument(
@@ -136,7 +141,7 @@ def add_commands(command: Callable[..., object]) -> None:
         default=list(MOTIONS),
         help="default: all three",
     )
-    s.add_argument("--seed", type=int, default=0, help="sampling seed (default 0)")
+    seed_option(s, "sampling")
     out_option(s, "runs/sensitivity")
     s.set_defaults(run=_sensitivity)
 
@@ -148,7 +153,7 @@ def add_commands(command: Callable[..., object]) -> None:
         "(central differences, 45 runs per trial): its spectrum and each material's posterior SD with the "
         "population prior, for the calibration trial, the held-out trial and both; CSV and a PNG per participant.",
     )
-    s.add_argument("participants", nargs="+", help="built-in participants (they have a hidden truth)")
+    participants_argument(s, "built-in participants (they have a hidden truth)")
     out_option(s, "runs/identifiability")
     s.set_defaults(run=_identifiability)
 
@@ -165,7 +170,7 @@ def add_commands(command: Callable[..., object]) -> None:
         "and 90 % credible intervals of the hidden truth (coverage.csv) and a figure of the intervals against "
         "the truth.",
     )
-    s.add_argument("participants", nargs="+", help="participant names (`wrist-bench participants` lists them)")
+    participants_argument(s)
     s.add_argument("--seeds", type=int, default=1, help="runs per participant, seeds 0 .. N-1 (default 1)")
     s.add_argument("--walkers", type=int, default=bayes.WALKERS, help="ensemble walkers (default %(default)s; >= 44)")
     s.add_argument("--steps", type=int, default=bayes.STEPS, help="ensemble steps (default %(default)s, ~12 min a run)")
@@ -203,5 +208,5 @@ def add_commands(command: Callable[..., object]) -> None:
         help="calibrate against the model's own run of the hidden truth plus the trials' tracking noise "
         "(no model error: tells the calibrator's honesty from the model's fidelity; files get a _model suffix)",
     )
-    s.add_argument("--no-progress", action="store_true", help="no progress bar")
+    progress_option(s)
     s.set_defaults(run=_posterior)

@@ -13,7 +13,12 @@ from typing import TYPE_CHECKING
 
 from wrist_env import design, figures, validation
 from wrist_env.builder.pipeline import BuildParams, add_anatomy_arguments, anatomy_params
-from wrist_env.cli.options import out_option
+from wrist_env.cli.options import (
+    PARTICIPANT_HELP,
+    json_option,
+    out_option,
+    participant_argument,
+)
 from wrist_env.errors import DesignError, ParticipantError, UsageError
 from wrist_env.figures.draw import FIGURES as figures_dir
 from wrist_env.frames import DOF_NAMES, DOF_UNITS
@@ -38,7 +43,6 @@ DESIGN_HELP = (
     "'population' (Table 2 means, default), 'truth' (a built-in participant's hidden ground truth) "
     "or a JSON file of a design (Design.as_dict; calibrate --out writes one)"
 )
-PARTICIPANT_HELP = "participant: built-in P1, P2, P3 or a registered folder's name (see `wrist-bench participants`)"
 
 
 def _participants(args) -> int:
@@ -291,8 +295,8 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "signed-distance grids; ~30-45 s on first use) and cache it by the hash of its inputs; later "
         "calls load the cache. Prints the build summary.",
     )
-    s.add_argument("participant", help=PARTICIPANT_HELP)
-    s.add_argument("--json", action="store_true", help="print the build summary as JSON")
+    participant_argument(s)
+    json_option(s, "the build summary")
     s.add_argument("--no-cache", action="store_true", help="rebuild even if a cached model exists")
     s.set_defaults(run=_build)
 
@@ -304,7 +308,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "wrist_env.register_participant accept unchanged: the starting point for a folder of your own. "
         "The folder's participant is named after the folder (or --name).",
     )
-    s.add_argument("participant", help="built-in participant to export: P1, P2 or P3")
+    participant_argument(s, "built-in participant to export: P1, P2 or P3")
     s.add_argument("out_folder", metavar="folder", help="new folder to write (must not exist or be empty)")
     s.add_argument("--name", help="the exported participant's name (default: the folder's name)")
     s.set_defaults(run=_export)
@@ -318,7 +322,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "still pays ~0.2 s to load it): --warm-up runs a one-frame simulation first and reports "
         "its time as compile_seconds, so that wall_seconds is the solver alone.",
     )
-    s.add_argument("participant", help=PARTICIPANT_HELP)
+    participant_argument(s)
     s.add_argument(
         "--motion",
         choices=["idealized", "static"],
@@ -332,7 +336,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     s.add_argument("--flexion", type=float, default=40.0, help="idealized: first frame's flexion, deg (default 40)")
     s.add_argument("--extension", type=float, default=40.0, help="idealized: last frame's extension, deg (default 40)")
     s.add_argument("--warm-up", action="store_true", help="run a one-frame simulation first (compile_seconds)")
-    s.add_argument("--json", action="store_true", help="print all per-frame outputs as JSON")
+    json_option(s, "all per-frame outputs")
     add_solver_argument(s)
     s.set_defaults(run=_simulate)
 
@@ -345,7 +349,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "sweep (reference: the hidden truth's sweep for built-in participants; none, cost 0, for "
         "user participants). Exit status 1 if the simulation failed.",
     )
-    s.add_argument("participant", help=PARTICIPANT_HELP)
+    participant_argument(s)
     s.add_argument(
         "--motion",
         choices=MOTIONS,
@@ -354,7 +358,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "validate; idealized: the flexion-extension sweep",
     )
     s.add_argument("--design", default="population", help=DESIGN_HELP)
-    s.add_argument("--json", action="store_true", help="print the cost, per-DOF errors and timings as JSON")
+    json_option(s, "the cost, per-DOF errors and timings")
     s.set_defaults(run=_evaluate)
 
     s = command(
@@ -366,8 +370,8 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "cites its source). Prints the table (or JSON) and writes a figure and its JSON record; exit status 1 if any check "
         "fails.",
     )
-    s.add_argument("participant", help=PARTICIPANT_HELP)
-    s.add_argument("--json", action="store_true", help="print the checks and series as JSON")
+    participant_argument(s)
+    json_option(s, "the checks and series")
     out_option(s, what=f"figure folder (default {FIGURES_HELP})")
     add_anatomy_arguments(s)
     s.add_argument(
@@ -395,7 +399,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "(radial view: bones, ligament fibres coloured by force, radiocarpal contact pressure).",
     )
     s.add_argument("kind", choices=["model", "annotations", "pressure", "kinematics", "animation"])
-    s.add_argument("participant", nargs="?", help=PARTICIPANT_HELP + " (default P1)")
+    participant_argument(s, PARTICIPANT_HELP + " (default P1)", nargs="?")
     out_option(s, what=f"output PNG path (default: a file named after the figure in {FIGURES_HELP})")
     s.add_argument(
         "--static",

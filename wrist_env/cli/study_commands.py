@@ -15,8 +15,15 @@ from wrist_env.bench.calibrate import PRIOR_SUFFIX, calibrate
 from wrist_env.bench.iohanalyzer import export
 from wrist_env.bench.leaderboard import reference, write_leaderboard
 from wrist_env.bench.runner import benchmark, make_cells
-from wrist_env.cli.options import out_option, scheduler_option
-from wrist_env.cli.participant_commands import PARTICIPANT_HELP
+from wrist_env.cli.options import (
+    json_option,
+    out_option,
+    participant_argument,
+    participants_argument,
+    progress_option,
+    scheduler_option,
+    seed_option,
+)
 from wrist_env.design import INJURABLE, LIGAMENT_NAMES, SPAN_SD
 from wrist_env.errors import UsageError
 from wrist_env.montecarlo.report import write_report
@@ -197,12 +204,12 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "and, for built-in participants, against the hidden truth (parameter recovery, Table 2 SD "
         "units). Prints the calibrated design in physical units.",
     )
-    s.add_argument("participant", help=PARTICIPANT_HELP)
+    participant_argument(s)
     s.add_argument(
         "--optimizer", default="cmaes", help=f"calibrator: {', '.join(optimizers.available())} (default cmaes)"
     )
     s.add_argument("--budget", type=int, default=300, help="simulations allowed (default 300)")
-    s.add_argument("--seed", type=int, default=0, help="calibrator seed (default 0)")
+    seed_option(s, "calibrator")
     s.add_argument("--log", help="run-log folder: log every batch, resume this run if it was cut short")
     s.add_argument("--storage", help="Optuna storage URL for Optuna calibrators (default: in memory)")
     s.add_argument(
@@ -212,7 +219,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "the cost; the same as the calibrator name with '+prior' appended",
     )
     out_option(s, what="also write the JSON result to this file (usable as --design elsewhere)")
-    s.add_argument("--json", action="store_true", help="print the result, design and held-out cost as JSON")
+    json_option(s, "the result, design and held-out cost")
     s.set_defaults(run=_calibrate)
 
     s = command(
@@ -242,7 +249,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "sqlite:///<out>/optuna/{cell}.db); 'memory': studies in memory only",
     )
     s.add_argument("--leaderboard", help="leaderboard folder (default: <out>/leaderboards)")
-    s.add_argument("--no-progress", action="store_true", help="no progress bar")
+    progress_option(s)
     s.set_defaults(run=_benchmark)
 
     s = command(
@@ -276,9 +283,9 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         f"runs succeed. Every run is logged to Parquet in --out as its batch finishes; run the same "
         f"command again to resume.",
     )
-    s.add_argument("participants", nargs="+", help="participant names (`wrist-bench participants` lists them)")
+    participants_argument(s)
     s.add_argument("--n", type=int, default=12500, help="successful runs per participant (default 12500)")
-    s.add_argument("--seed", type=int, default=0, help="study seed (default 0)")
+    seed_option(s, "study")
     s.add_argument(
         "--tear-probability",
         type=float,
@@ -303,7 +310,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         help="local worker processes, which die with this one (default 0, or 1: this process, "
         "Numba threads on every core)",
     )
-    s.add_argument("--no-progress", action="store_true", help="no progress bar")
+    progress_option(s)
     s.set_defaults(run=_montecarlo)
 
     s = command(
