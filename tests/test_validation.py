@@ -123,7 +123,7 @@ def test_a_failed_run_fails_its_check_and_says_why():
 
 
 @pytest.mark.xfail(
-    reason="issue 33: the load path misses RS/RL (0.90-0.96), the LC and TH shares, the column's turn; README: The load path",
+    reason="issue 33: the load path misses RS/RL (0.90-0.96), the LC and TH shares, the column's turn; docs/validation.md: The load path",
     strict=True,
     raises=AssertionError,
 )
@@ -152,26 +152,26 @@ def test_builtins_move_like_a_wrist(name, built):
 
 
 def test_load_directions_are_the_clis_choices_and_unit_vectors():
-    """`validate --load-direction` offers exactly `simulate.LOAD_DIRECTIONS`; each is a set of lines of
+    """`validate --load-direction` offers exactly `drivers.LOAD_DIRECTIONS`; each is a set of lines of
     unit pulls whose shares sum to 1 and whose resultant pulls proximally, the axial one a single line
     along the radius' axis on the capitate, and another name is refused by name."""
     from wrist_env.cli import parser
     from wrist_env.participants.registry import load_model
-    from wrist_env.solver import simulate
+    from wrist_env.solver import drivers
 
     validate = parser()._subparsers._group_actions[0].choices["validate"]
     option = next(a for a in validate._actions if "--load-direction" in a.option_strings)
-    assert tuple(option.choices) == simulate.LOAD_DIRECTIONS and option.default == simulate.DEFAULT_LOADS
+    assert tuple(option.choices) == drivers.LOAD_DIRECTIONS and option.default == drivers.DEFAULT_LOADS
     p1 = load_model("P1")
-    for name in simulate.LOAD_DIRECTIONS:
-        lines = simulate.loads(p1, name)
+    for name in drivers.LOAD_DIRECTIONS:
+        lines = drivers.loads(p1, name)
         assert np.allclose(np.linalg.norm(lines.direction, axis=1), 1.0) and np.isclose(lines.share.sum(), 1.0)
         total = lines.share @ lines.direction
         assert total[1] > 0.9 * np.linalg.norm(total), (name, total)
-    axial = simulate.loads(p1, "axial")
+    axial = drivers.loads(p1, "axial")
     assert np.array_equal(axial.direction, [[0.0, 1.0, 0.0]]) and axial.body.tolist() == [CAPITATE]
     with pytest.raises(ValueError, match="sideways"):
-        simulate.loads(p1, "sideways")
+        drivers.loads(p1, "sideways")
 
 
 def test_the_preconditioned_solver_validates_like_the_default(built):

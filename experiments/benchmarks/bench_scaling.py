@@ -29,9 +29,10 @@ import numpy as np
 from bench_solver import median_seconds, monte_carlo_designs  # this folder's script (on sys.path when run)
 
 from wrist_env import design
-from wrist_env.builder.pipeline import BuildParams
+from wrist_env.builder.params import BuildParams
 from wrist_env.participants.registry import load_model
-from wrist_env.solver.simulate import idealized, prepare, simulate, simulate_batch
+from wrist_env.solver.drivers import idealized
+from wrist_env.solver.simulate import prepare, simulate, simulate_batch
 
 BATCHES = (1, 2, 4, 8, 16, 32, 64)
 SPACINGS_MM = (0.7, 1.0, 1.4, 2.0)  # contact-sample spacing; 1.0 mm is the default build

@@ -34,8 +34,9 @@ from wrist_env.participants import registry
 from wrist_env.participants.registry import load_model
 from wrist_env.solver import arrays
 from wrist_env.solver.arrays import SolverSettings
+from wrist_env.solver.drivers import idealized, static, trial_driver
 from wrist_env.solver.forces import pair_transform, rebuild_active, sample_lookup, sample_lookup_smooth
-from wrist_env.solver.simulate import idealized, simulate, simulate_batch, static, trial_driver
+from wrist_env.solver.simulate import simulate, simulate_batch
 
 PREPRINT_SECONDS = 45.0  # one Abaqus simulation
 PREPRINT_STUDY_DAYS = 13  # the preprint's Monte Carlo study
@@ -181,7 +182,7 @@ def main(name: str, params=None, load_n=None) -> None:
 if __name__ == "__main__":
     import argparse
 
-    from wrist_env.builder.pipeline import add_anatomy_arguments, anatomy_params
+    from wrist_env.builder.params import add_anatomy_arguments, anatomy_params
 
     cli = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     cli.add_argument("participant", nargs="?", default="P1")

@@ -19,13 +19,14 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from wrist_env import design
-from wrist_env.builder.pipeline import BuildParams
+from wrist_env.builder.params import BuildParams
 from wrist_env.model import BODY_PARTS, BONES, PAIR_BONES, PAIRS
 from wrist_env.montecarlo import sampler
 from wrist_env.participants.registry import load_model
 from wrist_env.solver import arrays
+from wrist_env.solver.drivers import idealized, loaded
 from wrist_env.solver.forces import sample_pressures
-from wrist_env.solver.simulate import idealized, loaded, simulate, simulate_batch
+from wrist_env.solver.simulate import simulate, simulate_batch
 from wrist_env.validation import NEUTRAL_LOAD_N, validate
 
 VARIANTS = (

@@ -23,6 +23,7 @@ from scipy.optimize import minimize
 from wrist_env import design
 from wrist_env.anatomy.tendons import RIGS
 from wrist_env.participants.registry import load_model
+from wrist_env.solver import drivers
 from wrist_env.solver import simulate as sim
 from wrist_env.validation import NEUTRAL_LOAD_N
 
@@ -72,7 +73,7 @@ def main() -> None:
     tendons = list(RIGS[args.rig])
     for name in args.participants:
         model = load_model(name)
-        base = sim.loaded(model, [np.eye(3)], NEUTRAL_LOAD_N, direction=args.rig)
+        base = drivers.loaded(model, [np.eye(3)], NEUTRAL_LOAD_N, direction=args.rig)
         t0 = NEUTRAL_LOAD_N * base.loads.share
         t, M = balance(model, d, base, t0)
         _, result = run_with(model, d, base, t)

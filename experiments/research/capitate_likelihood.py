@@ -45,12 +45,12 @@ from scipy.stats import gamma
 from wrist_env import design
 from wrist_env.identification import likelihood
 from wrist_env.identification.map import map_estimate
-from wrist_env.model import BONES
+from wrist_env.model import BONES, CAPITATE
 from wrist_env.participants import builtin, registry
 from wrist_env.participants.builtin import TRACKING_NOISE_DEG, TRACKING_NOISE_MM
 from wrist_env.solver import equilibrium
-from wrist_env.solver.kernel import CAPITATE
-from wrist_env.solver.simulate import experimental, simulate, stiffness
+from wrist_env.solver.drivers import experimental
+from wrist_env.solver.simulate import simulate, stiffness
 from wrist_env.task import Task, task
 
 OUT = Path(__file__).resolve().parents[2] / "leaderboards" / "posterior"

@@ -21,7 +21,7 @@ from scipy.spatial.transform import Rotation
 from wrist_env import design
 from wrist_env.model import CAPITATE
 from wrist_env.participants.registry import load_model
-from wrist_env.solver import kernel
+from wrist_env.solver import drivers, kernel
 from wrist_env.solver import simulate as sim
 from wrist_env.solver.outputs import articulation_forces
 from wrist_env.validation import NEUTRAL_LOAD_N, load_shares_pct
@@ -47,7 +47,7 @@ def distal_row_moment(model, d, driver, result) -> np.ndarray:
 
 
 def run(model, d, rotvec, direction):
-    driver = sim.loaded(model, [Rotation.from_rotvec(rotvec).as_matrix()], NEUTRAL_LOAD_N, direction=direction)
+    driver = drivers.loaded(model, [Rotation.from_rotvec(rotvec).as_matrix()], NEUTRAL_LOAD_N, direction=direction)
     result = sim.simulate(model, d, driver)
     return driver, result
 
@@ -65,7 +65,7 @@ def summary(model, result) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("participants", nargs="+")
-    parser.add_argument("--load-direction", default="erhart2020", choices=sim.LOAD_DIRECTIONS)
+    parser.add_argument("--load-direction", default="erhart2020", choices=drivers.LOAD_DIRECTIONS)
     args = parser.parse_args()
     d = design.population()
     for name in args.participants:

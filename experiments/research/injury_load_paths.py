@@ -21,9 +21,10 @@ from wrist_env import design
 from wrist_env.model import BONES, PAIRS
 from wrist_env.montecarlo.sampler import INTACT_ACTION, TORN_ACTION
 from wrist_env.participants.registry import load_model
+from wrist_env.solver.drivers import idealized
 from wrist_env.solver.forces import R_AREA, R_FORCE, R_MEAN
 from wrist_env.solver.outputs import cardan_deg
-from wrist_env.solver.simulate import idealized, simulate_batch
+from wrist_env.solver.simulate import simulate_batch
 from wrist_env.validation import slope
 
 SHOWN = ("radioscaphoid", "radiolunate", "scaphotrapezial", "scaphocapitate", "lunocapitate", "ulnocarpal")

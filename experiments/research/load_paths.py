@@ -7,7 +7,7 @@ the force and share of each articulation (`model.ARTICULATIONS`: the midcarpal s
 Viegas 1993, the ulnar share against Palmer & Werner 1984) as `wrist-bench validate` checks them,
 and the space a TFCC would fill (`ulnocarpal_space`).
 Run: `python experiments/research/load_paths.py P1 [P2 ...] [--load-direction erhart2020]` (the load along the
-radius by default, or the tendon rig's resultant: `simulate.LOAD_DIRECTIONS`).
+radius by default, or the tendon rig's resultant: `drivers.LOAD_DIRECTIONS`).
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ import numpy as np
 from wrist_env import design
 from wrist_env.model import BODY_PARTS, BONES, PAIR_BONES, PAIRS
 from wrist_env.participants.registry import load_model
+from wrist_env.solver import drivers
 from wrist_env.solver import simulate as sim
 from wrist_env.solver.contact import OUTSIDE_MM, sdf_lookup
 from wrist_env.solver.outputs import articulation_forces, pair_slice, pressure_map, sample_parts
@@ -88,10 +89,10 @@ def ulnocarpal_space(model) -> dict:
     return out | {"ulnar_variance_mm": float(corner[1] - head[:, 1].min())}
 
 
-def main(names, load_direction: str = sim.DEFAULT_LOADS) -> None:
+def main(names, load_direction: str = drivers.DEFAULT_LOADS) -> None:
     for name in names:
         model = load_model(name)
-        driver = sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=load_direction)
+        driver = drivers.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=load_direction)
         result = sim.simulate(model, design.population(), driver)
         total = driver.resultant(0)
         print(
@@ -122,6 +123,6 @@ def main(names, load_direction: str = sim.DEFAULT_LOADS) -> None:
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("participants", nargs="*", default=["P1"])
-    parser.add_argument("--load-direction", choices=sim.LOAD_DIRECTIONS, default=sim.DEFAULT_LOADS)
+    parser.add_argument("--load-direction", choices=drivers.LOAD_DIRECTIONS, default=drivers.DEFAULT_LOADS)
     args = parser.parse_args()
     main(args.participants, args.load_direction)

@@ -26,6 +26,7 @@ from scipy.spatial.transform import Rotation
 from wrist_env import design
 from wrist_env.model import BODY_PARTS, BONES, PAIR_BONES, PAIRS
 from wrist_env.participants.registry import load_model
+from wrist_env.solver import drivers
 from wrist_env.solver import simulate as sim
 from wrist_env.solver.outputs import pair_slice, pressure_map, sample_parts
 
@@ -38,7 +39,7 @@ TH = (LC, ("hamate",))  # of the triquetrohamate joint
 
 
 def _neutral(model, d, load_n):
-    return sim.simulate(model, d, sim.loaded(model, [np.eye(3)], load_n=load_n))
+    return sim.simulate(model, d, drivers.loaded(model, [np.eye(3)], load_n=load_n))
 
 
 def _ratio(result) -> float:

@@ -38,7 +38,8 @@ from wrist_env.identification.map import map_estimate  # noqa: E402
 from wrist_env.model import BONES  # noqa: E402
 from wrist_env.participants import builtin  # noqa: E402
 from wrist_env.participants.registry import load_model  # noqa: E402
-from wrist_env.solver.simulate import experimental, loaded, simulate  # noqa: E402
+from wrist_env.solver.drivers import experimental, loaded
+from wrist_env.solver.simulate import simulate
 from wrist_env.task import cost_poses, task  # noqa: E402
 
 DRAWS = 16

@@ -47,8 +47,9 @@ from wrist_env import design
 from wrist_env.participants import registry
 from wrist_env.participants.registry import load_model
 from wrist_env.solver.arrays import SolverSettings
+from wrist_env.solver.drivers import idealized, trial_driver
 from wrist_env.solver.equilibrium import distance, nearest
-from wrist_env.solver.simulate import idealized, prepare, simulate_batch, simulate_frame, trial_driver
+from wrist_env.solver.simulate import prepare, simulate_batch, simulate_frame
 
 CACHE = Path(__file__).resolve().parents[2] / "runs" / "solver_accuracy"  # the repository root's runs/, git-ignored
 TOLERANCE = (0.1, 0.5)  # mm, degrees: issue 13's "answer unchanged"

@@ -26,8 +26,9 @@ from wrist_env import design
 from wrist_env.participants import registry
 from wrist_env.participants.registry import load_model
 from wrist_env.solver import arrays
+from wrist_env.solver.drivers import idealized, trial_driver
 from wrist_env.solver.equilibrium import block_mass, tangent_stiffness
-from wrist_env.solver.simulate import idealized, prepare, simulate, stiffness, trial_driver
+from wrist_env.solver.simulate import prepare, simulate, stiffness
 
 
 def node_courant(model, dsg, driver, settings: arrays.SolverSettings) -> float:

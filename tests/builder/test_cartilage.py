@@ -9,15 +9,12 @@ import trimesh
 from wrist_env.builder.cartilage import (
     build_cartilage,
     cartilage_layer,
-    closed_faces,
-    displaced_vertices,
     extrude_wedges,
-    gap_to,
-    grnn_smooth,
     remove_overclosure,
     thickness_fields,
     wedge_quality,
 )
+from wrist_env.builder.surface import closed_faces, displaced_vertices, gap_to, grnn_smooth
 from wrist_env.errors import BuildError, InputError, MeshError
 
 R = 10.0

@@ -7,7 +7,8 @@ from scipy import stats as sps
 from wrist_env import design
 from wrist_env.errors import DesignError
 from wrist_env.montecarlo import sampler
-from wrist_env.montecarlo.study import StudyConfig, _chunks, _plan
+from wrist_env.montecarlo.config import StudyConfig
+from wrist_env.montecarlo.study import _chunks, _plan
 
 
 def test_tear_rate_is_0_3_and_tears_are_independent():

@@ -10,11 +10,11 @@ import pytest
 import trimesh
 from scipy.spatial.transform import Rotation
 
-from wrist_env.builder.pipeline import BuildParams
+from wrist_env.builder.params import BuildParams
 from wrist_env.errors import MeshError, ParticipantError, TrialError
 from wrist_env.model import SUPPLIED
+from wrist_env.participants import bone_mesh as folder_module
 from wrist_env.participants import builtin, registry
-from wrist_env.participants import folder as folder_module
 from wrist_env.participants.folder import ParticipantSource, load_participant_folder, write_participant_folder
 from wrist_env.trial import MIRROR, Trial
 

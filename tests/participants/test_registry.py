@@ -7,7 +7,7 @@ import pytest
 import trimesh
 
 from wrist_env.anatomy.template import load_template
-from wrist_env.builder.pipeline import BuildParams
+from wrist_env.builder.params import BuildParams
 from wrist_env.builder.warp import random_warp
 from wrist_env.design import ALL_LIGAMENTS
 from wrist_env.errors import BuildError, ParticipantError

@@ -13,8 +13,9 @@ from wrist_env.design import LIGAMENT_NAMES
 from wrist_env.model import CAPITATE
 from wrist_env.participants import registry
 from wrist_env.solver.arrays import SolverSettings
+from wrist_env.solver.drivers import AXIAL, experimental, idealized, loaded
 from wrist_env.solver.equilibrium import nearest, tangent_stiffness
-from wrist_env.solver.simulate import AXIAL, experimental, idealized, loaded, simulate
+from wrist_env.solver.simulate import simulate
 
 SCAPHOID = 2
 AXIS = np.array([1.0, 2.0, 2.0]) / 3.0

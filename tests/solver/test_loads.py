@@ -1,4 +1,4 @@
-"""The drivers' loads as lines of action (`simulate.Loads`): where each tendon pulls, and the force and
+"""The drivers' loads as lines of action (`drivers.Loads`): where each tendon pulls, and the force and
 moment each line puts on its body."""
 
 import numpy as np
@@ -8,7 +8,8 @@ from wrist_env import design
 from wrist_env.anatomy.tendons import load_tendons, model_lines
 from wrist_env.model import BODY_PARTS, BONES, LUNATE
 from wrist_env.solver import kernel
-from wrist_env.solver.simulate import Loads, loaded, loads, prepare, stiffness
+from wrist_env.solver.drivers import Loads, loaded, loads
+from wrist_env.solver.simulate import prepare, stiffness
 
 
 def test_each_tendon_pulls_the_body_of_the_carpal_it_loads_near_its_template_site(p1):

@@ -9,10 +9,10 @@ from scipy.spatial.transform import Rotation
 from wrist_env import design
 from wrist_env.model import CAPITATE, FREE, N_BODIES
 from wrist_env.solver.arrays import SolverSettings
-from wrist_env.solver.forces import membrane_forces, place_nodes
-from wrist_env.solver.membrane import _gaps, _substep_forces, new_scratch, substep
+from wrist_env.solver.drivers import experimental, idealized
+from wrist_env.solver.membrane import _gaps, _substep_forces, membrane_forces, new_scratch, place_nodes, substep
 from wrist_env.solver.predictor import MAX_RATIO, capitate_move, history, predict, record
-from wrist_env.solver.simulate import experimental, idealized, prepare, simulate, stiffness
+from wrist_env.solver.simulate import prepare, simulate, stiffness
 
 PRECONDITIONED = SolverSettings().preconditioned()
 
@@ -58,7 +58,7 @@ def _shaken_neutral(model, shake_mm, seed):
 def test_a_substep_feels_the_force_kernels_membrane_forces(p1):
     """On P1's settled neutral state with the free nodes shaken by up to 0.3 mm (some pressed into the
     scaphoid, connectors taut and slack): the substep's forces on the free nodes equal
-    `forces.membrane_forces`' to rounding, so the subcycled nodes settle where the solver's own forces
+    `membrane.membrane_forces`' to rounding, so the subcycled nodes settle where the solver's own forces
     balance (a node is looked up where gap − √3·travel < 0: here every travel is 0)."""
     R, x, nodes, free, p, s, exact = _shaken_neutral(p1, 0.3, 0)
     gap, travel = np.zeros(len(nodes)), np.zeros(len(nodes))
@@ -72,7 +72,7 @@ def test_a_substep_feels_the_force_kernels_membrane_forces(p1):
 
 def test_substeps_relax_the_nodes_to_their_equilibrium(p1):
     """The bones held at P1's settled neutral state and the free nodes shaken by 0.2 mm: 300 steps of
-    substeps bring the nodes back to a balance of `forces.membrane_forces` (largest free-node force below
+    substeps bring the nodes back to a balance of `membrane.membrane_forces` (largest free-node force below
     1e-3 N from over 1 N): the damping takes the shake's energy out, it does not pump it."""
     R, x, nodes, free, p, s, exact = _shaken_neutral(p1, 0.2, 1)
     before = np.abs(exact()[free]).max()

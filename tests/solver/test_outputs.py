@@ -9,8 +9,9 @@ from wrist_env import design
 from wrist_env.model import BONES, N_BODIES, PAIR_BONES, PAIRS
 from wrist_env.solver import arrays, forces
 from wrist_env.solver.contact import sdf_lookup
+from wrist_env.solver.drivers import idealized
 from wrist_env.solver.outputs import pair_slice, pressure_map, result_to_dict
-from wrist_env.solver.simulate import Result, idealized, simulate
+from wrist_env.solver.simulate import Result, simulate
 
 RS = PAIRS.index("radioscaphoid")
 

@@ -8,7 +8,8 @@ from wrist_env import design
 from wrist_env.model import BONES, PAIRS
 from wrist_env.participants.builtin import truth
 from wrist_env.solver.arrays import SolverSettings
-from wrist_env.solver.simulate import experimental, idealized, simulate, simulate_batch
+from wrist_env.solver.drivers import experimental, idealized
+from wrist_env.solver.simulate import simulate, simulate_batch
 
 pytestmark = pytest.mark.slow  # builds models or runs simulations/studies (minutes)
 

@@ -10,9 +10,10 @@ from wrist_env import design
 from wrist_env.model import N_BODIES
 from wrist_env.participants import registry
 from wrist_env.solver import arrays
-from wrist_env.solver.forces import membrane_forces, place_nodes
+from wrist_env.solver.drivers import experimental
 from wrist_env.solver.ligaments import EPSILON_L
-from wrist_env.solver.simulate import experimental, prepare, simulate, stiffness
+from wrist_env.solver.membrane import membrane_forces, place_nodes
+from wrist_env.solver.simulate import prepare, simulate, stiffness
 
 pytestmark = pytest.mark.slow  # builds models or runs simulations/studies (minutes)
 

@@ -30,7 +30,8 @@ from wrist_env.design import LIGAMENT_NAMES
 from wrist_env.model import BONES, CAPITATE, LUNATE, PAIRS, RADIUS, SCAPHOID
 from wrist_env.participants.builtin import truth
 from wrist_env.solver.arrays import SolverSettings
-from wrist_env.solver.simulate import experimental, idealized, simulate
+from wrist_env.solver.drivers import experimental, idealized
+from wrist_env.solver.simulate import simulate
 
 LUNOCAPITATE = PAIRS.index("lunocapitate")
 MEAN, PEAK, AREA, FORCE = range(4)

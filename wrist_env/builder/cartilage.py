@@ -21,12 +21,11 @@ from dataclasses import dataclass
 
 import igl
 import numpy as np
-import scipy.sparse
 import trimesh
 from numpy.typing import ArrayLike
-from scipy.spatial import cKDTree
 
-from wrist_env.errors import BuildError, InputError, MeshError
+from wrist_env.builder.surface import _faces, _mask, _vertices, closed_faces, displaced_vertices, gap_to, grnn_smooth
+from wrist_env.errors import BuildError, InputError
 
 # Each 6-node wedge (bottom 0-1-2, top 3-4-5, node i+3 above node i) as three
 # positively oriented tetrahedra.
@@ -34,7 +33,6 @@ WEDGE_TETS = np.array([[0, 1, 2, 3], [1, 2, 3, 4], [2, 3, 4, 5]])
 WEDGE_EDGES = np.array([[0, 1], [1, 2], [2, 0], [3, 4], [4, 5], [5, 3], [0, 3], [1, 4], [2, 5]])
 OVERCLOSURE_TOL_MM = 1e-3
 REACH_MARGIN_MM = 1.0  # cartilage vertices farther than the layers plus this from a bone count as outside it
-NORMAL_SMOOTHING_MM = 1.0  # σ of the kernel that smooths extrusion directions over a patch
 
 
 @dataclass(frozen=True)
@@ -54,31 +52,6 @@ class CartilageLayer:
     wedges: np.ndarray
 
 
-def _vertices(v, name: str) -> np.ndarray:
-    v = np.asarray(v, dtype=np.float64)
-    if v.ndim != 2 or v.shape[1] != 3:
-        raise MeshError(f"vertices of {name} must have shape (n, 3), but got {v.shape}.")
-    if not np.isfinite(v).all():
-        raise MeshError(f"vertices of {name} must be finite, but {int((~np.isfinite(v)).any(axis=1).sum())} are not.")
-    return np.ascontiguousarray(v)
-
-
-def _faces(f, n_vertices: int, name: str) -> np.ndarray:
-    f = np.asarray(f)
-    if f.ndim != 2 or f.shape[1] != 3 or not np.issubdtype(f.dtype, np.integer):
-        raise MeshError(f"faces of {name} must be integers of shape (m, 3), but got {f.dtype} {f.shape}.")
-    if f.size and (f.min() < 0 or f.max() >= n_vertices):
-        raise MeshError(f"faces of {name} must index 0..{n_vertices - 1}, but span {f.min()}..{f.max()}.")
-    return np.ascontiguousarray(f, dtype=np.int64)
-
-
-def _mask(m, n_vertices: int, name: str) -> np.ndarray:
-    m = np.asarray(m)
-    if m.dtype != bool or m.shape != (n_vertices,):
-        raise InputError(f"coverage of {name} must be bool of shape ({n_vertices},), but got {m.dtype} {m.shape}.")
-    return m
-
-
 def _articulations(vertices: dict, faces: dict, articulations: dict) -> tuple[dict, dict, dict]:
     """Validated copies of the inputs, restricted to the bones of the articulations."""
     bones = sorted({bone for pair in articulations for bone in pair})
@@ -93,52 +66,6 @@ def _articulations(vertices: dict, faces: dict, articulations: dict) -> tuple[di
             raise InputError(f"an articulation must join two bones, but got ({a!r}, {b!r}).")
         arts[(a, b)] = (_mask(mask_a, len(v[a]), f"{a} in {a}-{b}"), _mask(mask_b, len(v[b]), f"{b} in {a}-{b}"))
     return v, f, arts
-
-
-def gap_to(
-    vertices_a: ArrayLike, cover_a: ArrayLike, vertices_b: ArrayLike, faces_b: ArrayLike, cover_b: ArrayLike
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Gap from each covered vertex of A to B's covered triangles (all three vertices covered).
-
-    Returns distance (n_cov,) mm, closest points (n_cov, 3) mm and face ids (n_cov,) into `faces_b`.
-    """
-    va, vb = _vertices(vertices_a, "A"), _vertices(vertices_b, "B")
-    fb = _faces(faces_b, len(vb), "B")
-    cover_a, cover_b = _mask(cover_a, len(va), "A"), _mask(cover_b, len(vb), "B")
-    face_ids = np.flatnonzero(cover_b[fb].all(axis=1))
-    if face_ids.size == 0:
-        raise InputError(f"`cover_b` must cover at least one triangle of B, but covers 0 of {len(fb)}.")
-    d2, i, closest = igl.point_mesh_squared_distance(va[cover_a], vb, fb[face_ids])
-    return np.sqrt(d2), closest, face_ids[i]
-
-
-def grnn_smooth(
-    points: ArrayLike, values: ArrayLike, bandwidth_mm: float, query: ArrayLike | None = None
-) -> np.ndarray:
-    """Generalized regression neural network (Gaussian-kernel Nadaraya–Watson) estimate at `query`.
-
-    points: (n, 3) mm; values: (n,) or (n, k); query: (q, 3) mm, default `points`; bandwidth_mm:
-    kernel σ. The kernel is cut at 3σ; a query with no point within 3σ takes its nearest point's
-    value. Returns an array of shape (q,) or (q, k).
-    """
-    if not bandwidth_mm > 0:
-        raise InputError(f"`bandwidth_mm > 0` must hold, but got {bandwidth_mm=}.")
-    points = _vertices(points, "points")
-    values = np.asarray(values, dtype=np.float64)
-    if values.ndim not in (1, 2) or len(values) != len(points):
-        raise InputError(f"`values` must have shape ({len(points)},) or ({len(points)}, k), but got {values.shape}.")
-    query = points if query is None else _vertices(query, "query")
-    tree = cKDTree(points)
-    pairs = cKDTree(query).sparse_distance_matrix(tree, 3.0 * bandwidth_mm, output_type="ndarray")
-    w = np.exp(-0.5 * (pairs["v"] / bandwidth_mm) ** 2)
-    kernel = scipy.sparse.csr_array((w, (pairs["i"], pairs["j"])), shape=(len(query), len(points)))
-    weight = kernel.sum(axis=1)
-    out = kernel @ values
-    alone = weight == 0
-    out[~alone] = (out[~alone].T / weight[~alone]).T
-    if alone.any():
-        out[alone] = values[tree.query(query[alone])[1]]
-    return out
 
 
 def thickness_fields(
@@ -176,61 +103,6 @@ def thickness_fields(
             t = np.clip(smooth, min_thickness_mm, max_thickness_mm)
             thickness[me][cover_me] = np.maximum(thickness[me][cover_me], t)
     return thickness
-
-
-def vertex_normals(vertices: ArrayLike, faces: ArrayLike) -> np.ndarray:
-    """Area-weighted unit vertex normals, shape (n, 3); zero at vertices no face uses."""
-    v = _vertices(vertices, "mesh")
-    normals = igl.per_vertex_normals(v, _faces(faces, len(v), "mesh"), igl.PER_VERTEX_NORMALS_WEIGHTING_TYPE_AREA)
-    return np.nan_to_num(normals)
-
-
-def extrusion_directions(
-    vertices: ArrayLike, faces: ArrayLike, covered: ArrayLike, *, smoothing_mm: float = NORMAL_SMOOTHING_MM
-) -> np.ndarray:
-    """Unit extrusion directions, shape (n, 3): area-weighted vertex normals, smoothed over the
-    covered vertices (bool (n,)) by a Gaussian kernel of σ = `smoothing_mm` (0: no smoothing)."""
-    v = _vertices(vertices, "mesh")
-    normals = vertex_normals(v, faces)
-    covered = np.asarray(covered, dtype=bool)
-    if smoothing_mm > 0 and covered.sum() > 1:
-        smooth = grnn_smooth(v[covered], normals[covered], smoothing_mm)
-        length = np.linalg.norm(smooth, axis=1, keepdims=True)
-        normals[covered] = np.where(length > 1e-6, smooth / np.maximum(length, 1e-300), normals[covered])
-    return normals
-
-
-def displaced_vertices(
-    vertices: ArrayLike, faces: ArrayLike, thickness: ArrayLike, *, smoothing_mm: float = NORMAL_SMOOTHING_MM
-) -> np.ndarray:
-    """Bone-plus-cartilage vertices, shape (n, 3), mm: each vertex moved outward by its thickness
-    (mm, shape (n,)) along its extrusion direction (see `extrusion_directions`)."""
-    v = _vertices(vertices, "mesh")
-    t = np.asarray(thickness, dtype=np.float64)
-    if t.shape != (len(v),) or not np.isfinite(t).all() or (t < 0).any():
-        raise InputError(
-            f"thickness must be finite, >= 0 and of shape ({len(v)},), but got shape {t.shape}, "
-            f"min {np.min(t, initial=0.0)}."
-        )
-    return v + t[:, None] * extrusion_directions(v, faces, t > 0, smoothing_mm=smoothing_mm)
-
-
-def closed_face_mask(faces: ArrayLike) -> np.ndarray:
-    """Bool (m,): faces of the watertight connected components of a mesh (components joined across
-    edges of exactly two faces; one with an edge of one face, or of more than two, is open)."""
-    f = np.asarray(faces, dtype=np.int64)
-    component = trimesh.graph.connected_component_labels(trimesh.graph.face_adjacency(f), node_count=len(f))
-    edges = np.sort(f[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-    _, edge_id, uses = np.unique(edges, axis=0, return_inverse=True, return_counts=True)
-    open_edge = (uses[edge_id.ravel()] != 2).reshape(-1, 3).any(axis=1)
-    return ~np.isin(component, component[open_edge])
-
-
-def closed_faces(faces: ArrayLike) -> np.ndarray:
-    """Faces of the watertight connected components of a mesh, shape (k, 3); all faces if none is watertight."""
-    f = np.asarray(faces, dtype=np.int64)
-    closed = closed_face_mask(f)
-    return f[closed] if closed.any() else f
 
 
 def _penetration(points, target_vertices, target_faces, target_thickness, reach_mm):

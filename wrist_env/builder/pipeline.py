@@ -11,8 +11,7 @@ import hashlib
 import json
 import os
 import time
-from dataclasses import asdict, dataclass
-from typing import TYPE_CHECKING
+from dataclasses import asdict
 
 import numpy as np
 import trimesh
@@ -22,12 +21,12 @@ from tqdm import tqdm
 from wrist_env.anatomy.annotations import read_annotation_data, template_annotations
 from wrist_env.anatomy.template import closed, load_template
 from wrist_env.builder import cartilage, contact_law, fibres, mass, morph, sdf
+from wrist_env.builder.contact_samples import _contact_samples, _seat_samples
+from wrist_env.builder.params import BuildParams
+from wrist_env.builder.surface import displaced_vertices, extrusion_directions, gap_to, grnn_smooth
 from wrist_env.design import ALL_LIGAMENTS, COLUMN_LIGAMENTS, LIGAMENT_NAMES, LIGAMENTS, RSC_INDEX
 from wrist_env.errors import BuildError
-from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model, offsets
-
-if TYPE_CHECKING:
-    import argparse
+from wrist_env.model import BONES, PAIRS, Model, offsets
 
 BUILDER_VERSION = 6  # 6: the TFCC (the ulna's head closed and gridded, the ulnocarpal pair); 5: the radial column a body of its own (trapezium + trapezoid), its STT and trapeziocapitate contacts and ligaments; 2: distal row and triquetrum as body parts, swept fossae; 3: both by default, TC and TH; 4: the distal row seated (anatomy.midcarpal)
 BUILD_STEPS = ("morph", "cartilage", "ligaments", "contact_law", "grids", "mass")  # timed in the report
@@ -37,7 +36,6 @@ TFCC = "ulnocarpal"
 between the ulnar head and the lunate and triquetrum (Palmer & Werner 1981), so the disc is a layer
 on the ulnar head as thick as that space at neutral (`tfcc_thickness`), under the cartilage law."""
 MIN_SITE_VERTICES = 8
-SEAT_ITERATIONS = 6  # `_seat_samples`: the TFCC's domed layer needs more than the cartilage's 3
 JOINT_SPACE_MM = {art: (0.3, 4.0) for art in PAIRS} | {"scapholunate": (0.3, 8.0)}
 """Plausible neutral joint space per articulation (mm; the median bone-to-bone gap over its cartilage
 coverage, `cartilage.build_cartilage`). Normal radiocarpal and intercarpal spaces are ~1.5–2 mm
@@ -46,74 +44,6 @@ built-in P1–P3 1.5–2.5 mm. The bounds leave room for variation and disease: 
 fits; a scapholunate gap over 3–4 mm is a dissociation, so that one may reach 8 mm. Outside them the
 bones do not sit as the template's do: right-hand meshes declared left measured 13–16 mm in three or
 four articulations (issue 11)."""
-
-
-@dataclass(frozen=True)
-class BuildParams:
-    """Build parameters (all lengths mm)."""
-
-    contact_spacing_mm: float = 1.0
-    grid_spacing_mm: float = 0.5
-    grid_margin_mm: float = 3.0
-    grnn_bandwidth_mm: float = 1.0
-    max_thickness_mm: float = 1.1
-    min_total_thickness_mm: float = 0.2
-    membrane_along: int = 9
-    membrane_across: int = 5
-    seed: int = 0
-    fossa_sweep_deg: tuple = (20.0, 10.0)
-    """(flexion, deviation) half-ranges, deg, of the row's sweep that shapes the radius fossae
-    ((0, 0): moulded to the neutral row; see `anatomy.radius_cap`)."""
-    distal_row: bool = True
-    """The triquetrum moves with the lunate and the trapezium, trapezoid and hamate with the
-    capitate, bringing the STT and triquetrohamate contacts (`model.BODY_PARTS`) and the fixed
-    TC and TH ligaments (`design.FIXED_LIGAMENTS`); participant folders get these bones from
-    the template (`anatomy.template.carry_parts`)."""
-    fixed_ligaments: bool = True
-    """Build the fixed TC and TH with the distal row (False: the lunate body is tied to the
-    distal row by contact alone; for studying what they do)."""
-
-    @property
-    def anatomy(self) -> tuple:
-        """The template variant of these parameters: (fossa_sweep_deg, distal_row)."""
-        return (tuple(float(a) for a in self.fossa_sweep_deg), bool(self.distal_row))
-
-
-def add_anatomy_arguments(parser: argparse.ArgumentParser) -> None:
-    """Add the anatomy-variant options (`--fossa-sweep`, `--no-distal-row`) to an argparse parser."""
-    d = BuildParams()
-    parser.add_argument(
-        "--fossa-sweep",
-        nargs=2,
-        type=float,
-        default=d.fossa_sweep_deg,
-        metavar=("FLEXION", "DEVIATION"),
-        help="anatomy variant: radius fossae as the envelope of the row swept +-these angles (deg); "
-        f"0 0 moulds them to the neutral row (default {d.fossa_sweep_deg[0]:g} "
-        f"{d.fossa_sweep_deg[1]:g})",
-    )
-    parser.add_argument(
-        "--no-distal-row",
-        dest="distal_row",
-        action="store_false",
-        help="anatomy variant: the five principal bones alone (no triquetrum, trapezium, trapezoid, "
-        "hamate; no TC/TH ligaments)",
-    )
-    parser.add_argument(
-        "--no-fixed-ligaments",
-        dest="fixed_ligaments",
-        action="store_false",
-        help="anatomy variant: the distal row without the TC and TH ligaments",
-    )
-
-
-def anatomy_params(args: argparse.Namespace) -> BuildParams:
-    """The `BuildParams` of parsed `add_anatomy_arguments` options."""
-    return BuildParams(
-        fossa_sweep_deg=tuple(float(a) for a in args.fossa_sweep),
-        distal_row=bool(args.distal_row),
-        fixed_ligaments=bool(args.fixed_ligaments),
-    )
 
 
 def source_hash(name: str, bones: dict, params: BuildParams) -> str:
@@ -223,93 +153,27 @@ def _ligaments(bones: dict, sites: dict, params: BuildParams):
 
 def tfcc_thickness(bones: dict, thickness: dict, coverage: tuple, bandwidth_mm: float) -> tuple[np.ndarray, dict]:
     """The TFCC as a layer on the ulnar head (`TFCC`): per ulna vertex (mm, zero off its coverage) the
-    distance along its extrusion direction (`cartilage.extrusion_directions`) to the lunate body's
+    distance along its extrusion direction (`surface.extrusion_directions`) to the lunate body's
     cartilage surface (the closest distance where that ray misses or runs beyond the coverage's
     max_gap_mm), smoothed over the patch
-    (`cartilage.grnn_smooth`); and its min/mean/max."""
+    (`surface.grnn_smooth`); and its min/mean/max."""
     a, _, mask_a, mask_b = coverage
     ulna, carpal = (mask_a, mask_b) if a == "ulna" else (mask_b, mask_a)
     head, lunate = bones["ulna"], bones["lunate"]
-    surface = cartilage.displaced_vertices(lunate.vertices, lunate.faces, thickness["lunate"])
-    gap = cartilage.gap_to(head.vertices, ulna, surface, lunate.faces, carpal)[0]
+    surface = displaced_vertices(lunate.vertices, lunate.faces, thickness["lunate"])
+    gap = gap_to(head.vertices, ulna, surface, lunate.faces, carpal)[0]
     origins = head.vertices[ulna]
-    rays = cartilage.extrusion_directions(head.vertices, head.faces, ulna)[ulna]
+    rays = extrusion_directions(head.vertices, head.faces, ulna)[ulna]
     target = trimesh.Trimesh(surface, lunate.faces, process=False)
     hits, ray_ids, _ = target.ray.intersects_location(origins, rays, multiple_hits=False)
     along = np.einsum("ij,ij->i", hits - origins[ray_ids], rays[ray_ids])
     reach = read_annotation_data()["cartilage"][TFCC]["max_gap_mm"]  # a grazing ray leaves the space
     gap[ray_ids] = np.where((along > 0) & (along <= reach), along, gap[ray_ids])
     out = np.zeros(len(head.vertices))
-    out[ulna] = cartilage.grnn_smooth(origins, gap, bandwidth_mm)
+    out[ulna] = grnn_smooth(origins, gap, bandwidth_mm)
     layer = out[ulna]
     report = {k: round(float(f(layer)), 4) for k, f in (("min", np.min), ("mean", np.mean), ("max", np.max))}
     return out, report | {"rays_hit": int(len(ray_ids)), "vertices": int(ulna.sum())}
-
-
-def _vertex_areas(vertices, faces) -> np.ndarray:
-    area = trimesh.triangles.area(vertices[faces])
-    out = np.zeros(len(vertices))
-    np.add.at(out, faces.ravel(), np.repeat(area / 3.0, 3))
-    return out
-
-
-def _thin(points, spacing_mm) -> np.ndarray:
-    """Indices of one point per `spacing_mm` voxel (the one nearest its voxel centre)."""
-    cell = np.floor(points / spacing_mm).astype(np.int64)
-    d = np.linalg.norm(points / spacing_mm - cell - 0.5, axis=1)
-    order = np.lexsort((d, cell[:, 2], cell[:, 1], cell[:, 0]))
-    c = cell[order]
-    first = np.ones(len(order), bool)
-    first[1:] = np.any(c[1:] != c[:-1], axis=1)
-    return order[first], order, np.cumsum(first) - 1
-
-
-def _contact_samples(bones, thickness, coverage, params):
-    """Pair-sorted contact samples on each pair's sample bone (see `Model`)."""
-    pts, nrm, area, h, sizes = [], [], [], [], []
-    paired = sorted({BONES[i] for i in np.unique(PAIR_BONES)})
-    displaced = {b: cartilage.displaced_vertices(bones[b].vertices, bones[b].faces, thickness[b]) for b in paired}
-    for p, art in enumerate(PAIRS):
-        a, b = BONES[PAIR_BONES[p][0]], BONES[PAIR_BONES[p][1]]
-        ca, cb = coverage[art][2], coverage[art][3]
-        if coverage[art][0] != a:
-            ca, cb = cb, ca
-        idx = np.flatnonzero(ca)
-        if len(idx) == 0:
-            raise BuildError(f"articulation {art} has no cartilage coverage on the {a}")
-        mesh = trimesh.Trimesh(displaced[a], bones[a].faces, process=False)
-        vertex_area = _vertex_areas(displaced[a], bones[a].faces)[idx]
-        keep, order, group = _thin(displaced[a][idx], params.contact_spacing_mm)
-        sample_area = np.bincount(group, weights=vertex_area[order])
-        chosen = idx[keep]
-        partner = np.flatnonzero(cb)
-        _, nearest = cKDTree(displaced[b][partner]).query(displaced[a][chosen])
-        total = thickness[a][chosen] + thickness[b][partner[nearest]]
-        pts.append(displaced[a][chosen])
-        nrm.append(mesh.vertex_normals[chosen])
-        area.append(sample_area)
-        h.append(np.maximum(total, params.min_total_thickness_mm))
-        sizes.append(len(chosen))
-    return displaced, np.vstack(pts), np.vstack(nrm), np.concatenate(area), np.concatenate(h), offsets(sizes)
-
-
-def _seat_samples(points, normals, sample_offsets, grids):
-    """Remove what overclosure the grids still see in the neutral pose (interpolation of
-    curved surfaces): each sample inside the opposing grid moves back along its normal.
-
-    Returns the points and the largest correction (mm).
-    """
-    points = points.copy()
-    worst = 0.0
-    for p in range(len(PAIRS)):
-        grid = grids[BONES[PAIR_BONES[p][1]]]
-        sl = slice(sample_offsets[p], sample_offsets[p + 1])
-        for _ in range(SEAT_ITERATIONS):
-            d, _ = sdf.trilinear(grid, points[sl])
-            inside = np.minimum(d, 0.0)
-            worst = max(worst, float(-inside.min()))
-            points[sl] += inside[:, None] * normals[sl]
-    return points, worst
 
 
 def build_model(

@@ -7,7 +7,7 @@ import os
 import sys
 from collections.abc import Sequence
 
-from wrist_env.cli import identification_commands, participant_commands, study_commands
+from wrist_env.cli import figure_commands, identification_commands, participant_commands, study_commands
 from wrist_env.errors import WristEnvError
 from wrist_env.participants import registry
 
@@ -27,6 +27,7 @@ def parser() -> argparse.ArgumentParser:
         return sub.add_parser(name, parents=[folders] if folders_option else [], **kwargs)
 
     participant_commands.add_commands(command)
+    figure_commands.add_commands(command)
     study_commands.add_commands(command)
     identification_commands.add_commands(command)
     return p

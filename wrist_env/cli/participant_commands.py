@@ -1,4 +1,4 @@
-"""`wrist-bench` commands on one participant: participants, build, export, simulate, evaluate, validate, figure."""
+"""`wrist-bench` commands on one participant: participants, build, export, simulate, evaluate."""
 
 from __future__ import annotations
 
@@ -11,32 +11,26 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from wrist_env import design, figures, validation
-from wrist_env.builder.pipeline import BuildParams, add_anatomy_arguments, anatomy_params
+from wrist_env import design
 from wrist_env.cli.options import (
-    PARTICIPANT_HELP,
     json_option,
-    out_option,
     participant_argument,
 )
 from wrist_env.errors import DesignError, ParticipantError, UsageError
-from wrist_env.figures.draw import FIGURES as figures_dir
 from wrist_env.frames import DOF_NAMES, DOF_UNITS
-from wrist_env.io import write_json
 from wrist_env.model import BONES, PAIRS
 from wrist_env.participants import builtin, registry
 from wrist_env.participants.folder import NAME_PATTERN, PARTICIPANT_FILE, write_participant_folder
-from wrist_env.solver import simulate
+from wrist_env.solver import drivers, simulate
 from wrist_env.solver.arrays import SOLVERS, solver_settings
 from wrist_env.solver.outputs import cardan_deg, result_to_dict
-from wrist_env.solver.simulate import DEFAULT_LOADS, IDEALIZED_LOAD_N, LOAD_DIRECTIONS
 from wrist_env.task import task
 from wrist_env.trial import MOTIONS
 
 if TYPE_CHECKING:
     from wrist_env.design import Design
     from wrist_env.model import Model
-    from wrist_env.solver.simulate import Driver
+    from wrist_env.solver.drivers import Driver
 
 FIGURES_HELP = "$WRIST_ENV_FIGURES or runs/figures"  # where wrist_env.figures.draw.FIGURES points
 DESIGN_HELP = (
@@ -132,8 +126,8 @@ def make_driver(model: Model, motion: str, frames: int | None, flexion: float, e
     """The capitate driver of `simulate`: an idealized sweep or the capitate held at neutral."""
 
     if motion == "idealized":
-        return simulate.idealized(model, flexion_deg=flexion, extension_deg=extension, n_frames=frames or 17)
-    return simulate.static(model, frames or 3)
+        return drivers.idealized(model, flexion_deg=flexion, extension_deg=extension, n_frames=frames or 17)
+    return drivers.static(model, frames or 3)
 
 
 def _simulate(args) -> int:
@@ -228,55 +222,6 @@ def _evaluate(args) -> int:
     return 1 if evaluation.failed else 0
 
 
-def _validate(args) -> int:
-
-    registry.require(args.participant)
-    params = anatomy_params(args)
-    report = validation.validate(
-        args.participant,
-        params=params,
-        load_n=IDEALIZED_LOAD_N if args.load is None else args.load,
-        load_direction=args.load_direction,
-        settings=solver_settings(args.solver),
-    )
-    default = (
-        params == BuildParams()
-        and args.load is None
-        and args.load_direction == DEFAULT_LOADS
-        and args.solver == "default"
-    )
-    variant = "" if default else "_variant"
-
-    out = Path(args.out or figures_dir) / f"validation_{report.participant}{variant}.png"
-    figure = validation.validation_figure(report, out)
-    write_json(out.with_suffix(".json"), report.to_dict())  # the record the docs' validation page renders
-    if args.json:
-        print(json.dumps(dict(report.to_dict(), figure=str(figure)), indent=1, allow_nan=False))
-    else:
-        print(validation.format_table(report))
-        print(f"figure: {figure} (and its record, {out.with_suffix('.json').name})")
-    return 0 if report.passed else 1
-
-
-def _figure(args) -> int:
-
-    out = Path(args.out) if args.out else None
-    if args.kind == "model":
-        path = figures.model_figure(args.participant or "P1", out)
-    elif args.kind == "annotations":
-        path = figures.annotations_figure(out)
-    elif args.kind == "pressure":
-        path = figures.pressure_figure(args.participant or "P1", out, static=args.static)
-    elif args.kind == "kinematics":
-        path = figures.kinematics_figure(args.participant or "P1", out)
-    elif args.kind == "animation":
-        path = figures.animation_figure(args.participant or "P1", out)
-    else:
-        raise UsageError(f"unknown figure {args.kind!r}")
-    print(path)
-    return 0
-
-
 def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     """Add these commands; `command(name, **kwargs)` makes a subcommand's parser."""
 
@@ -360,51 +305,3 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     s.add_argument("--design", default="population", help=DESIGN_HELP)
     json_option(s, "the cost, per-DOF errors and timings")
     s.set_defaults(run=_evaluate)
-
-    s = command(
-        "validate",
-        help="check the model against published wrist measurements (exit 1 if any check fails)",
-        description="Simulate the population design (idealized +-40 deg sweep intact and with all three SLIL bundles "
-        "torn, and the capitate held at neutral) and compare carpal kinematics, radiocarpal load share, "
-        "SL gap after SLIL tear, radioscaphoid pressure and SLIL force with published bands (each row "
-        "cites its source). Prints the table (or JSON) and writes a figure and its JSON record; exit status 1 if any check "
-        "fails.",
-    )
-    participant_argument(s)
-    json_option(s, "the checks and series")
-    out_option(s, what=f"figure folder (default {FIGURES_HELP})")
-    add_anatomy_arguments(s)
-    s.add_argument(
-        "--load",
-        type=float,
-        help="compressive load on the capitate in the sweeps, N (default: the idealized "
-        "driver's; the load-share check always takes 100 N)",
-    )
-    s.add_argument(
-        "--load-direction",
-        choices=LOAD_DIRECTIONS,
-        default=DEFAULT_LOADS,
-        help="the loads' direction: along the radius (default), or the resultant at neutral of a tendon "
-        "rig's tensions along myo-sim's tendon paths (Erhart 2020; see anatomy/tendons.py)",
-    )
-    add_solver_argument(s)
-    s.set_defaults(run=_validate)
-
-    s = command(
-        "figure",
-        help="write a figure (PNG)",
-        description="model: bones, cartilage, ligaments; annotations: the template; pressure: "
-        "contact pressure at the neutral pose viewed from distal (population design); "
-        "kinematics: scaphoid and lunate rotations over an idealized sweep; animation: a GIF of that sweep "
-        "(radial view: bones, ligament fibres coloured by force, radiocarpal contact pressure).",
-    )
-    s.add_argument("kind", choices=["model", "annotations", "pressure", "kinematics", "animation"])
-    participant_argument(s, PARTICIPANT_HELP + " (default P1)", nargs="?")
-    out_option(s, what=f"output PNG path (default: a file named after the figure in {FIGURES_HELP})")
-    s.add_argument(
-        "--static",
-        action="store_true",
-        help="pressure: capitate held at neutral without load, instead of the 0° frame of the "
-        "idealized sweep (10 N compressive load)",
-    )
-    s.set_defaults(run=_figure)

@@ -30,7 +30,7 @@ from wrist_env.montecarlo.report import write_report
 from wrist_env.montecarlo.sampler import EXCLUDE_ABOVE_MPA, TEAR_PROBABILITY
 from wrist_env.montecarlo.study import StudyConfig, run_study
 from wrist_env.participants import builtin, registry
-from wrist_env.solver.simulate import DEFAULT_LOADS, LOAD_DIRECTIONS
+from wrist_env.solver.drivers import DEFAULT_LOADS, LOAD_DIRECTIONS
 from wrist_env.trial import TRIAL_MOTIONS
 
 

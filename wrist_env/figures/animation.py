@@ -14,6 +14,7 @@ from wrist_env import design
 from wrist_env.figures import draw
 from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model
 from wrist_env.participants.registry import load_model
+from wrist_env.solver import drivers
 from wrist_env.solver import simulate as sim
 from wrist_env.solver.outputs import pair_slice, pressure_map
 
@@ -52,7 +53,7 @@ def _bone_polygons(surfaces: list, poses_frame: np.ndarray) -> tuple[np.ndarray,
 def animation_figure(name: str, out: Path | None = None, *, n_frames: int = 17, fps: float = 4.0) -> Path:
     """Write a GIF of the population design's idealized sweep of `name` (radial view): returns its path."""
     model = load_model(name)
-    driver = sim.idealized(model, n_frames=n_frames)
+    driver = drivers.idealized(model, n_frames=n_frames)
     result = sim.simulate(model, design.population(), driver)
     if not result.ok:
         raise RuntimeError(f"{name}: the population design's sweep failed ({result.message})")

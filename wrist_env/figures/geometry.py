@@ -11,7 +11,7 @@ from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
 from wrist_env.anatomy.annotations import ARTICULATIONS, template_annotations
 from wrist_env.anatomy.template import load_template
-from wrist_env.builder.pipeline import BuildParams
+from wrist_env.builder.params import BuildParams
 from wrist_env.design import ALL_LIGAMENT_NAMES
 from wrist_env.figures import draw
 from wrist_env.model import BONES

@@ -13,7 +13,7 @@ from wrist_env.figures import draw
 from wrist_env.model import BONES, PAIR_BONES, PAIRS
 from wrist_env.participants import builtin
 from wrist_env.participants.registry import load_model
-from wrist_env.solver import simulate
+from wrist_env.solver import drivers, simulate
 from wrist_env.solver.outputs import cardan_deg, pair_slice, pressure_map
 
 
@@ -74,11 +74,11 @@ def pressure_figure(name: str, out: Path | None = None, *, static: bool = False)
     model = load_model(name)
     out = out or draw.FIGURES / f"pressure_{name}.png"
     if static:
-        driver = simulate.static(model)
+        driver = drivers.static(model)
         frame = len(driver.rotation) - 1
         how = "capitate held at neutral (all 6 DOF), no external load"
     else:
-        driver = simulate.idealized(model)
+        driver = drivers.idealized(model)
         frame = int(np.argmin(np.abs(driver.angle_deg)))
         load = getattr(driver, "load_n", None)
         how = (
@@ -219,7 +219,7 @@ def kinematics_figure(name: str, out: Path | None = None, *, n_frames: int = 17)
 
     model = load_model(name)
     out = out or draw.FIGURES / f"kinematics_{name}.png"
-    driver = simulate.idealized(model, n_frames=n_frames)
+    driver = drivers.idealized(model, n_frames=n_frames)
     runs = [("population", design.population(), "-")]
     if name in builtin.BUILTIN:
         runs.append(("hidden truth", builtin.truth(name), "--"))

@@ -5,6 +5,8 @@
 Figures 8–10 from the log (`wrist-bench montecarlo-report`).
 """
 
-from wrist_env.montecarlo.study import StudyConfig, StudyError, read_runs, run_study
+from wrist_env.montecarlo.config import StudyConfig, StudyError
+from wrist_env.montecarlo.log import read_runs
+from wrist_env.montecarlo.study import run_study
 
 __all__ = ["StudyConfig", "StudyError", "read_runs", "run_study"]

@@ -19,7 +19,9 @@ import numpy as np
 
 from wrist_env.io import write_json
 from wrist_env.montecarlo import figures, stats
-from wrist_env.montecarlo.study import StudyError, config_of, counts, read_runs
+from wrist_env.montecarlo.config import StudyError
+from wrist_env.montecarlo.log import read_runs
+from wrist_env.montecarlo.study import config_of, counts
 
 PREPRINT = {
     "mean_pressure_mpa": 0.65,

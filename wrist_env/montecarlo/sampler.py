@@ -41,7 +41,7 @@ from wrist_env import design
 from wrist_env.design import INJURABLE, LIGAMENT_NAMES, N_DESIGN, N_MATERIAL, NAMES, SPAN_SD
 from wrist_env.errors import DesignError
 from wrist_env.participants import registry
-from wrist_env.solver.simulate import DEFAULT_LOADS
+from wrist_env.solver.drivers import DEFAULT_LOADS
 from wrist_env.task import task
 
 if TYPE_CHECKING:
@@ -168,7 +168,7 @@ def run_chunk(
 
     Runs wherever it is called: in this process, a local worker process or a dask worker
     (`folders`: user participant folders to register there first). load_direction: the sweep's
-    load (`simulate.LOAD_DIRECTIONS`).
+    load (`drivers.LOAD_DIRECTIONS`).
     """
     if folders:
         for folder in folders:

@@ -29,7 +29,6 @@ process), or on a `dask.distributed` scheduler (`scheduler="tcp://…"`, or a
 
 from __future__ import annotations
 
-import json
 import time
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import asdict, dataclass, field
@@ -37,71 +36,27 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-import pyarrow as pa
-import pyarrow.compute as pc
-import pyarrow.parquet as pq
 
-from wrist_env.errors import StoreError, WristEnvError
-from wrist_env.io import read_json, write_json
-from wrist_env.limits import MAX_BATCH, MAX_RUNS, MAX_SEED, MAX_WORKERS, check_int, check_unique
+from wrist_env.limits import MAX_BATCH, MAX_WORKERS, check_int
 from wrist_env.montecarlo import sampler
+from wrist_env.montecarlo.config import StudyConfig, StudyError
+from wrist_env.montecarlo.log import (
+    RERUN,
+    RUNS,
+    _manifest,
+    check_settings,
+    part_name,
+    read_manifest,
+    read_runs,
+    repair,
+    runs_log,
+    with_settings,
+)
 from wrist_env.participants import registry
 from wrist_env.runs.executor import executor
-from wrist_env.runs.store import RunStore
-from wrist_env.solver.simulate import DEFAULT_LOADS, LOAD_DIRECTIONS
 
 if TYPE_CHECKING:
     from distributed import Client
-
-MANIFEST = "study.json"
-RUNS = "runs"
-VERSION = 1
-
-
-class StudyError(WristEnvError):
-    """A study that cannot run: a folder holding another study, a duplicated run, no successes."""
-
-
-@dataclass(frozen=True)
-class StudyConfig:
-    """What a study is: these decide every run (how it is run does not)."""
-
-    participants: tuple[str, ...]
-    n: int
-    seed: int = 0
-    tear_probability: float = sampler.TEAR_PROBABILITY
-    exclude_above_mpa: float = sampler.EXCLUDE_ABOVE_MPA
-    max_attempts: int | None = None
-    """Give up (StudyError) after this many runs of one participant; default 5 n + 100."""
-    load_direction: str = DEFAULT_LOADS
-    """The sweeps' load direction (`simulate.LOAD_DIRECTIONS`): along the radius, or a tendon rig's."""
-
-    def __post_init__(self):
-        object.__setattr__(self, "participants", tuple(self.participants))
-        if not self.participants:
-            raise StudyError("a study needs at least one participant")
-        check_unique("participants", self.participants)
-        check_int("n", self.n, 1, MAX_RUNS, "a round's draws are held in memory")
-        check_int("seed", self.seed, 0, MAX_SEED)
-        if not 0.0 <= self.tear_probability <= 1.0:
-            raise StudyError(f"tear_probability must be in [0, 1], but got {self.tear_probability}")
-        if self.load_direction not in LOAD_DIRECTIONS:
-            raise StudyError(f"load_direction must be one of {LOAD_DIRECTIONS}, but got {self.load_direction!r}")
-
-    @property
-    def attempt_limit(self) -> int:
-        return int(self.max_attempts) if self.max_attempts is not None else 5 * int(self.n) + 100
-
-    def key(self) -> dict:
-        """The fields that must match to resume a study in the same folder (the load direction only when
-        not the axial default, so that a study logged before it existed resumes)."""
-        return {
-            "version": VERSION,
-            "n": int(self.n),
-            "seed": int(self.seed),
-            "tear_probability": float(self.tear_probability),
-            "exclude_above_mpa": float(self.exclude_above_mpa),
-        } | ({} if self.load_direction == "axial" else {"load_direction": self.load_direction})
 
 
 @dataclass
@@ -149,157 +104,6 @@ class StudySummary:
             f"excluded {self.excluded} ({100 * self.excluded / max(self.attempts, 1):.2f} %), "
             f"failed {self.failed} ({100 * self.failed / max(self.attempts, 1):.2f} %) of {self.attempts} runs; {per}"
         )
-
-
-# ---------------------------------------------------------------------------- the log
-
-
-RERUN = "rerun the montecarlo command (same arguments) to simulate its runs again"
-
-
-def runs_log(out: str | Path) -> RunStore:
-    """The study's run store (parts in `<out>/runs`)."""
-    return RunStore(Path(out), parts=RUNS)
-
-
-SETTINGS = b"wrist_env.study"
-"""The Parquet metadata key under which every part records the settings it was made with (`StudyConfig.key`)."""
-
-
-def with_settings(table: pa.Table, config: StudyConfig) -> pa.Table:
-    """A chunk's rows with the study's settings in their metadata (so a part says what made it)."""
-    return table.replace_schema_metadata({SETTINGS: json.dumps(config.key(), sort_keys=True)})
-
-
-def part_settings(store: RunStore, name: str) -> dict | None:
-    """The settings a part was made with (None: written before parts recorded them); StoreError if
-    the part cannot be read."""
-    path = store.part_path(name)
-    try:
-        raw = (pq.read_schema(path).metadata or {}).get(SETTINGS)
-        return None if raw is None else json.loads(raw)
-    except (OSError, pa.ArrowException, ValueError) as e:
-        raise StoreError(f"{path}: damaged Parquet part ({type(e).__name__}); {RERUN}") from None
-
-
-def _differences(old: dict, key: dict) -> str:
-    old, key = _settings(old), _settings(key)
-    return ", ".join(f"{k} {old[k]!r} (asked {key[k]!r})" for k in sorted(key) if old[k] != key[k])
-
-
-def check_settings(out: str | Path, config: StudyConfig) -> None:
-    """StudyError if a logged part was made under other settings than `config`'s, or if neither its
-    parts nor `study.json` say what they were made with (damaged parts are left to `repair`)."""
-    out, key = Path(out), config.key()
-    store, unrecorded = runs_log(out), []
-    for name in store.part_names():
-        try:
-            settings = part_settings(store, name)
-        except StoreError:
-            continue
-        if settings is None:
-            unrecorded.append(name)
-        elif _settings(settings) != _settings(key):
-            raise StudyError(
-                f"{store.part_path(name)}: its runs were made with other settings ({_differences(settings, key)}); "
-                "use another --out or the same settings"
-            )
-    if unrecorded and not (out / MANIFEST).is_file():
-        raise StudyError(
-            f"{out}: {len(unrecorded)} parts (first {unrecorded[0]}.parquet) do not record their settings and there "
-            f"is no {MANIFEST} to say them; restore it, or use another --out"
-        )
-
-
-def repair(out: str | Path) -> int:
-    """Before a run: remove killed writers' temporary files and move to `<out>/damaged/` every damaged
-    part and every part that is not where the study writes it (a copy, or runs logged twice); their
-    runs are then missing, and simulated again. Returns the parts moved."""
-    store = runs_log(out)
-    store.clean(min_age_s=0.0)  # the caller holds the store lock: no live writer
-    damaged = [
-        (n, "damaged Parquet part, its runs are simulated again") for n, _ in store.damaged_parts(sampler.SCHEMA)
-    ]
-    return sum(store.quarantine(store.part_path(n), why) is not None for n, why in damaged + _stray_parts(store))
-
-
-def _stray_parts(store: RunStore) -> list[tuple[str, str]]:
-    """(name, reason) of the readable parts whose runs are not the ones their name says (a copy under
-    another name) or were logged by an earlier part."""
-    seen: dict[str, set[int]] = {}
-    out = []
-    for name in store.part_names():
-        try:
-            cols = store.read_part(name, columns=["participant", "sample_id"]).to_pydict()
-        except StoreError:
-            continue  # damaged: moved by `repair`
-        ids, participants = tuple(cols["sample_id"]), set(cols["participant"])
-        p = next(iter(participants)) if len(participants) == 1 else None
-        if p is None or not ids or ids != tuple(range(ids[0], ids[0] + len(ids))) or part_name(p, ids) != name:
-            out.append((name, "its runs are not the ones its name says (a copy?); moved aside, not used"))
-        elif seen.setdefault(p, set()) & set(ids):
-            out.append((name, "repeats runs an earlier part logged; moved aside, not used"))
-        else:
-            seen[p].update(ids)
-    return out
-
-
-def read_runs(out: str | Path, columns: list[str] | None = None) -> pa.Table | None:
-    """Every logged run of the study in `out`, sorted by (participant, sample_id); None if empty.
-    StudyError naming both parts if a run is logged twice; StoreError naming a damaged part."""
-    store = runs_log(out)
-    names = store.part_names()
-    if not names:
-        return None
-    tables = [store.read_part(n, sampler.SCHEMA, columns, RERUN) for n in names]
-    table = pa.concat_tables(tables)
-    keys = ["participant", "sample_id"]
-    if columns is not None and not set(keys) <= set(columns):
-        return table
-    order = pc.sort_indices(table, sort_keys=[(k, "ascending") for k in keys])
-    table = table.take(order)
-    source = np.repeat(np.arange(len(names)), [t.num_rows for t in tables])[order.to_numpy()]
-    p, s = table["participant"].to_numpy(zero_copy_only=False), table["sample_id"].to_numpy()
-    dup = (p[1:] == p[:-1]) & (s[1:] == s[:-1])
-    if dup.any():
-        i = int(np.flatnonzero(dup)[0])
-        first, second = sorted((names[source[i]], names[source[i + 1]]))
-        raise StudyError(
-            f"{store.part_path(second)}: run {p[i]} #{s[i]} is logged twice (also in {first}.parquet); "
-            "rerun the montecarlo command (same arguments) to move the copy aside"
-        )
-    return table
-
-
-def _settings(key: dict) -> dict:
-    """A study key's fields with the load direction filled in (a key leaves out the axial default)."""
-    fields = set(StudyConfig(("-",), 1).key()) | {"load_direction"}
-    return {k: key.get(k, "axial" if k == "load_direction" else None) for k in fields}
-
-
-def _manifest(out: Path, config: StudyConfig) -> None:
-    path = out / MANIFEST
-    key = config.key()
-    participants = list(config.participants)
-    if path.is_file():
-        old = read_json(path, "study manifest", "it records the study's settings: restore it, or use another --out")
-        if _settings(old) != _settings(key):
-            raise StudyError(
-                f"{out} holds another study ({_differences(old, key)}); use another --out or the same settings"
-            )
-        participants = list(old.get("participants", [])) + [
-            p for p in participants if p not in old.get("participants", [])
-        ]
-        if participants == old.get("participants"):
-            return
-    write_json(path, {**key, "participants": participants})
-
-
-def read_manifest(out: str | Path) -> dict:
-    path = Path(out) / MANIFEST
-    if not path.is_file():
-        raise StudyError(f"{out} holds no Monte Carlo study (no {MANIFEST})")
-    return read_json(path, "study manifest", "it records the study's settings: restore it, or use another --out")
 
 
 # ---------------------------------------------------------------------------- rounds
@@ -355,10 +159,6 @@ def _chunks(ids: tuple[int, ...], batch: int) -> Iterator[tuple[int, ...]]:
         run.append(i)
     if run:
         yield tuple(run)
-
-
-def part_name(participant: str, ids: tuple[int, ...]) -> str:
-    return f"{participant}-{ids[0]:07d}-{ids[-1] + 1:07d}"
 
 
 # ---------------------------------------------------------------------------- the study

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from wrist_env.anatomy.template import BoneSurface, load_template
-from wrist_env.builder.pipeline import BuildParams
+from wrist_env.builder.params import BuildParams
 from wrist_env.builder.warp import Warp
 from wrist_env.design import Design
 from wrist_env.errors import ParticipantError

@@ -13,11 +13,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from wrist_env.anatomy.template import BoneSurface, carry_parts, load_template
-from wrist_env.builder.pipeline import BuildParams, build_model, source_hash
+from wrist_env.builder.params import BuildParams
+from wrist_env.builder.pipeline import build_model, source_hash
 from wrist_env.errors import BuildError, ParticipantError, StoreError
 from wrist_env.model import BONES, Model
 from wrist_env.participants import builtin
-from wrist_env.participants.folder import load_participant_folder, solid_mask
+from wrist_env.participants import folder as folder_module  # by module: tests count its reads
+from wrist_env.participants.bone_mesh import solid_mask
 
 if TYPE_CHECKING:
     from wrist_env.trial import Trial
@@ -59,7 +61,7 @@ def add_folder(folder: str | Path) -> str:
 
     The folder is read and checked once, here: edit its files, then add it again."""
 
-    source = load_participant_folder(folder)
+    source = folder_module.load_participant_folder(folder)
     if source.name in builtin.BUILTIN:
         raise ParticipantError(
             f"{Path(folder) / 'participant.toml'}: name {source.name!r} is taken by a built-in participant"

@@ -17,7 +17,7 @@ none and are read unchecked. A damaged part or record (truncated, empty,
 garbage, or not the bytes it was written with) is a `StoreError` naming the
 file and what to do; the studies move such files to `damaged/` on resume and redo their work.
 Nothing here knows what a row means: `wrist_env.bench.log` (the benchmark's
-evaluations) and `wrist_env.montecarlo.study` (the Monte Carlo runs) do.
+evaluations) and `wrist_env.montecarlo.log` (the Monte Carlo runs) do.
 """
 
 from __future__ import annotations

@@ -20,9 +20,9 @@ from scipy.optimize import least_squares
 from wrist_env.design import Design
 from wrist_env.model import CAPITATE, FREE, Model
 from wrist_env.solver import arrays, kernel, preconditioner
-from wrist_env.solver.kernel import LEVER_MM
-from wrist_env.solver.rigid import pose_state, pose_translation, rotate_in_place
+from wrist_env.solver.rigid import LEVER_MM, pose_state, pose_translation, rotate_in_place
 from wrist_env.solver.simulate import prepare, stiffness
+from wrist_env.solver.tangent import tangent
 
 JACOBIAN_STEP = 1e-6  # finite-difference step of the Jacobian (rad, mm)
 MAX_EVALUATIONS = 60  # residual evaluations per frame (each with a Jacobian): where contact stalls it, stop
@@ -283,7 +283,7 @@ def block_mass(
     load = driver.kernel_load(frame)
     kernel._forces(state, work, p.bodies, g, p.law, p.fibres, st, p.membrane, p.settings, load, True)
     m = preconditioner.metric()
-    preconditioner.tangent(
+    tangent(
         state.R,
         state.x,
         state.nodes,

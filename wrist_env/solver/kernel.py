@@ -5,7 +5,7 @@ quasi-static answer. The radius and ulna are fixed, the free bodies (`model.FREE
 free in 6 DOF, the capitate driven (all 6 DOF prescribed, or, for the
 loaded driver, rotations prescribed and translations free under its
 loads), the RSC membrane's interior nodes free point masses; the driver's
-loads are lines of action on the bodies (`simulate.Loads`).
+loads are lines of action on the bodies (`drivers.Loads`).
 The free bones' masses are their (scaled) physical ones or, with
 `Settings.block_mass`, one block each from the tangent stiffness
 (`preconditioner`): the answer is the same equilibrium, reached in fewer steps.
@@ -19,7 +19,7 @@ import numpy as np
 from numba import njit, prange
 
 from wrist_env.design import ALL_LIGAMENT_NAMES, RSC_INDEX
-from wrist_env.model import BONES, CAPITATE, FREE, PAIRS, TRAPEZIUM
+from wrist_env.model import BONES, CAPITATE, FREE, PAIRS
 from wrist_env.solver.arrays import EXPERIMENTAL, LOADED
 from wrist_env.solver.forces import (
     C_AREA,
@@ -32,118 +32,25 @@ from wrist_env.solver.forces import (
     apply_force,
     contact_forces,
     fibre_forces,
-    membrane_forces,
-    place_nodes,
     to_world,
 )
-from wrist_env.solver.membrane import new_scratch, substep
-from wrist_env.solver.preconditioner import SOLVED, block_mass, dof, metric, tangent
+from wrist_env.solver.integrator import fire_step, kinetic_energy, move_blocks, move_diagonal
+from wrist_env.solver.membrane import membrane_forces, new_scratch, place_nodes, substep
+from wrist_env.solver.preconditioner import SOLVED, block_mass, metric
 from wrist_env.solver.predictor import capitate_move, history, predict, record
 from wrist_env.solver.rigid import (
-    LEVER_MM,
     interpolate_pose,
     matrix_to_rotvec,
     orthonormalize,
-    rotate_in_place,
     smoothstep,
 )
+from wrist_env.solver.stopping import converged, displacement, residual
+from wrist_env.solver.tangent import tangent
 
 N_BONES, N_PAIRS = len(BONES), len(PAIRS)
 N_LIGAMENTS = len(ALL_LIGAMENT_NAMES)
 RSC = RSC_INDEX
 OK, FAILED_NAN, FAILED_DIVERGED = 0, 1, 2
-
-
-FIRE_F_ALPHA, FIRE_N_MIN = 0.99, 5
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def _mix(vel, force, a):
-    """FIRE mixing of one velocity group (rows of `vel`) towards its force direction."""
-    vn = 0.0
-    fn = 0.0
-    for i in range(vel.shape[0]):
-        for k in range(3):
-            vn += vel[i, k] * vel[i, k]
-            fn += force[i, k] * force[i, k]
-    if fn > 0.0:
-        c = a * np.sqrt(vn / fn)
-        for i in range(vel.shape[0]):
-            for k in range(3):
-                vel[i, k] = (1.0 - a) * vel[i, k] + c * force[i, k]
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def _force_of(F, T, b, i):
-    """Generalized force of body b's unknown i (`preconditioner.dof`): F (N) then T (N·mm)."""
-    return F[b, i] if i < 3 else T[b, i - 3]
-
-
-@njit(cache=True, error_model="numpy")
-def _mix_metric(v, w, F, T, st, m, a):
-    """FIRE mixing of each free body's velocity (v; w) towards M⁻¹(F; T) in the block mass's metric
-    (preconditioned FIRE): u ← (1 − a)·u + a·|u|_M·M⁻¹g / |M⁻¹g|_M."""
-    M, Minv = m.mass, m.inverse
-    for b in SOLVED:
-        i0, nb = dof(st, b)
-        if i0 < 0:
-            continue
-        vn = 0.0
-        fn = 0.0
-        for i in range(nb):
-            ui = v[b, i] if i < 3 else w[b, i - 3]
-            gi = _force_of(F, T, b, i)
-            for j in range(nb):
-                uj = v[b, j] if j < 3 else w[b, j - 3]
-                vn += ui * M[i0 + i, i0 + j] * uj
-                fn += gi * Minv[i0 + i, i0 + j] * _force_of(F, T, b, j)
-        if fn <= 0.0:
-            continue
-        c = a * np.sqrt(max(vn, 0.0) / fn)
-        for i in range(nb):
-            di = 0.0
-            for j in range(nb):
-                di += Minv[i0 + i, i0 + j] * _force_of(F, T, b, j)
-            if i < 3:
-                v[b, i] = (1.0 - a) * v[b, i] + c * di
-            else:
-                w[b, i - 3] = (1.0 - a) * w[b, i - 3] + c * di
-
-
-@njit(cache=True, error_model="numpy")
-def _fire(v, w, nv, F, T, node_force, mem, st, fire, m):
-    """FIRE relaxation (Bitzek et al. 2006) at a fixed step: mix velocities towards the
-    forces while the power is positive, stop everything when it turns negative.
-    fire = [alpha, steps with positive power, 1 after a restart (the caller clears it)]."""
-    power = 0.0
-    for k in range(3):
-        for b in FREE:
-            power += F[b, k] * v[b, k] + T[b, k] * w[b, k]
-        if st.driver == LOADED:
-            power += F[CAPITATE, k] * v[CAPITATE, k]
-        for i in range(nv.shape[0]):
-            power += node_force[i, k] * nv[i, k]
-    if power > 0.0:
-        a = fire[0]
-        if st.block_mass:
-            _mix_metric(v, w, F, T, st, m, a)
-        else:
-            for b in FREE:
-                _mix(v[b : b + 1], F[b : b + 1], a)
-                _mix(w[b : b + 1], T[b : b + 1], a)
-            if st.driver == LOADED:
-                _mix(v[CAPITATE : CAPITATE + 1], F[CAPITATE : CAPITATE + 1], a)
-        _mix(nv, node_force, a)
-        fire[1] += 1.0
-        if fire[1] > FIRE_N_MIN:
-            fire[0] *= FIRE_F_ALPHA
-    else:
-        v[:] = 0.0
-        w[:] = 0.0
-        nv[:] = 0.0
-        fire[0] = st.fire_alpha0
-        fire[1] = 0.0
-        fire[2] = 1.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -216,13 +123,13 @@ def _step(
         tangent(R, x, nodes, bod.com0, grids, law, fib, stiffness, mem, st, active, n_active, m)
         block_mass(R, bod, st, m)
     if st.fire_alpha0 > 0.0:
-        _fire(v, w, nv, F, T, node_force, mem, st, fire, m)
+        fire_step(v, w, nv, F, T, node_force, mem, st, fire, m)
     dt = st.dt
     lin = 1.0 / (1.0 + st.damping * dt)
     if st.block_mass:
-        _move_blocks(R, x, v, w, F, T, st, m)
+        move_blocks(R, x, v, w, F, T, st, m)
     else:
-        _move_diagonal(R, x, v, w, F, T, bod, st)
+        move_diagonal(R, x, v, w, F, T, bod, st)
     if stiffness.node_mass > 0.0:
         for i in range(nodes.shape[0]):
             if mem.bone[i] < 0:
@@ -238,113 +145,6 @@ def _step(
 
 
 @njit(cache=True, error_model="numpy")
-def _move_diagonal(R, x, v, w, F, T, bod, st):
-    """Semi-implicit Euler of the free bodies under their (scaled) mass and inertia, with
-    mass-proportional damping."""
-    dt = st.dt
-    lin = 1.0 / (1.0 + st.damping * dt)
-    rot = 1.0 / (1.0 + st.rot_damping * dt)
-    for b in FREE:
-        for k in range(3):
-            v[b, k] = (v[b, k] + dt * bod.inv_mass[b] * F[b, k]) * lin
-            x[b, k] += dt * v[b, k]
-        # angular acceleration R I⁻¹ Rᵀ T, world frame
-        Rb, J = R[b], bod.inv_inertia[b]
-        u0 = Rb[0, 0] * T[b, 0] + Rb[1, 0] * T[b, 1] + Rb[2, 0] * T[b, 2]
-        u1 = Rb[0, 1] * T[b, 0] + Rb[1, 1] * T[b, 1] + Rb[2, 1] * T[b, 2]
-        u2 = Rb[0, 2] * T[b, 0] + Rb[1, 2] * T[b, 1] + Rb[2, 2] * T[b, 2]
-        a0 = J[0, 0] * u0 + J[0, 1] * u1 + J[0, 2] * u2
-        a1 = J[1, 0] * u0 + J[1, 1] * u1 + J[1, 2] * u2
-        a2 = J[2, 0] * u0 + J[2, 1] * u1 + J[2, 2] * u2
-        for k in range(3):
-            w[b, k] = (w[b, k] + dt * (Rb[k, 0] * a0 + Rb[k, 1] * a1 + Rb[k, 2] * a2)) * rot
-        rotate_in_place(Rb, w[b, 0] * dt, w[b, 1] * dt, w[b, 2] * dt)
-    if st.driver == LOADED:
-        for k in range(3):
-            v[CAPITATE, k] = (v[CAPITATE, k] + dt * bod.inv_mass[CAPITATE] * F[CAPITATE, k]) * lin
-            x[CAPITATE, k] += dt * v[CAPITATE, k]
-
-
-@njit(cache=True, error_model="numpy")
-def _move_blocks(R, x, v, w, F, T, st, m):
-    """Semi-implicit Euler of the free bodies under the block mass: u ← u + dt·M⁻¹g (FIRE damps it),
-    the velocity cut where a body's step would move it more than st.block_max_move_mm (its shift
-    plus its rotation × LEVER_MM): the mass is a linearization, and a contact that closes between
-    refreshes is stiffer than it says."""
-    dt = st.dt
-    Minv = m.inverse
-    for b in SOLVED:
-        i0, nb = dof(st, b)
-        if i0 < 0:
-            continue
-        for i in range(nb):
-            acc = 0.0
-            for j in range(nb):
-                acc += Minv[i0 + i, i0 + j] * _force_of(F, T, b, j)
-            if i < 3:
-                v[b, i] += dt * acc
-            else:
-                w[b, i - 3] += dt * acc
-        move = dt * np.sqrt(v[b, 0] ** 2 + v[b, 1] ** 2 + v[b, 2] ** 2)
-        if nb == 6:
-            move += dt * LEVER_MM * np.sqrt(w[b, 0] ** 2 + w[b, 1] ** 2 + w[b, 2] ** 2)
-        if move > st.block_max_move_mm:
-            cut = st.block_max_move_mm / move
-            for k in range(3):
-                v[b, k] *= cut
-                w[b, k] *= cut
-        for k in range(3):
-            x[b, k] += dt * v[b, k]
-        if nb == 6:
-            rotate_in_place(R[b], w[b, 0] * dt, w[b, 1] * dt, w[b, 2] * dt)
-
-
-@njit(cache=True, error_model="numpy")
-def _displacement(R, x, com0, b):
-    """How far (mm) free body b has moved from its place: the proximal row's (scaphoid, lunate) from its
-    neutral place on the radius; the radial column's from where the capitate carries it (the distal
-    row moves as one, Akhbari 2019; at ±40° the capitate carries the column's centre 15–18 mm)."""
-    if b == TRAPEZIUM:
-        return np.linalg.norm(x[b] - x[CAPITATE] - R[CAPITATE] @ (com0[b] - com0[CAPITATE]))
-    return np.linalg.norm(x[b] - com0[b])
-
-
-@njit(cache=True, error_model="numpy")
-def _converged(F, T, bundle, st):
-    """Quasi-static equilibrium: the net force (N) on every free body at most
-    max(force_floor, tolerance × largest bundle force), the net moment (N·mm)
-    at most that times LEVER_MM."""
-    largest = 0.0
-    for i in range(bundle.shape[0]):
-        largest = max(largest, bundle[i])
-    tol = max(st.force_floor, st.tolerance * largest)
-    for b in SOLVED:
-        if b == CAPITATE and st.driver == EXPERIMENTAL:
-            continue
-        f2 = F[b, 0] * F[b, 0] + F[b, 1] * F[b, 1] + F[b, 2] * F[b, 2]
-        if not f2 <= tol * tol:
-            return False
-        if b != CAPITATE:
-            t2 = T[b, 0] * T[b, 0] + T[b, 1] * T[b, 1] + T[b, 2] * T[b, 2]
-            if not t2 <= (tol * LEVER_MM) ** 2:
-                return False
-    return True
-
-
-@njit(cache=True, error_model="numpy")
-def _residual(F, T, st):
-    """The largest net force (N) on a free body, or net moment (N·mm) / LEVER_MM."""
-    worst = 0.0
-    for b in SOLVED:
-        if b == CAPITATE and st.driver == EXPERIMENTAL:
-            continue
-        worst = max(worst, np.sqrt(F[b, 0] ** 2 + F[b, 1] ** 2 + F[b, 2] ** 2))
-        if b != CAPITATE:
-            worst = max(worst, np.sqrt(T[b, 0] ** 2 + T[b, 1] ** 2 + T[b, 2] ** 2) / LEVER_MM)
-    return worst
-
-
-@njit(cache=True, error_model="numpy")
 def _predicted(state, work, bod, grids, law, fib, stiffness, mem, st, hist, capR, capx, load, move):
     """Start the next stage, whose capitate pose is (capR, capx) under `load`, from the secant
     predictor's state (`predictor.predict`) if the free bodies' residual there, with the capitate
@@ -357,47 +157,15 @@ def _predicted(state, work, bod, grids, law, fib, stiffness, mem, st, hist, capR
     if st.driver == EXPERIMENTAL:
         x[CAPITATE] = capx
     _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, True, False)
-    before = _residual(work.F, work.T, st)
+    before = residual(work.F, work.T, st)
     if not predict(hist, R, x, v, w, nodes, nv, mem, st, move):
         R[:], x[:], nodes[:] = keep_R, keep_x, keep_nodes
         return False
     _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, True, False)
-    if _residual(work.F, work.T, st) < before:
+    if residual(work.F, work.T, st) < before:
         return True
     R[:], x[:], nodes[:] = keep_R, keep_x, keep_nodes
     return False
-
-
-@njit(cache=True, error_model="numpy")
-def _kinetic(R, v, w, nv, bod, st, node_mass, m):
-    """Kinetic energy (N·mm) of the free bodies and membrane nodes of mass `node_mass` (t) (mass-scaled;
-    with st.block_mass, in the block mass m)."""
-    ke = 0.0
-    if st.block_mass:
-        for b in SOLVED:
-            i0, nb = dof(st, b)
-            for i in range(nb if i0 >= 0 else 0):
-                ui = v[b, i] if i < 3 else w[b, i - 3]
-                for j in range(nb):
-                    ke += 0.5 * ui * m.mass[i0 + i, i0 + j] * (v[b, j] if j < 3 else w[b, j - 3])
-    else:
-        for b in FREE:
-            # body-frame angular velocity Rᵀw against the neutral-pose inertia
-            u0 = R[b, 0, 0] * w[b, 0] + R[b, 1, 0] * w[b, 1] + R[b, 2, 0] * w[b, 2]
-            u1 = R[b, 0, 1] * w[b, 0] + R[b, 1, 1] * w[b, 1] + R[b, 2, 1] * w[b, 2]
-            u2 = R[b, 0, 2] * w[b, 0] + R[b, 1, 2] * w[b, 1] + R[b, 2, 2] * w[b, 2]
-            I = bod.inertia[b]
-            rot = (
-                u0 * (I[0, 0] * u0 + I[0, 1] * u1 + I[0, 2] * u2)
-                + u1 * (I[1, 0] * u0 + I[1, 1] * u1 + I[1, 2] * u2)
-                + u2 * (I[2, 0] * u0 + I[2, 1] * u1 + I[2, 2] * u2)
-            )
-            ke += 0.5 * bod.mass[b] * (v[b, 0] ** 2 + v[b, 1] ** 2 + v[b, 2] ** 2) + 0.5 * rot
-        if st.driver == LOADED:
-            ke += 0.5 * bod.mass[CAPITATE] * (v[CAPITATE, 0] ** 2 + v[CAPITATE, 1] ** 2 + v[CAPITATE, 2] ** 2)
-    for i in range(nv.shape[0]):
-        ke += 0.5 * node_mass * (nv[i, 0] ** 2 + nv[i, 1] ** 2 + nv[i, 2] ** 2)
-    return ke
 
 
 State = namedtuple("State", ["R", "x", "v", "w", "nodes", "nv"])
@@ -429,7 +197,7 @@ Stiffness = namedtuple("Stiffness", ["f_l0", "f_K", "m_l0", "m_K", "node_mass"])
 """A design's zero-load lengths (mm) and stiffnesses of the fibres and the membrane connectors, and the
 membrane's free-node mass (t) its connectors need (`arrays.node_mass`)."""
 Load = namedtuple("Load", ["body", "point", "direction", "tension"])
-"""The driver's loads as lines of action (the tendons where they enter, `simulate.Loads`): each line's
+"""The driver's loads as lines of action (the tendons where they enter, `drivers.Loads`): each line's
 body (n_lines,) int64, point (n_lines, 3) mm fixed in the body (RCS at neutral), direction (n_lines, 3)
 unit, RCS, and tension N: (n_lines,) at one state, (n_frames, n_lines) per frame in `Frames`."""
 Frames = namedtuple("Frames", ["rotation", "com", "tension", "body", "point", "direction"])
@@ -538,7 +306,7 @@ def _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes, fir
             )
             step += 1
             k += 1
-            if k >= ramp + st.min_hold_steps and _converged(F, T, bundle, st):
+            if k >= ramp + st.min_hold_steps and converged(F, T, bundle, st):
                 settled = True
                 break
         taken += k
@@ -551,7 +319,7 @@ def _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes, fir
             status[0] = FAILED_NAN
         else:
             for b in FREE:
-                if _displacement(R, x, com0, b) > st.max_disp_mm:
+                if displacement(R, x, com0, b) > st.max_disp_mm:
                     status[0] = FAILED_DIVERGED
                 rel = matrix_to_rotvec(R[b] @ R[CAPITATE].T)
                 if np.linalg.norm(rel) > st.max_rot_rad:
@@ -576,7 +344,7 @@ def _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes, fir
             contact[f, p, R_AREA] = area
             contact[f, p, R_FORCE] = stats[p, C_FORCE]
         bundle_out[f] = bundle
-        energy_out[f, 0] = _kinetic(R, v, w, nv, bod, st, stiffness.node_mass, m)
+        energy_out[f, 0] = kinetic_energy(R, v, w, nv, bod, st, stiffness.node_mass, m)
         energy_out[f, 1] = energy
         residual_out[f, 0] = 0.0
         residual_out[f, 1] = 0.0

@@ -1,4 +1,5 @@
-"""The RSC membrane's free nodes, subcycled: several cheap node steps per explicit step (Numba).
+"""The RSC membrane (Numba): its nodes carried by their bones, its connectors' tensions and the scaphoid's
+contact on its free nodes (N, mm), and the free nodes subcycled: several cheap node steps per explicit step.
 
 The membrane's free nodes are the lightest and the softest part of the model. Sliding over the
 scaphoid, or with their connectors slack, they have next to no stiffness, so they are the slowest
@@ -13,7 +14,7 @@ mass-proportional damping `Settings.membrane_substep_damping` (1/s). A substep r
 connectors' tensions, and the scaphoid's contact on every node that may touch it: each node's distance
 is looked up at the substeps' start and again only once it has moved far enough to reach the bone
 (`LIPSCHITZ`), so no contact is missed and most substeps need no look-up. The answer is the
-equilibrium of `forces.membrane_forces`; only the path to it is faster.
+equilibrium of `membrane_forces`; only the path to it is faster.
 """
 
 from __future__ import annotations
@@ -21,12 +22,118 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from wrist_env.solver.contact import sdf_distance
-from wrist_env.solver.forces import connector_pull, node_contact, to_local
+from wrist_env.solver.contact import sdf_distance, sdf_lookup_scalar, sdf_lookup_smooth
+from wrist_env.solver.forces import apply_force, rotate, to_local, to_world
+from wrist_env.solver.ligaments import blankevoort_energy, blankevoort_force
 
 LIPSCHITZ = np.sqrt(3.0)
 """Bound on the trilinear signed distance's slope (each axis' difference of a distance field is at most
 1): a node that has moved t mm since its distance d was looked up is at least d − √3·t from the bone."""
+
+
+@njit(cache=True, error_model="numpy")
+def place_nodes(R, x, com0, mem, nodes):
+    """Move the membrane nodes attached to a bone with it."""
+    for i in range(nodes.shape[0]):
+        b = mem.bone[i]
+        if b >= 0:
+            nodes[i, 0], nodes[i, 1], nodes[i, 2] = to_world(
+                R, x, com0, b, mem.rest[i, 0], mem.rest[i, 1], mem.rest[i, 2]
+            )
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def connector_pull(nodes, i, j, l0, K):
+    """A membrane connector from node i to node j of zero-load length l0 (mm) and scale K (N): its
+    tension per unit length (N/mm; 0 when slack), the vector from i to j (mm), its length (mm) and strain."""
+    dx, dy, dz = nodes[j, 0] - nodes[i, 0], nodes[j, 1] - nodes[i, 1], nodes[j, 2] - nodes[i, 2]
+    length = np.sqrt(dx * dx + dy * dy + dz * dz)
+    strain = length / l0 - 1.0
+    if strain <= 0.0:
+        return 0.0, dx, dy, dz, length, strain
+    return blankevoort_force(K, strain) / length, dx, dy, dz, length, strain
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def node_contact(R, x, com0, mem, px, py, pz, contact_stiffness, smooth):
+    """The scaphoid's push (N, world) on a membrane node at world point p, the node's signed distance (mm)
+    and whether it touches (a negative distance with a normal; else no push)."""
+    s = mem.scaphoid
+    qx, qy, qz = to_local(R, x, com0, s, px, py, pz)
+    if smooth:
+        d, gx, gy, gz = sdf_lookup_smooth(
+            mem.grid_values,
+            mem.grid_normals,
+            mem.grid_offset,
+            mem.grid_shape,
+            mem.grid_origin,
+            mem.grid_spacing,
+            qx,
+            qy,
+            qz,
+        )
+    else:
+        d, gx, gy, gz = sdf_lookup_scalar(
+            mem.grid_values, mem.grid_offset, mem.grid_shape, mem.grid_origin, mem.grid_spacing, qx, qy, qz
+        )
+    if d < 0.0:
+        gn = np.sqrt(gx * gx + gy * gy + gz * gz)
+        if gn > 1e-12:
+            scale = contact_stiffness * -d / gn
+            fx, fy, fz = rotate(R, s, gx * scale, gy * scale, gz * scale)
+            return fx, fy, fz, d, True
+    return 0.0, 0.0, 0.0, d, False
+
+
+@njit(cache=True, error_model="numpy")
+def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node_force, want_energy=True, smooth=False):
+    """RSC membrane: connector tension and node–scaphoid contact.
+
+    nodes (M, 3): world positions (attached nodes already placed on their bones).
+    node_force (M, 3) receives forces on the free nodes; forces on attached
+    nodes go to their bones. Returns (energy N·mm, tension N of the membrane's
+    radial row of along connectors).
+    """
+    energy = 0.0
+    along = 0.0
+    node_force[:] = 0.0
+    for c in range(l0.shape[0]):
+        if K[c] == 0.0:
+            continue
+        i, j = mem.connectors[c, 0], mem.connectors[c, 1]
+        tension, dx, dy, dz, length, strain = connector_pull(nodes, i, j, l0[c], K[c])
+        if strain <= 0.0:
+            continue
+        node_force[i, 0] += tension * dx
+        node_force[i, 1] += tension * dy
+        node_force[i, 2] += tension * dz
+        node_force[j, 0] -= tension * dx
+        node_force[j, 1] -= tension * dy
+        node_force[j, 2] -= tension * dz
+        if want_energy:
+            energy += blankevoort_energy(K[c], l0[c], strain)
+        if mem.first_row[c]:
+            along += tension * length
+    for i in range(nodes.shape[0]):
+        if mem.bone[i] >= 0:
+            continue
+        fx, fy, fz, d, touching = node_contact(
+            R, x, com0, mem, nodes[i, 0], nodes[i, 1], nodes[i, 2], contact_stiffness, smooth
+        )
+        if touching:
+            node_force[i, 0] += fx
+            node_force[i, 1] += fy
+            node_force[i, 2] += fz
+            apply_force(F, T, x, mem.scaphoid, -fx, -fy, -fz, nodes[i, 0], nodes[i, 1], nodes[i, 2])
+            energy += 0.5 * contact_stiffness * d * d
+    for i in range(nodes.shape[0]):
+        b = mem.bone[i]
+        if b >= 0:
+            apply_force(
+                F, T, x, b, node_force[i, 0], node_force[i, 1], node_force[i, 2], nodes[i, 0], nodes[i, 1], nodes[i, 2]
+            )
+            node_force[i, 0] = node_force[i, 1] = node_force[i, 2] = 0.0
+    return energy, along
 
 
 @njit(cache=True, error_model="numpy")

@@ -6,7 +6,7 @@ the free bodies (scaphoid, lunate, the loaded capitate's centre) and the membran
 put where the line through the last two frames' equilibria says they will be (the secant predictor
 of numerical continuation), their velocities zeroed, and the hold starts from there. The predictor
 only chooses the starting point of the hold: the frame still ends at equilibrium
-(`kernel._converged`), so a poor prediction costs steps, not accuracy, unless the path has more
+(`stopping.converged`), so a poor prediction costs steps, not accuracy, unless the path has more
 than one equilibrium (a design whose answer depends on its path; `experiments/verification/solver_accuracy.py`).
 """
 

@@ -8,12 +8,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from wrist_env import design as design_mod
-from wrist_env.builder.pipeline import BuildParams
+from wrist_env.builder.params import BuildParams
 from wrist_env.model import BONES, MIDCARPAL, PAIRS, Model
 from wrist_env.participants.registry import load_model
+from wrist_env.solver import drivers
 from wrist_env.solver import simulate as sim
+from wrist_env.solver.drivers import DEFAULT_LOADS, IDEALIZED_LOAD_N
 from wrist_env.solver.outputs import cardan_deg
-from wrist_env.solver.simulate import DEFAULT_LOADS, IDEALIZED_LOAD_N
 from wrist_env.validation.bands import (
     EXTENSION_30_DEG,
     NEUTRAL_LOAD_N,
@@ -26,7 +27,7 @@ from wrist_env.validation.measures import at_angle, column_rotation_deg, load_sh
 from wrist_env.validation.report import Report, _row
 
 if TYPE_CHECKING:
-    from wrist_env.builder.pipeline import BuildParams
+    from wrist_env.builder.params import BuildParams
 
 
 def _failure(label, result) -> str | None:
@@ -48,7 +49,7 @@ def validate(
 
     params: build parameters (`BuildParams`; the anatomy variant), default the default build.
     load_n: the compressive load (N) of the sweeps; the neutral pose takes `NEUTRAL_LOAD_N`.
-    load_direction: the loads' direction in the sweeps and at neutral (`simulate.LOAD_DIRECTIONS`).
+    load_direction: the loads' direction in the sweeps and at neutral (`drivers.LOAD_DIRECTIONS`).
     settings: the solver's (`arrays.SolverSettings`), default its defaults.
     """
 
@@ -58,10 +59,10 @@ def validate(
     intact_design = d if d is not None else design_mod.population()
     torn_design = with_tears(intact_design, SLIL)
     direction = load_direction
-    sweep = sim.idealized(model, n_frames=n_frames, load_n=load_n, direction=direction)
+    sweep = drivers.idealized(model, n_frames=n_frames, load_n=load_n, direction=direction)
     intact, torn = sim.simulate_batch(model, [intact_design, torn_design], sweep, settings)
     neutral = sim.simulate(
-        model, intact_design, sim.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=direction), settings
+        model, intact_design, drivers.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=direction), settings
     )
 
     b = {bone: BONES.index(bone) for bone in ("capitate", "scaphoid", "lunate")}

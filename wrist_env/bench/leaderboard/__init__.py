@@ -26,10 +26,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from wrist_env.bench.leaderboard import plots, tables
+from wrist_env.bench.leaderboard import plots
+from wrist_env.bench.leaderboard.board import Leaderboard, build, write_csvs
 from wrist_env.bench.leaderboard.readme import readme
 from wrist_env.bench.leaderboard.reference import Reference, reference
-from wrist_env.bench.leaderboard.tables import TARGETS, Leaderboard, build, load_runs
+from wrist_env.bench.leaderboard.tables import TARGETS, load_runs
 
 __all__ = ["TARGETS", "Leaderboard", "Reference", "build", "load_runs", "reference", "write_leaderboard"]
 
@@ -43,7 +44,7 @@ def write_leaderboard(
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     board = build(runs, references)
-    tables.write_csvs(board, out)
+    write_csvs(board, out)
     colors = plots.colors(board.labels)
     plots.convergence_figure(out / "convergence.png", board, colors)
     plots.ecdf_figure(out / "ecdf.png", board, colors)

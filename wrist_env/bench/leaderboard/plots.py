@@ -7,7 +7,8 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from wrist_env.bench.leaderboard.tables import Leaderboard, hit, runs_of
+from wrist_env.bench.leaderboard.board import Leaderboard
+from wrist_env.bench.leaderboard.tables import hit, runs_of
 
 _RGBA = tuple[float, float, float, float]
 

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from wrist_env.bench.leaderboard.tables import CSV_FILES, ECDF_TARGETS, Leaderboard
+from wrist_env.bench.leaderboard.board import CSV_FILES, Leaderboard
+from wrist_env.bench.leaderboard.tables import ECDF_TARGETS
 
 
 def fmt(v: float | None, digits: int = 3) -> str:

@@ -1,20 +1,18 @@
-"""The leaderboard's tables: from a run log's finished cells to pandas frames (and their CSV files)."""
+"""The leaderboard's cost tables and what every table is made from: a run log's finished cells and
+one row per run (pandas frames), best-so-far cost curves, cost targets, the best calibration cost and
+the evaluations to reach each target (COCO's expected running time)."""
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike
 
-from wrist_env.bench.leaderboard.reference import Reference, reference, rmse_array
+from wrist_env.bench.leaderboard.reference import Reference, rmse_array
 from wrist_env.bench.log import RunLog
-from wrist_env.cost import COST_BONES
-from wrist_env.frames import DOF_NAMES, DOF_UNITS
-from wrist_env.trial import TRIAL_MOTIONS
 
 TARGETS = (("pop×0.75", "population", 0.75), ("pop×0.5", "population", 0.5), ("truth×1.1", "truth", 1.1))
 """Cost targets (name, reference, factor): a target is factor × the reference design's cost on the
@@ -29,9 +27,6 @@ ECDF_DECADES = 3.0
 Optim Methods Softw 36:114): f* + (f_pop − f*)·10^(−3k/50), k = 0..50, from the population design's
 cost f_pop down to a thousandth of its distance to f*, the best cost any run of the log reached
 (the optimum is unknown: COCO's "best known" convention)."""
-
-PREPRINT_SHARE_IMPROVED = {"calibrate": 66.7, "validate": 61.1}
-"""Share of DOF (%) with lower RMSE after calibration in the preprint's Tables 3 and 4."""
 
 
 def quantile(values: Iterable[float | None], q: float) -> float:
@@ -156,197 +151,6 @@ def evals_to_target(
     return pd.DataFrame(rows)
 
 
-def recovery(
-    runs_frame: pd.DataFrame, summaries: Iterable[dict], participants: Iterable[str], labels: Sequence[str]
-) -> pd.DataFrame:
-    population = {s["participant"]: s["recovery_z_population"] for s in summaries}
-    rows = []
-    for p in participants:
-        for label in labels:
-            sub = runs_of(runs_frame, p, label)
-            v = [x for x in sub.recovery_z if x is not None and np.isfinite(x)]
-            if sub.empty or not v:
-                continue
-            rows.append(
-                {
-                    "participant": p,
-                    "calibrator": label,
-                    "runs": len(v),
-                    **spread(v),
-                    "population": population.get(p),
-                }
-            )
-    return pd.DataFrame(rows)
-
-
-def heldout(
-    runs_frame: pd.DataFrame, refs: dict[str, Reference], participants: Iterable[str], labels: Sequence[str]
-) -> pd.DataFrame:
-    rows = []
-    for p in participants:
-        r = refs[p]
-        for name, score in (("population", r.population), ("truth (hidden)", r.truth)):
-            if score is None:
-                continue
-            val = rmse_array(score["validate"]["rmse"])
-            rows.append(
-                {
-                    "participant": p,
-                    "calibrator": name,
-                    "runs": 0,
-                    "cost_median": score["validate"]["cost"],
-                    "cost_q25": np.nan,
-                    "cost_q75": np.nan,
-                    "failed": int(score["validate"]["failed"]),
-                    "rmse_translation_mm": float(np.nanmean(val[:, :3])),
-                    "rmse_rotation_deg": float(np.nanmean(val[:, 3:])),
-                }
-            )
-        for label in labels:
-            sub = runs_of(runs_frame, p, label)
-            if sub.empty:
-                continue
-            v = sub.validate_cost.to_numpy()
-            rows.append(
-                {
-                    "participant": p,
-                    "calibrator": label,
-                    "runs": len(v),
-                    **spread(v, "cost_"),
-                    "failed": int(sub.validate_failed.sum()),
-                    "rmse_translation_mm": quantile(sub.validate_rmse_translation_mm, 0.5),
-                    "rmse_rotation_deg": quantile(sub.validate_rmse_rotation_deg, 0.5),
-                }
-            )
-    return pd.DataFrame(rows)
-
-
-def best_runs(summaries: Iterable[dict]) -> dict[str, dict]:
-    """Per participant, the run with the lowest calibration cost over all calibrators and seeds
-    (ties: the first in participant, optimizer, budget, seed order) — as the preprint reports its one
-    optimization per participant."""
-    chosen = {}
-    for s in summaries:
-        p = s["participant"]
-        if p not in chosen or s["best_cost"] < chosen[p]["best_cost"]:
-            chosen[p] = s
-    return chosen
-
-
-def rmse_table(
-    chosen: dict[str, dict], refs: dict[str, Reference], participants: Iterable[str], trial: str
-) -> pd.DataFrame:
-    rows = []
-    for p in participants:
-        r, s = refs[p], chosen[p]
-        materials = [("Population", r.population[trial]["rmse"], "")]
-        materials.append(("Calibrated", s[trial]["rmse"], f"{s['optimizer']} seed {s['seed']}"))
-        if r.truth is not None:
-            materials.append(("Truth (hidden)", r.truth[trial]["rmse"], ""))
-        for b, bone in enumerate(COST_BONES):
-            for material, rmse, run in materials:
-                a = rmse_array(rmse)
-                row = {"participant": p, "bone": bone.capitalize(), "material": material}
-                row.update({f"{dof} ({unit})": a[b, d] for d, (dof, unit) in enumerate(zip(DOF_NAMES, DOF_UNITS))})
-                row["run"] = run
-                rows.append(row)
-    return pd.DataFrame(rows)
-
-
-def share_improved(pairs: Iterable[tuple[np.ndarray, np.ndarray]]) -> float:
-    """Percent of DOF entries with calibrated RMSE < population RMSE; pairs: [(population (2, 6), calibrated (2, 6))]."""
-    better = total = 0
-    for pop, cal in pairs:
-        ok = np.isfinite(pop) & np.isfinite(cal)
-        better += int(np.sum(cal[ok] < pop[ok]))
-        total += int(np.sum(np.isfinite(pop)))
-    return 100.0 * better / total if total else np.nan
-
-
-def dof_improved(
-    summaries: Sequence[dict],
-    chosen: dict[str, dict],
-    refs: dict[str, Reference],
-    participants: Sequence[str],
-    labels: Iterable[str],
-    budgets: set[int],
-) -> pd.DataFrame:
-    rows = []
-
-    def row(name, trial_pairs, runs):
-        rows.append(
-            {
-                "calibrated design": name,
-                "runs": runs,
-                "calibrate_pct": trial_pairs["calibrate"],
-                "validate_pct": trial_pairs["validate"],
-                "dof": 12 * len(participants),
-            }
-        )
-
-    row(
-        "best run per participant",
-        {
-            t: share_improved(
-                [(rmse_array(refs[p].population[t]["rmse"]), rmse_array(chosen[p][t]["rmse"])) for p in participants]
-            )
-            for t in TRIAL_MOTIONS
-        },
-        len(participants),
-    )
-    for label in labels:
-        shares = {"calibrate": [], "validate": []}
-        mine = [s for s in summaries if calibrator_label(s["optimizer"], s["budget"], budgets) == label]
-        for t in shares:  # every run counts: share over all its runs' DOF, pooled over participants
-            shares[t] = share_improved(
-                [(rmse_array(refs[s["participant"]].population[t]["rmse"]), rmse_array(s[t]["rmse"])) for s in mine]
-            )
-        rows.append(
-            {
-                "calibrated design": f"{label} (all runs)",
-                "runs": len(mine),
-                "calibrate_pct": shares["calibrate"],
-                "validate_pct": shares["validate"],
-                "dof": 12 * len(mine),
-            }
-        )
-    rows.append(
-        {
-            "calibrated design": "preprint (Tables 3–4)",
-            "runs": 3,
-            "calibrate_pct": PREPRINT_SHARE_IMPROVED["calibrate"],
-            "validate_pct": PREPRINT_SHARE_IMPROVED["validate"],
-            "dof": 36,
-        }
-    )
-    return pd.DataFrame(rows)
-
-
-@dataclass(frozen=True)
-class Leaderboard:
-    """Everything a leaderboard shows, computed once from a run log (`build`)."""
-
-    runs: str
-    summaries: list
-    unfinished: int
-    participants: list
-    labels: list
-    budgets: set
-    refs: dict
-    curves: dict
-    targets: pd.DataFrame
-    ecdf_targets: pd.DataFrame
-    runs_frame: pd.DataFrame
-    best: pd.DataFrame
-    ert: pd.DataFrame
-    recovery: pd.DataFrame
-    heldout: pd.DataFrame
-    chosen: dict
-    table3: pd.DataFrame
-    table4: pd.DataFrame
-    improved: pd.DataFrame
-
-
 def _targets(participants, refs) -> pd.DataFrame:
     rows = []
     for p in participants:
@@ -415,64 +219,3 @@ def _runs_frame(summaries, curves_by_key, targets, budgets, unsettled_by_key) ->
             row[f"evals_to_{t.target}"] = hit(curve, t.value)
         rows.append(row)
     return pd.DataFrame(rows)
-
-
-def build(runs: str | Path, references: dict[str, Reference] | None = None) -> Leaderboard:
-    """The leaderboard of the finished cells of the run log in `runs` (`references`: {participant:
-    `Reference`} already simulated; the others are simulated here)."""
-    evals, summaries, unfinished = load_runs(runs)
-    if not summaries:
-        raise ValueError(f"{runs}: no finished benchmark cell in this run log")
-    summaries = sorted(summaries, key=lambda s: (s["participant"], s["optimizer"], s["budget"], s["seed"]))
-    budgets = {s["budget"] for s in summaries}
-    participants = sorted({s["participant"] for s in summaries})
-    labels = sorted({calibrator_label(s["optimizer"], s["budget"], budgets) for s in summaries})
-    refs = dict(references or {})
-    for p in participants:
-        if p not in refs:
-            refs[p] = reference(p)
-    by_key = curves(evals)
-    targets = _targets(participants, refs)
-    runs_frame = _runs_frame(summaries, by_key, targets, budgets, unsettled_shares(evals))
-    chosen = best_runs(summaries)
-    return Leaderboard(
-        str(runs),
-        summaries,
-        unfinished,
-        participants,
-        labels,
-        budgets,
-        refs,
-        by_key,
-        targets,
-        ecdf_targets(participants, refs, by_key),
-        runs_frame,
-        best_cost(runs_frame, refs, participants, labels),
-        evals_to_target(runs_frame, targets, participants, labels, by_key),
-        recovery(runs_frame, summaries, participants, labels),
-        heldout(runs_frame, refs, participants, labels),
-        chosen,
-        rmse_table(chosen, refs, participants, "calibrate"),
-        rmse_table(chosen, refs, participants, "validate"),
-        dof_improved(summaries, chosen, refs, participants, labels, budgets),
-    )
-
-
-CSV_FILES = {
-    "best_cost.csv": ("best", "%.6g"),
-    "targets.csv": ("targets", "%.6g"),
-    "ecdf_targets.csv": ("ecdf_targets", "%.6g"),
-    "evals_to_target.csv": ("ert", "%.6g"),
-    "recovery.csv": ("recovery", "%.6g"),
-    "heldout.csv": ("heldout", "%.6g"),
-    "table3_rmse_calibrate.csv": ("table3", "%.4g"),
-    "table4_rmse_validate.csv": ("table4", "%.4g"),
-    "dof_improved.csv": ("improved", "%.4g"),
-    "runs.csv": ("runs_frame", "%.6g"),
-}
-"""The CSV files of a leaderboard: {file name: (Leaderboard field, float format)}."""
-
-
-def write_csvs(board: Leaderboard, out: Path) -> None:
-    for name, (field, float_format) in CSV_FILES.items():
-        getattr(board, field).to_csv(out / name, index=False, float_format=float_format)

@@ -1,0 +1,109 @@
+"""The leaderboard: every table and curve of a run log's finished cells, computed once
+(`Leaderboard`, `build`), and the CSV files it is written to."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from wrist_env.bench.leaderboard.accuracy import best_runs, dof_improved, heldout, recovery, rmse_table
+from wrist_env.bench.leaderboard.reference import Reference, reference
+from wrist_env.bench.leaderboard.tables import (
+    _runs_frame,
+    _targets,
+    best_cost,
+    calibrator_label,
+    curves,
+    ecdf_targets,
+    evals_to_target,
+    load_runs,
+    unsettled_shares,
+)
+
+
+@dataclass(frozen=True)
+class Leaderboard:
+    """Everything a leaderboard shows, computed once from a run log (`build`)."""
+
+    runs: str
+    summaries: list
+    unfinished: int
+    participants: list
+    labels: list
+    budgets: set
+    refs: dict
+    curves: dict
+    targets: pd.DataFrame
+    ecdf_targets: pd.DataFrame
+    runs_frame: pd.DataFrame
+    best: pd.DataFrame
+    ert: pd.DataFrame
+    recovery: pd.DataFrame
+    heldout: pd.DataFrame
+    chosen: dict
+    table3: pd.DataFrame
+    table4: pd.DataFrame
+    improved: pd.DataFrame
+
+
+def build(runs: str | Path, references: dict[str, Reference] | None = None) -> Leaderboard:
+    """The leaderboard of the finished cells of the run log in `runs` (`references`: {participant:
+    `Reference`} already simulated; the others are simulated here)."""
+    evals, summaries, unfinished = load_runs(runs)
+    if not summaries:
+        raise ValueError(f"{runs}: no finished benchmark cell in this run log")
+    summaries = sorted(summaries, key=lambda s: (s["participant"], s["optimizer"], s["budget"], s["seed"]))
+    budgets = {s["budget"] for s in summaries}
+    participants = sorted({s["participant"] for s in summaries})
+    labels = sorted({calibrator_label(s["optimizer"], s["budget"], budgets) for s in summaries})
+    refs = dict(references or {})
+    for p in participants:
+        if p not in refs:
+            refs[p] = reference(p)
+    by_key = curves(evals)
+    targets = _targets(participants, refs)
+    runs_frame = _runs_frame(summaries, by_key, targets, budgets, unsettled_shares(evals))
+    chosen = best_runs(summaries)
+    return Leaderboard(
+        str(runs),
+        summaries,
+        unfinished,
+        participants,
+        labels,
+        budgets,
+        refs,
+        by_key,
+        targets,
+        ecdf_targets(participants, refs, by_key),
+        runs_frame,
+        best_cost(runs_frame, refs, participants, labels),
+        evals_to_target(runs_frame, targets, participants, labels, by_key),
+        recovery(runs_frame, summaries, participants, labels),
+        heldout(runs_frame, refs, participants, labels),
+        chosen,
+        rmse_table(chosen, refs, participants, "calibrate"),
+        rmse_table(chosen, refs, participants, "validate"),
+        dof_improved(summaries, chosen, refs, participants, labels, budgets),
+    )
+
+
+CSV_FILES = {
+    "best_cost.csv": ("best", "%.6g"),
+    "targets.csv": ("targets", "%.6g"),
+    "ecdf_targets.csv": ("ecdf_targets", "%.6g"),
+    "evals_to_target.csv": ("ert", "%.6g"),
+    "recovery.csv": ("recovery", "%.6g"),
+    "heldout.csv": ("heldout", "%.6g"),
+    "table3_rmse_calibrate.csv": ("table3", "%.4g"),
+    "table4_rmse_validate.csv": ("table4", "%.4g"),
+    "dof_improved.csv": ("improved", "%.4g"),
+    "runs.csv": ("runs_frame", "%.6g"),
+}
+"""The CSV files of a leaderboard: {file name: (Leaderboard field, float format)}."""
+
+
+def write_csvs(board: Leaderboard, out: Path) -> None:
+    for name, (field, float_format) in CSV_FILES.items():
+        getattr(board, field).to_csv(out / name, index=False, float_format=float_format)

@@ -1,0 +1,77 @@
+"""Build parameters (lengths mm, angles deg) and the command-line options that choose an anatomy variant."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import argparse
+
+
+@dataclass(frozen=True)
+class BuildParams:
+    """Build parameters (all lengths mm)."""
+
+    contact_spacing_mm: float = 1.0
+    grid_spacing_mm: float = 0.5
+    grid_margin_mm: float = 3.0
+    grnn_bandwidth_mm: float = 1.0
+    max_thickness_mm: float = 1.1
+    min_total_thickness_mm: float = 0.2
+    membrane_along: int = 9
+    membrane_across: int = 5
+    seed: int = 0
+    fossa_sweep_deg: tuple = (20.0, 10.0)
+    """(flexion, deviation) half-ranges, deg, of the row's sweep that shapes the radius fossae
+    ((0, 0): moulded to the neutral row; see `anatomy.radius_cap`)."""
+    distal_row: bool = True
+    """The triquetrum moves with the lunate and the trapezium, trapezoid and hamate with the
+    capitate, bringing the STT and triquetrohamate contacts (`model.BODY_PARTS`) and the fixed
+    TC and TH ligaments (`design.FIXED_LIGAMENTS`); participant folders get these bones from
+    the template (`anatomy.template.carry_parts`)."""
+    fixed_ligaments: bool = True
+    """Build the fixed TC and TH with the distal row (False: the lunate body is tied to the
+    distal row by contact alone; for studying what they do)."""
+
+    @property
+    def anatomy(self) -> tuple:
+        """The template variant of these parameters: (fossa_sweep_deg, distal_row)."""
+        return (tuple(float(a) for a in self.fossa_sweep_deg), bool(self.distal_row))
+
+
+def add_anatomy_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add the anatomy-variant options (`--fossa-sweep`, `--no-distal-row`) to an argparse parser."""
+    d = BuildParams()
+    parser.add_argument(
+        "--fossa-sweep",
+        nargs=2,
+        type=float,
+        default=d.fossa_sweep_deg,
+        metavar=("FLEXION", "DEVIATION"),
+        help="anatomy variant: radius fossae as the envelope of the row swept +-these angles (deg); "
+        f"0 0 moulds them to the neutral row (default {d.fossa_sweep_deg[0]:g} "
+        f"{d.fossa_sweep_deg[1]:g})",
+    )
+    parser.add_argument(
+        "--no-distal-row",
+        dest="distal_row",
+        action="store_false",
+        help="anatomy variant: the five principal bones alone (no triquetrum, trapezium, trapezoid, "
+        "hamate; no TC/TH ligaments)",
+    )
+    parser.add_argument(
+        "--no-fixed-ligaments",
+        dest="fixed_ligaments",
+        action="store_false",
+        help="anatomy variant: the distal row without the TC and TH ligaments",
+    )
+
+
+def anatomy_params(args: argparse.Namespace) -> BuildParams:
+    """The `BuildParams` of parsed `add_anatomy_arguments` options."""
+    return BuildParams(
+        fossa_sweep_deg=tuple(float(a) for a in args.fossa_sweep),
+        distal_row=bool(args.distal_row),
+        fixed_ligaments=bool(args.fixed_ligaments),
+    )

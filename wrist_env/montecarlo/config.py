@@ -1,0 +1,60 @@
+"""What a Monte Carlo study is: the settings that decide every run (`StudyConfig`: participants, n
+successful runs each, seed, tear probability, exclusion threshold in MPa, load direction), and the
+error raised by a study that cannot run (`StudyError`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from wrist_env.errors import WristEnvError
+from wrist_env.limits import MAX_RUNS, MAX_SEED, check_int, check_unique
+from wrist_env.montecarlo import sampler
+from wrist_env.solver.drivers import DEFAULT_LOADS, LOAD_DIRECTIONS
+
+VERSION = 1
+
+
+class StudyError(WristEnvError):
+    """A study that cannot run: a folder holding another study, a duplicated run, no successes."""
+
+
+@dataclass(frozen=True)
+class StudyConfig:
+    """What a study is: these decide every run (how it is run does not)."""
+
+    participants: tuple[str, ...]
+    n: int
+    seed: int = 0
+    tear_probability: float = sampler.TEAR_PROBABILITY
+    exclude_above_mpa: float = sampler.EXCLUDE_ABOVE_MPA
+    max_attempts: int | None = None
+    """Give up (StudyError) after this many runs of one participant; default 5 n + 100."""
+    load_direction: str = DEFAULT_LOADS
+    """The sweeps' load direction (`drivers.LOAD_DIRECTIONS`): along the radius, or a tendon rig's."""
+
+    def __post_init__(self):
+        object.__setattr__(self, "participants", tuple(self.participants))
+        if not self.participants:
+            raise StudyError("a study needs at least one participant")
+        check_unique("participants", self.participants)
+        check_int("n", self.n, 1, MAX_RUNS, "a round's draws are held in memory")
+        check_int("seed", self.seed, 0, MAX_SEED)
+        if not 0.0 <= self.tear_probability <= 1.0:
+            raise StudyError(f"tear_probability must be in [0, 1], but got {self.tear_probability}")
+        if self.load_direction not in LOAD_DIRECTIONS:
+            raise StudyError(f"load_direction must be one of {LOAD_DIRECTIONS}, but got {self.load_direction!r}")
+
+    @property
+    def attempt_limit(self) -> int:
+        return int(self.max_attempts) if self.max_attempts is not None else 5 * int(self.n) + 100
+
+    def key(self) -> dict:
+        """The fields that must match to resume a study in the same folder (the load direction only when
+        not the axial default, so that a study logged before it existed resumes)."""
+        return {
+            "version": VERSION,
+            "n": int(self.n),
+            "seed": int(self.seed),
+            "tear_probability": float(self.tear_probability),
+            "exclude_above_mpa": float(self.exclude_above_mpa),
+        } | ({} if self.load_direction == "axial" else {"load_direction": self.load_direction})
