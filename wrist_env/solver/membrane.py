@@ -85,6 +85,32 @@ def node_contact(R, x, com0, mem, px, py, pz, contact_stiffness, smooth):
     return 0.0, 0.0, 0.0, d, False
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def connector_forces(mem, nodes, l0, K, force, want_energy):
+    """force (M, 3) N += each taut connector's pull on its two nodes; returns (their energy N·mm, 0 unless
+    want_energy; the tension N of the radial row of along connectors)."""
+    energy = 0.0
+    along = 0.0
+    for c in range(l0.shape[0]):
+        if K[c] == 0.0:
+            continue
+        i, j = mem.connectors[c, 0], mem.connectors[c, 1]
+        tension, dx, dy, dz, length, strain = connector_pull(nodes, i, j, l0[c], K[c])
+        if strain <= 0.0:
+            continue
+        force[i, 0] += tension * dx
+        force[i, 1] += tension * dy
+        force[i, 2] += tension * dz
+        force[j, 0] -= tension * dx
+        force[j, 1] -= tension * dy
+        force[j, 2] -= tension * dz
+        if want_energy:
+            energy += blankevoort_energy(K[c], l0[c], strain)
+        if mem.first_row[c]:
+            along += tension * length
+    return energy, along
+
+
 @njit(cache=True, error_model="numpy")
 def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node_force, want_energy=True, smooth=False):
     """RSC membrane: connector tension and node–scaphoid contact.
@@ -94,26 +120,8 @@ def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node
     nodes go to their bones. Returns (energy N·mm, tension N of the membrane's
     radial row of along connectors).
     """
-    energy = 0.0
-    along = 0.0
     node_force[:] = 0.0
-    for c in range(l0.shape[0]):
-        if K[c] == 0.0:
-            continue
-        i, j = mem.connectors[c, 0], mem.connectors[c, 1]
-        tension, dx, dy, dz, length, strain = connector_pull(nodes, i, j, l0[c], K[c])
-        if strain <= 0.0:
-            continue
-        node_force[i, 0] += tension * dx
-        node_force[i, 1] += tension * dy
-        node_force[i, 2] += tension * dz
-        node_force[j, 0] -= tension * dx
-        node_force[j, 1] -= tension * dy
-        node_force[j, 2] -= tension * dz
-        if want_energy:
-            energy += blankevoort_energy(K[c], l0[c], strain)
-        if mem.first_row[c]:
-            along += tension * length
+    energy, along = connector_forces(mem, nodes, l0, K, node_force, want_energy)
     for i in range(nodes.shape[0]):
         if mem.bone[i] >= 0:
             continue
@@ -156,19 +164,7 @@ def _substep_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, gap, trave
     """force (M, 3) N ← connector tensions and the scaphoid's contact, looked up only on the free nodes that
     may touch it (gap − √3·travel < 0: `LIPSCHITZ`), whose gap and travel then restart there."""
     force[:] = 0.0
-    for c in range(l0.shape[0]):
-        if K[c] == 0.0:
-            continue
-        i, j = mem.connectors[c, 0], mem.connectors[c, 1]
-        tension, dx, dy, dz, _, strain = connector_pull(nodes, i, j, l0[c], K[c])
-        if strain <= 0.0:
-            continue
-        force[i, 0] += tension * dx
-        force[i, 1] += tension * dy
-        force[i, 2] += tension * dz
-        force[j, 0] -= tension * dx
-        force[j, 1] -= tension * dy
-        force[j, 2] -= tension * dz
+    connector_forces(mem, nodes, l0, K, force, False)
     for i in range(nodes.shape[0]):
         if not gap[i] - LIPSCHITZ * travel[i] < 0.0:
             continue
