@@ -66,3 +66,14 @@ def test_a_results_page_shows_the_committed_numbers(site):
     )
     for cost in population.split("|")[2:-1]:
         assert cost.strip() in board
+
+
+def test_the_sensitivity_page_ranks_the_calibration_trials_own_indices(site):
+    import pandas as pd
+
+    page = (ROOT / "docs" / "results" / "sensitivity.md").read_text()  # rendered by the build (`site`)
+    p1 = page.split("## P1")[1].split("## P2")[0]
+    rows = [line.split("|")[1:3] for line in p1.splitlines() if line.startswith("| ") and "variable" not in line]
+    morris = pd.read_csv(ROOT / "leaderboards" / "sensitivity" / "sensitivity_P1_morris.csv")
+    top = morris.query("output == 'cost' and motion == 'calibrate'").nlargest(len(rows), "mu_star")
+    assert [(m.strip(), v.strip()) for m, v in rows] == [(r.material, f"{r.mu_star:.3g}") for r in top.itertuples()]

@@ -8,11 +8,15 @@ and lays them out as tables and figures. A missing file is a build error.
 from __future__ import annotations
 
 import json
+import math
 import re
 import subprocess
 from pathlib import Path
 
 import pandas as pd
+
+from wrist_env.bench.leaderboard.readme import md_table
+from wrist_env.validation.report import band_text
 
 ROOT = Path(__file__).resolve().parents[2]
 BOARDS = ROOT / "leaderboards"
@@ -21,16 +25,10 @@ PARTICIPANTS = ("P1", "P2", "P3")
 
 
 def table(header: list[str], rows: list[list]) -> str:
-    """A Markdown table; floats to 3 significant places."""
-
-    def cell(x) -> str:
-        if isinstance(x, float):
-            return f"{x:.3g}"
-        return str(x)
-
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(cell(x) for x in row) + " |" for row in rows]
-    return "\n".join(lines)
+    """A Markdown table (the leaderboards' `md_table`); floats to 3 significant places."""
+    return md_table(
+        pd.DataFrame([[f"{x:.3g}" if isinstance(x, float) else x for x in row] for row in rows], columns=header)
+    )
 
 
 def committed(*paths: Path) -> str:
@@ -82,20 +80,24 @@ def sensitivity(top: int = 6) -> str:
     parts = [
         "# Sensitivity",
         "",
-        "Rendered from `leaderboards/sensitivity/*.csv`: the design variables the calibration cost "
+        "Rendered from `leaderboards/sensitivity/*.csv`: the design variables the cost on the calibration trial "
         f"moves most with, {top} per participant (Morris μ*, Sobol total index S_T)."
         + committed(BOARDS / "sensitivity"),
     ]
     for p in PARTICIPANTS:
-        morris = pd.read_csv(BOARDS / "sensitivity" / f"sensitivity_{p}_morris.csv").query("output == 'cost'")
-        sobol = pd.read_csv(BOARDS / "sensitivity" / f"sensitivity_{p}_sobol.csv").query("output == 'cost'")
+        morris = pd.read_csv(BOARDS / "sensitivity" / f"sensitivity_{p}_morris.csv").query(
+            "output == 'cost' and motion == 'calibrate'"
+        )
+        sobol = pd.read_csv(BOARDS / "sensitivity" / f"sensitivity_{p}_sobol.csv").query(
+            "output == 'cost' and motion == 'calibrate'"
+        )
         m = morris.nlargest(top, "mu_star")
         s = sobol.nlargest(top, "ST")
         rows = [
             [a.material, float(a.mu_star), float(a.mu_star_conf), b.material, float(b.ST), float(b.ST_conf)]
             for a, b in zip(m.itertuples(), s.itertuples())
         ]
-        header = ["Morris: variable", "μ*", "± (95 %)", "Sobol: variable", "S_T", "± (95 %)"]
+        header = ["Morris: variable", "μ*", "μ* ± (95 %)", "Sobol: variable", "S_T", "S_T ± (95 %)"]
         parts += [f"\n## {p}\n", table(header, rows), ""]
         parts.append(figure(BOARDS / "sensitivity" / f"sensitivity_{p}_morris.png", f"Morris indices, {p}"))
     return "\n".join(parts) + "\n"
@@ -147,15 +149,6 @@ def posterior() -> str:
     return "\n".join(parts) + "\n"
 
 
-def band(low: float | None, high: float | None, unit: str) -> str:
-    """A published band; None is an open edge."""
-    if low is None:
-        return f"≤ {high:.3g} {unit}"
-    if high is None:
-        return f"≥ {low:.3g} {unit}"
-    return f"{low:.3g}–{high:.3g} {unit}"
-
-
 def validation() -> str:
     parts = [
         "# Validation",
@@ -174,7 +167,8 @@ def validation() -> str:
             c = reports[p]["checks"][i]
             value = "—" if c["value"] is None else f"{c['value']:.3g}"
             cells.append(f"{value} {'✓' if c['passed'] else '✗'}")
-        rows.append([check["description"], band(*check["band"], check["unit"]), *cells])
+        low, high = (math.inf if edge is None else edge for edge in check["band"])  # JSON's None: unbounded
+        rows.append([check["description"], f"{band_text(low, high)} {check['unit']}", *cells])
     passed = [sum(c["passed"] for c in reports[p]["checks"]) for p in PARTICIPANTS]
     parts += [table(["check", "band", *PARTICIPANTS], rows), ""]
     parts.append(

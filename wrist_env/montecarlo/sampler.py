@@ -176,7 +176,8 @@ def run_chunk(
     actions = np.asarray(actions, dtype=np.float64)
     k = len(actions)
     idealized = task(participant, "idealized", load_direction)
-    infos = [e.info for e in idealized.evaluate_batch([design.from_action(a) for a in actions])]
+    designs = [design.from_action(a) for a in actions]
+    infos = [e.info for e in idealized.evaluate_batch(designs)]
     angle = np.asarray(idealized.driver.angle_deg, dtype=np.float64)
     n_frames = len(angle)
     status = [str(info["status"]) for info in infos]
@@ -192,7 +193,7 @@ def run_chunk(
 
     rs_mean = rs("mean_pressure_mpa")
     excluded = ok & np.any(rs_mean > exclude_above_mpa, axis=1)
-    physical = np.stack([design.from_action(a).vector for a in actions]) if k else np.zeros((0, len(NAMES)))
+    physical = np.stack([d.vector for d in designs]) if k else np.zeros((0, len(NAMES)))
     columns = {
         "participant": [participant] * k,
         "sample_id": np.asarray(sample_ids, dtype=np.int64),

@@ -89,6 +89,11 @@ def _fmt(x: float) -> str:
     return f"{x:.3g}" if math.isfinite(x) else str(x)
 
 
+def band_text(low: float, high: float) -> str:
+    """A published band as the tables print it: "low-high", or "> low" when it has no upper edge (inf)."""
+    return f"{_fmt(low)}-{_fmt(high)}" if math.isfinite(high) else f"> {_fmt(low)}"
+
+
 def format_table(report: Report) -> str:
     """The checks as a plain-text table: check, value, band, unit, pass/FAIL, source."""
     c = report.conditions
@@ -104,9 +109,8 @@ def format_table(report: Report) -> str:
         f"{'check':<24} {'value':>8}  {'band':<13} {'unit':<8} {'result':<6}  source",
     ]
     for r in report.rows:
-        band = f"{_fmt(r.band[0])}-{_fmt(r.band[1])}" if math.isfinite(r.band[1]) else f"> {_fmt(r.band[0])}"
         lines.append(
-            f"{r.id:<24} {_fmt(r.value):>8}  {band:<13} {r.unit:<8} {'pass' if r.passed else 'FAIL':<6}  "
+            f"{r.id:<24} {_fmt(r.value):>8}  {band_text(*r.band):<13} {r.unit:<8} {'pass' if r.passed else 'FAIL':<6}  "
             f"{r.source.split(' (')[0]}"
         )
     for r in report.rows:
