@@ -49,9 +49,7 @@ def test_a_line_adds_its_force_and_its_moment_about_the_centre_of_mass(p1):
         state = kernel.State(R.copy(), x.copy(), np.zeros_like(x), np.zeros_like(x), nodes, np.zeros_like(nodes))
         work = kernel.new_work(p.grids, nodes)
         load = with_line.kernel_load(0)._replace(tension=np.array([tension]))
-        kernel._forces(
-            state, work, p.bodies, p.grids, p.law, p.fibres, design_arrays, p.membrane, p.settings, load, True
-        )
+        kernel.net_forces(state, work, p.system, design_arrays, load, True)
         return work.F.copy(), work.T.copy()
 
     F0, T0 = forces(0.0)

@@ -33,6 +33,9 @@ Settings = namedtuple(
     "active_band_mm node_mass membrane_contact_stiffness driver max_disp_mm max_rot_rad fire_alpha0 smooth_normals "
     "block_mass block_courant block_floor block_refresh_steps block_max_move_mm membrane_substeps membrane_substep_damping block_refresh_restart predict predict_ramp_steps",
 )
+System = namedtuple("System", "bodies grids law fibres membrane settings")
+"""A model's physics as the kernels read it and none writes: `Bodies`, contact `Grids`, the contact law
+(`model.contact_law`), `Fibres`, the RSC `Membrane` and the solver `Settings`."""
 
 RSC = RSC_INDEX
 EXPERIMENTAL, LOADED = 0, 1

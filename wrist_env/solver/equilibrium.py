@@ -54,14 +54,14 @@ def moved_state(q, R0, x0, nodes0, free_nodes, loaded):
 
 
 @njit(cache=True, error_model="numpy")
-def _residual(q, R0, x0, nodes0, free_nodes, bod, grids, law, fib, stiffness, mem, st, load, out):
+def _residual(q, R0, x0, nodes0, free_nodes, system, stiffness, load, out):
     """Net forces (N) and moments / LEVER_MM (N) on the unknowns (`moved_state`) at the state moved by q."""
-    loaded = st.driver == arrays.LOADED
+    loaded = system.settings.driver == arrays.LOADED
     R, x, nodes = moved_state(q, R0, x0, nodes0, free_nodes, loaded)
     n_bones = R.shape[0]
     state = kernel.State(R, x, np.zeros((n_bones, 3)), np.zeros((n_bones, 3)), nodes, np.zeros_like(nodes))
-    work = kernel.new_work(grids, nodes)
-    kernel._forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, True)
+    work = kernel.new_work(system.grids, nodes)
+    kernel.net_forces(state, work, system, stiffness, load, True)
     F, T, node_force = work.F, work.T, work.node_force
     k = 0
     for b in FREE:
@@ -81,7 +81,7 @@ def _residual(q, R0, x0, nodes0, free_nodes, bod, grids, law, fib, stiffness, me
 
 
 @njit(cache=True, error_model="numpy")
-def _jacobian(q, R0, x0, nodes0, free_nodes, bod, grids, law, fib, stiffness, mem, st, load, step):
+def _jacobian(q, R0, x0, nodes0, free_nodes, system, stiffness, load, step):
     """Central-difference Jacobian of `_residual` (n, n) with steps `step` (rad or mm)."""
     n = q.shape[0]
     J = np.empty((n, n))
@@ -90,9 +90,9 @@ def _jacobian(q, R0, x0, nodes0, free_nodes, bod, grids, law, fib, stiffness, me
     for j in range(n):
         qj = q[j]
         q[j] = qj + step
-        _residual(q, R0, x0, nodes0, free_nodes, bod, grids, law, fib, stiffness, mem, st, load, plus)
+        _residual(q, R0, x0, nodes0, free_nodes, system, stiffness, load, plus)
         q[j] = qj - step
-        _residual(q, R0, x0, nodes0, free_nodes, bod, grids, law, fib, stiffness, mem, st, load, minus)
+        _residual(q, R0, x0, nodes0, free_nodes, system, stiffness, load, minus)
         q[j] = qj
         for i in range(n):
             J[i, j] = (plus[i] - minus[i]) / (2.0 * step)
@@ -137,20 +137,7 @@ def _frame_args(p, design_stiffness, free_nodes, driver, result, f: int) -> tupl
     """`_residual`'s arguments after q for frame f of `result`: its state and the kernel arrays."""
     R0, x0 = pose_state(result.poses[f], p.bodies.com0)
     nodes0 = np.ascontiguousarray(result.membrane_nodes[f])
-    return (
-        R0,
-        x0,
-        nodes0,
-        free_nodes,
-        p.bodies,
-        p.grids,
-        p.law,
-        p.fibres,
-        design_stiffness,
-        p.membrane,
-        p.settings,
-        driver.kernel_load(f),
-    )
+    return R0, x0, nodes0, free_nodes, p.system, design_stiffness, driver.kernel_load(f)
 
 
 def nearest(model: Model, design: Design, driver, result, settings: arrays.SolverSettings | None = None) -> Equilibrium:
@@ -281,22 +268,8 @@ def block_mass(
     )
     work = kernel.new_work(g, nodes0)
     load = driver.kernel_load(frame)
-    kernel._forces(state, work, p.bodies, g, p.law, p.fibres, st, p.membrane, p.settings, load, True)
+    kernel.net_forces(state, work, p.system, st, load, True)
     m = preconditioner.metric()
-    tangent(
-        state.R,
-        state.x,
-        state.nodes,
-        p.bodies.com0,
-        g,
-        p.law,
-        p.fibres,
-        st,
-        p.membrane,
-        p.settings,
-        work.active,
-        work.n_active,
-        m,
-    )
+    tangent(state.R, state.x, state.nodes, p.system, st, work.active, work.n_active, m)
     preconditioner.block_mass(state.R, p.bodies, p.settings, m)
     return BlockMass(m.stiffness[:n_bones, :n_bones].copy(), m.mass[:n_bones, :n_bones].copy())

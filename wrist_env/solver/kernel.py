@@ -9,6 +9,11 @@ loads are lines of action on the bodies (`drivers.Loads`).
 The free bones' masses are their (scaled) physical ones or, with
 `Settings.block_mass`, one block each from the tangent stiffness
 (`preconditioner`): the answer is the same equilibrium, reached in fewer steps.
+
+Read `run` → `_run`: per stage (settle, move, each frame) it stages the capitate's targets
+(`_stage`, or the secant predictor's state: `_predicted`), holds (`_ramp_and_hold`, which calls
+`_step`, which calls `net_forces`), checks (`_failure`) and records the frame (`_record`). Every
+kernel reads the model through one `arrays.System` and a design through one `Stiffness`.
 """
 
 from __future__ import annotations
@@ -20,7 +25,7 @@ from numba import njit, prange
 
 from wrist_env.design import ALL_LIGAMENT_NAMES, RSC_INDEX
 from wrist_env.model import BONES, CAPITATE, FREE, PAIRS
-from wrist_env.solver.arrays import EXPERIMENTAL, LOADED
+from wrist_env.solver.arrays import EXPERIMENTAL, LOADED, System
 from wrist_env.solver.forces import (
     C_AREA,
     C_FORCE,
@@ -67,11 +72,12 @@ def _contact(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, w
 
 
 @njit(cache=True, error_model="numpy")
-def _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, rebuild, want_energy=True):
-    """Forces F (N), torques T (N·mm), contact stats and bundle forces at the current
-    state; with `rebuild`, every pair's active contact samples are refilled first (otherwise a
-    pair refills when its samples may have moved half the band); returns internal energy
-    (N·mm; 0 unless `want_energy`)."""
+def net_forces(state, work, system, stiffness, load, rebuild, want_energy=True):
+    """Forces F (N), torques T (N·mm), contact stats and bundle forces (all in `work`) at `state`
+    (`State`) of `system` (`arrays.System`) under a design's `stiffness` and the driver's `load`; with
+    `rebuild`, every pair's active contact samples are refilled first (otherwise a pair refills when
+    its samples may have moved half the band); returns internal energy (N·mm; 0 unless `want_energy`)."""
+    bod, grids, law, fib, mem, st = system
     R, x, v, w, nodes, _ = state
     active, n_active, ref, F, T, node_force, stats, bundle = work
     f_l0, f_K, m_l0, m_K, _ = stiffness
@@ -103,14 +109,13 @@ def _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, rebuild
 
 
 @njit(cache=True, error_model="numpy")
-def _step(
-    state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step_index, fire, m, refresh, scratch
-):
+def _step(state, work, system, stiffness, capR, capx, load, step_index, fire, m, refresh, scratch):
     """One explicit step with the capitate at target (capR, capx), or, for the loaded
     driver, at rotation capR; `load` (`Load`) the driver's lines of action at this step's tensions; with st.block_mass and
     `refresh`, the block mass m (`preconditioner.Metric`) is rebuilt at this state first; with
     st.membrane_substeps the membrane's free nodes then take that many more steps of their own
     (`membrane.substep`; scratch its arrays)."""
+    bod, _, _, _, mem, st = system
     R, x, v, w, nodes, nv = state
     active, n_active, _, F, T, node_force, _, _ = work
     R[CAPITATE] = capR
@@ -118,9 +123,9 @@ def _step(
         x[CAPITATE, 0], x[CAPITATE, 1], x[CAPITATE, 2] = capx
         v[CAPITATE] = 0.0
     w[CAPITATE] = 0.0
-    _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, False, False)
+    net_forces(state, work, system, stiffness, load, False, False)
     if st.block_mass and refresh:
-        tangent(R, x, nodes, bod.com0, grids, law, fib, stiffness, mem, st, active, n_active, m)
+        tangent(R, x, nodes, system, stiffness, active, n_active, m)
         block_mass(R, bod, st, m)
     if st.fire_alpha0 > 0.0:
         fire_step(v, w, nv, F, T, node_force, mem, st, fire, m)
@@ -145,23 +150,24 @@ def _step(
 
 
 @njit(cache=True, error_model="numpy")
-def _predicted(state, work, bod, grids, law, fib, stiffness, mem, st, hist, capR, capx, load, move):
+def _predicted(state, work, system, stiffness, hist, capR, capx, load, move):
     """Start the next stage, whose capitate pose is (capR, capx) under `load`, from the secant
     predictor's state (`predictor.predict`) if the free bodies' residual there, with the capitate
     already at that pose, is below their residual left where they are; True if so (the state is
     the prediction), False if not (the positions are restored; the velocities, ~0 at the end of a
     hold, stay zeroed)."""
+    mem, st = system.membrane, system.settings
     R, x, v, w, nodes, nv = state
     keep_R, keep_x, keep_nodes = R.copy(), x.copy(), nodes.copy()
     R[CAPITATE] = capR
     if st.driver == EXPERIMENTAL:
         x[CAPITATE] = capx
-    _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, True, False)
+    net_forces(state, work, system, stiffness, load, True, False)
     before = residual(work.F, work.T, st)
     if not predict(hist, R, x, v, w, nodes, nv, mem, st, move):
         R[:], x[:], nodes[:] = keep_R, keep_x, keep_nodes
         return False
-    _forces(state, work, bod, grids, law, fib, stiffness, mem, st, load, True, False)
+    net_forces(state, work, system, stiffness, load, True, False)
     if residual(work.F, work.T, st) < before:
         return True
     R[:], x[:], nodes[:] = keep_R, keep_x, keep_nodes
@@ -231,10 +237,10 @@ def _stage(f, R0, x0, frame_R, frame_x, frame_load, st):
 
 
 @njit(cache=True, error_model="numpy")
-def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
-    """Simulate one design (`Stiffness`) through the capitate's `Frames`; fills `out` (`Outputs`) and
-    out.status[0] (0 ok, 1 NaN, 2 diverged). Steps per frame count those since the previous frame
-    (frame 0: settling and the move included).
+def run(system, stiffness, frames, out):
+    """Simulate one design (`Stiffness`) of `system` (`arrays.System`) through the capitate's `Frames`;
+    fills `out` (`Outputs`) and out.status[0] (0 ok, 1 NaN, 2 diverged). Steps per frame count those
+    since the previous frame (frame 0: settling and the move included).
     Each stage ramps the capitate over its ramp steps, then holds until
     `_converged` (at least min_hold_steps, at most max_hold_steps; settling
     at most settle_steps).
@@ -242,37 +248,34 @@ def run(bod, grids, law, fib, stiffness, mem, st, frames, out):
     R = np.zeros((N_BONES, 3, 3))
     for b in range(N_BONES):
         R[b] = np.eye(3)
-    _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R, bod.com0.copy(), mem.rest.copy(), SETTLE)
+    _run(system, stiffness, frames, out, R, system.bodies.com0.copy(), system.membrane.rest.copy(), SETTLE)
 
 
 @njit(cache=True, error_model="numpy")
-def run_from(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes):
+def run_from(system, stiffness, frames, out, R, x, nodes):
     """`run` from a given state at frame 0 instead of from rest: rotations R (5, 3, 3), centres of mass
     x (5, 3) mm (the capitate at frame 0's pose) and membrane nodes (M, 3) mm, at rest; no settling or
     move, frame 0's outputs left unfilled, each later frame as in `run` (for a frame-local comparison:
     `experiments/verification/solver_accuracy.py --frame-local`)."""
-    _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R.copy(), x.copy(), nodes.copy(), 1)
+    _run(system, stiffness, frames, out, R.copy(), x.copy(), nodes.copy(), 1)
 
 
 @njit(cache=True, error_model="numpy")
-def _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes, first):
-    """`run` from the state (R, x, nodes), its stages from `first` (`SETTLE`, or 1 from a frame-0 state)."""
+def _run(system, stiffness, frames, out, R, x, nodes, first):
+    """`run` from the state (R, x, nodes), its stages from `first` (`SETTLE`, or 1 from a frame-0 state):
+    per stage, stage (its capitate targets, from the predictor's state if that is closer) → hold
+    (`_ramp_and_hold`) → check (`_failure`) → record (`_record`)."""
+    st = system.settings
     frame_R, frame_x, frame_load, body, point, direction = frames
-    poses, contact, bundle_out, energy_out, residual_out, steps_out, settled_out, nodes_out, status = out
-    com0 = bod.com0
+    status = out.status
     n_frames = frame_R.shape[0]
-    v = np.zeros((N_BONES, 3))
-    w = np.zeros((N_BONES, 3))
-    nv = np.zeros_like(nodes)
-    state = State(R, x, v, w, nodes, nv)
-    work = new_work(grids, nodes)
-    F, T, stats, bundle = work.F, work.T, work.stats, work.bundle
+    state = State(R, x, np.zeros((N_BONES, 3)), np.zeros((N_BONES, 3)), nodes, np.zeros_like(nodes))
+    work = new_work(system.grids, nodes)
     status[0] = OK
     step = 0
     R0 = np.eye(3)
-    x0 = com0[CAPITATE].copy()
+    x0 = system.bodies.com0[CAPITATE].copy()
     fire = np.array([st.fire_alpha0, 0.0, 0.0])
-    capR = np.eye(3)
     load = Load(body, point, direction, np.zeros(frame_load.shape[1]))
     m = metric()
     scratch = new_scratch(nodes)
@@ -288,91 +291,125 @@ def _run(bod, grids, law, fib, stiffness, mem, st, frames, out, R, x, nodes, fir
             st.predict
             and st.driver == LOADED
             and f > 0
-            and _predicted(state, work, bod, grids, law, fib, stiffness, mem, st, hist, Rb, xb, at_end, move)
+            and _predicted(state, work, system, stiffness, hist, Rb, xb, at_end, move)
         ):
             ramp = st.predict_ramp_steps
             fire[0], fire[1], fire[2] = st.fire_alpha0, 0.0, 1.0
-        k = 0
-        settled = False
-        while k < ramp + most:
-            s = smoothstep((k + 1) / ramp) if ramp > 0 else 1.0
-            capx = interpolate_pose(Ra, xa, axis, capR, shift, s)
-            for i in range(frame_load.shape[1]):
-                load.tension[i] = la[i] + s * (lb[i] - la[i])
-            refresh = k % st.block_refresh_steps == 0 or (st.block_refresh_restart and fire[2] > 0.0)
-            fire[2] = 0.0
-            _step(
-                state, work, bod, grids, law, fib, stiffness, mem, st, capR, capx, load, step, fire, m, refresh, scratch
-            )
-            step += 1
-            k += 1
-            if k >= ramp + st.min_hold_steps and converged(F, T, bundle, st):
-                settled = True
-                break
+        k, settled = _ramp_and_hold(
+            state, work, system, stiffness, Ra, xa, la, axis, shift, lb, ramp, most, load, step, fire, m, scratch
+        )
+        step += k
         taken += k
-        bad = False
-        for b in SOLVED:
-            for i in range(3):
-                if not np.isfinite(x[b, i]):
-                    bad = True
-        if bad:
-            status[0] = FAILED_NAN
-        else:
-            for b in FREE:
-                if displacement(R, x, com0, b) > st.max_disp_mm:
-                    status[0] = FAILED_DIVERGED
-                rel = matrix_to_rotvec(R[b] @ R[CAPITATE].T)
-                if np.linalg.norm(rel) > st.max_rot_rad:
-                    status[0] = FAILED_DIVERGED
+        status[0] = _failure(state.R, state.x, system.bodies.com0, st)
         if status[0] != OK:
             return
         if f < 0:  # SETTLE and MOVE have no output frame
             continue
         if st.predict:
             record(hist, R, x, nodes, move)
-        # outputs at the state reached (the last step's forces were those before it)
-        energy = _forces(state, work, bod, grids, law, fib, stiffness, mem, st, at_end, True)
-        for b in range(N_BONES):
-            poses[f, b, :3, :3] = R[b]
-            poses[f, b, :3, 3] = x[b] - R[b] @ com0[b]
-            poses[f, b, 3, :3] = 0.0
-            poses[f, b, 3, 3] = 1.0
-        for p in range(stats.shape[0]):
-            area = stats[p, C_AREA]
-            contact[f, p, R_MEAN] = stats[p, C_FORCE] / area if area > 0 else 0.0
-            contact[f, p, R_PEAK] = stats[p, C_PEAK]
-            contact[f, p, R_AREA] = area
-            contact[f, p, R_FORCE] = stats[p, C_FORCE]
-        bundle_out[f] = bundle
-        energy_out[f, 0] = kinetic_energy(R, v, w, nv, bod, st, stiffness.node_mass, m)
-        energy_out[f, 1] = energy
-        residual_out[f, 0] = 0.0
-        residual_out[f, 1] = 0.0
-        for b in FREE:
-            residual_out[f, 0] = max(residual_out[f, 0], np.linalg.norm(F[b]))
-            residual_out[f, 1] = max(residual_out[f, 1], np.linalg.norm(T[b]))
-        steps_out[f] = taken
-        settled_out[f] = 1 if settled else 0
-        nodes_out[f] = nodes
+        _record(f, state, work, system, stiffness, at_end, m, out, taken, settled)
         taken = 0
 
 
+@njit(cache=True, error_model="numpy")
+def _ramp_and_hold(
+    state, work, system, stiffness, Ra, xa, la, axis, shift, lb, ramp, most, load, step, fire, m, scratch
+):
+    """One stage's steps: the capitate ramps from (Ra, xa) by the rotation vector `axis` and `shift`
+    (mm), the lines' tensions from la to lb (N), over `ramp` steps, then holds until `converged` (after
+    at least min_hold_steps, at most `most`); `step` the run's steps before it. Returns the steps taken
+    and whether the hold ended in equilibrium."""
+    st = system.settings
+    capR = np.eye(3)
+    k = 0
+    while k < ramp + most:
+        s = smoothstep((k + 1) / ramp) if ramp > 0 else 1.0
+        capx = interpolate_pose(Ra, xa, axis, capR, shift, s)
+        for i in range(la.shape[0]):
+            load.tension[i] = la[i] + s * (lb[i] - la[i])
+        refresh = k % st.block_refresh_steps == 0 or (st.block_refresh_restart and fire[2] > 0.0)
+        fire[2] = 0.0
+        _step(state, work, system, stiffness, capR, capx, load, step + k, fire, m, refresh, scratch)
+        k += 1
+        if k >= ramp + st.min_hold_steps and converged(work.F, work.T, work.bundle, st):
+            return k, True
+    return k, False
+
+
+@njit(cache=True, error_model="numpy")
+def _failure(R, x, com0, st):
+    """The run's status at this state: `FAILED_NAN` if a solved body's centre is not finite,
+    `FAILED_DIVERGED` if a free bone dislocated (`displacement` beyond max_disp_mm, or turned beyond
+    max_rot_rad from the capitate), else `OK`."""
+    for b in SOLVED:
+        for i in range(3):
+            if not np.isfinite(x[b, i]):
+                return FAILED_NAN
+    status = OK
+    for b in FREE:
+        if displacement(R, x, com0, b) > st.max_disp_mm:
+            status = FAILED_DIVERGED
+        rel = matrix_to_rotvec(R[b] @ R[CAPITATE].T)
+        if np.linalg.norm(rel) > st.max_rot_rad:
+            status = FAILED_DIVERGED
+    return status
+
+
+@njit(cache=True, error_model="numpy")
+def _record(f, state, work, system, stiffness, load, m, out, taken, settled):
+    """Fill frame f of `out` at the state reached (the last step's forces were those before it, so they
+    are evaluated again here under the stage's end `load`); `taken` steps since the previous frame."""
+    bod, st = system.bodies, system.settings
+    R, x, v, w, nodes, nv = state
+    F, T, stats = work.F, work.T, work.stats
+    com0 = bod.com0
+    energy = net_forces(state, work, system, stiffness, load, True)
+    for b in range(N_BONES):
+        out.poses[f, b, :3, :3] = R[b]
+        out.poses[f, b, :3, 3] = x[b] - R[b] @ com0[b]
+        out.poses[f, b, 3, :3] = 0.0
+        out.poses[f, b, 3, 3] = 1.0
+    contact = out.contact
+    for p in range(stats.shape[0]):
+        area = stats[p, C_AREA]
+        contact[f, p, R_MEAN] = stats[p, C_FORCE] / area if area > 0 else 0.0
+        contact[f, p, R_PEAK] = stats[p, C_PEAK]
+        contact[f, p, R_AREA] = area
+        contact[f, p, R_FORCE] = stats[p, C_FORCE]
+    out.bundle[f] = work.bundle
+    out.energy[f, 0] = kinetic_energy(R, v, w, nv, bod, st, stiffness.node_mass, m)
+    out.energy[f, 1] = energy
+    out.residual[f, 0] = 0.0
+    out.residual[f, 1] = 0.0
+    for b in FREE:
+        out.residual[f, 0] = max(out.residual[f, 0], np.linalg.norm(F[b]))
+        out.residual[f, 1] = max(out.residual[f, 1], np.linalg.norm(T[b]))
+    out.steps[f] = taken
+    out.settled[f] = 1 if settled else 0
+    out.nodes[f] = nodes
+
+
 @njit(cache=True, error_model="numpy", parallel=True)
-def run_batch(bod, grids, law, fib, stiffness, mem, st, frames, out):
-    """`run` for many designs: `Stiffness` and `Outputs` arrays with a leading design axis."""
+def run_batch(bod, grids, law, fib, mem, st, stiffness, frames, out):
+    """`run` for many designs: `Stiffness` and `Outputs` arrays with a leading design axis; the
+    `arrays.System` comes flat (bod, grids, law, fib, mem, st): a parallel loop takes no nested tuples."""
     for i in prange(stiffness.f_l0.shape[0]):
-        design = Stiffness(
-            stiffness.f_l0[i], stiffness.f_K[i], stiffness.m_l0[i], stiffness.m_K[i], stiffness.node_mass[i]
-        )
-        filled = Outputs(
-            out.poses[i],
-            out.contact[i],
-            out.bundle[i],
-            out.energy[i],
-            out.residual[i],
-            out.steps[i],
-            out.settled[i],
-            out.nodes[i],
-            out.status[i],
-        )
-        run(bod, grids, law, fib, design, mem, st, frames, filled)
+        _run_design(i, bod, grids, law, fib, mem, st, stiffness, frames, out)
+
+
+@njit(cache=True, error_model="numpy")
+def _run_design(i, bod, grids, law, fib, mem, st, stiffness, frames, out):
+    """`run` on design i of `run_batch`'s arrays."""
+    design = Stiffness(stiffness.f_l0[i], stiffness.f_K[i], stiffness.m_l0[i], stiffness.m_K[i], stiffness.node_mass[i])
+    filled = Outputs(
+        out.poses[i],
+        out.contact[i],
+        out.bundle[i],
+        out.energy[i],
+        out.residual[i],
+        out.steps[i],
+        out.settled[i],
+        out.nodes[i],
+        out.status[i],
+    )
+    run(System(bod, grids, law, fib, mem, st), design, frames, filled)

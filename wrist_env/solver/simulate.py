@@ -92,6 +92,11 @@ class Prepared:
     law: np.ndarray
     membrane_eigenvalue: float
 
+    @property
+    def system(self) -> arrays.System:
+        """The arrays every kernel reads (`arrays.System`)."""
+        return arrays.System(self.bodies, self.grids, self.law, self.fibres, self.membrane, self.settings)
+
     def check(self, model: Model, driver: Driver) -> None:
         if model is not self.model or driver.mode != self.mode:
             raise ValueError(
@@ -144,7 +149,7 @@ def simulate(
     prepared: `prepare(model, settings, driver.mode)`, to skip rebuilding the kernel arrays."""
     p = _prepared(model, settings, driver, prepared)
     out = _outputs(0, len(driver.rotation), len(model.membrane_nodes))
-    _run(kernel.run, p, stiffness(p, design), driver, out)
+    kernel.run(p.system, stiffness(p, design), _frames(driver), out)
     return _result(out, driver, int(out.status[0]))
 
 
@@ -176,20 +181,7 @@ def simulate_frame(
     R, x = pose_state(poses, model.com)
     out = _outputs(0, 2, len(model.membrane_nodes))
     frames = _frames(two)
-    kernel.run_from(
-        p.bodies,
-        p.grids,
-        p.law,
-        p.fibres,
-        stiffness(p, design),
-        p.membrane,
-        p.settings,
-        frames,
-        out,
-        R,
-        x,
-        np.ascontiguousarray(nodes, dtype=np.float64),
-    )
+    kernel.run_from(p.system, stiffness(p, design), frames, out, R, x, np.ascontiguousarray(nodes, dtype=np.float64))
     return _result(out, two, int(out.status[0]))
 
 
@@ -208,16 +200,10 @@ def simulate_batch(
     out = _outputs(len(per), len(driver.rotation), len(model.membrane_nodes))
     previous = numba.set_parallel_chunksize(1)  # designs differ in cost: hand them out one at a time
     try:
-        _run(kernel.run_batch, p, stacked, driver, out)
+        kernel.run_batch(*p.system, stacked, _frames(driver), out)  # flat: see `kernel.run_batch`
     finally:
         numba.set_parallel_chunksize(previous)
     return [_result(kernel.Outputs(*(o[i] for o in out)), driver, int(out.status[i, 0])) for i in range(len(per))]
-
-
-def _run(entry, p: Prepared, stiffness: kernel.Stiffness, driver: Driver, out: kernel.Outputs) -> None:
-    """Call a kernel entry point (`kernel.run` or `kernel.run_batch`) on prepared arrays; fills `out`."""
-    frames = _frames(driver)
-    entry(p.bodies, p.grids, p.law, p.fibres, stiffness, p.membrane, p.settings, frames, out)
 
 
 def _frames(driver: Driver) -> kernel.Frames:

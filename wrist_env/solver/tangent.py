@@ -157,9 +157,12 @@ def _pair_sums(grids, b, M, samples, law, com0, S, J, smooth):
 
 
 @njit(cache=True, error_model="numpy")
-def tangent(R, x, nodes, com0, grids, law, fib, stiffness, mem, st, active, n_active, m):
-    """Assemble m.stiffness, the Gauss–Newton tangent at the state (R, x, nodes) over the active contact
-    samples (as the last force evaluation left them)."""
+def tangent(R, x, nodes, system, stiffness, active, n_active, m):
+    """Assemble m.stiffness, the Gauss–Newton tangent of `system` (`arrays.System`) under a design's
+    `stiffness` at the state (R, x, nodes) over the active contact samples (as the last force evaluation
+    left them)."""
+    _, grids, law, fib, mem, st = system
+    com0 = system.bodies.com0
     K, S = m.stiffness, m.block
     K[:] = 0.0
     J = np.empty(6)
