@@ -1,6 +1,7 @@
 """The Bayesian calibrator (`wrist_env.identification`): the sampler against a closed-form posterior, its
 diagnostics, and a short run on P1 through the command."""
 
+import dataclasses
 import json
 
 import numpy as np
@@ -8,9 +9,11 @@ import pytest
 
 from wrist_env import design
 from wrist_env.cli import main
+from wrist_env.errors import InputError
 from wrist_env.identification import bayes, mcmc, posterior, smc
 from wrist_env.identification import map as map_
 from wrist_env.identification import study as study_
+from wrist_env.identification.settings import SamplerSettings
 
 
 def _linear_gaussian():
@@ -230,7 +233,7 @@ def test_a_model_trials_study_keeps_its_own_files_and_says_so(built, tmp_path, m
     asked = []
     n_frames = 15
 
-    def fake(participant, seed, progress, trials, **settings):
+    def fake(participant, seed, settings, progress, trials):
         asked.append(trials)
         rng = np.random.default_rng(seed)
         zeros = np.zeros(design.N_MATERIAL)
@@ -252,16 +255,42 @@ def test_a_model_trials_study_keeps_its_own_files_and_says_so(built, tmp_path, m
     assert (tmp_path / "posterior_intervals_P1_model.png").exists()
 
 
-@pytest.mark.parametrize("bad", [["--prior-refresh", "1"], ["--walkers", "40"], ["--map-starts", "0"]])
-def test_the_command_refuses_sampler_settings_out_of_range(bad, capsys):
-    assert main(["posterior", "P1", *bad]) == 2  # a usage error, one line
-    assert "--prior-refresh < 1" in capsys.readouterr().err
+@pytest.mark.parametrize(
+    "bad, says",
+    [
+        (["--prior-refresh", "1"], "prior_refresh must be a share in [0, 1), but got 1.0"),
+        (["--walkers", "40"], "walkers must be an integer >= 44 (2 per material, 22 materials), but got 40"),
+        (["--map-starts", "0"], "map_starts must be an integer >= 1 (one Gauss-Newton run), but got 0"),
+        (["--seeds", "0"], "needs --seeds >= 1, but got 0"),
+    ],
+)
+def test_the_command_refuses_sampler_settings_out_of_range(bad, says, capsys):
+    assert main(["posterior", "P1", *bad]) == 2  # a usage error, one line naming the setting and the value
+    assert says in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "field, value",
+    [("sampler", "nuts"), ("walkers", 43), ("walkers", 48.0), ("steps", 3), ("particles", True), ("mcmc_steps", 0),
+     ("prior_refresh", -0.1), ("prior_refresh", float("nan"))],
+)  # fmt: skip
+def test_sampler_settings_refuse_values_out_of_range(field, value):
+    with pytest.raises(InputError, match=f"SamplerSettings.{field} must be"):
+        SamplerSettings(**{field: value})
+
+
+def test_sampler_settings_are_frozen_and_record_what_shapes_a_run():
+    emcee, tempered = SamplerSettings(walkers=48, steps=8, map_starts=2), SamplerSettings("smc", particles=64)
+    assert emcee.record() == {"walkers": 48, "steps": 8, "map_starts": 2, "prior_refresh": mcmc.PRIOR_REFRESH}
+    assert tempered.record() == {"particles": 64, "mcmc_steps": smc.MCMC_STEPS, "map_starts": map_.MAP_STARTS}
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        emcee.steps = 4
 
 
 def test_the_commands_defaults_are_the_samplers_own(capsys):
     with pytest.raises(SystemExit):
         main(["posterior", "--help"])
     text = " ".join(capsys.readouterr().out.split())
-    for flag, value in [("--steps", bayes.STEPS), ("--map-starts", bayes.MAP_STARTS)]:
+    for flag, value in [("--steps", mcmc.STEPS), ("--map-starts", map_.MAP_STARTS)]:
         assert f"{flag.upper().lstrip('-').replace('-', '_')} " in text and f"default {value}" in text
     assert f"(default {mcmc.PRIOR_REFRESH})" in text

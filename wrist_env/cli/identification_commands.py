@@ -14,10 +14,13 @@ from wrist_env.cli.options import (
     seed_option,
 )
 from wrist_env.errors import UsageError
-from wrist_env.identification import bayes, fisher, sensitivity
+from wrist_env.identification import fisher, sensitivity
+from wrist_env.identification.settings import SAMPLERS, SamplerSettings
 from wrist_env.identification.study import study
 from wrist_env.participants import builtin, registry
 from wrist_env.trial import MOTIONS
+
+DEFAULTS = SamplerSettings()
 
 
 def _sensitivity(args) -> int:
@@ -59,19 +62,11 @@ def _identifiability(args) -> int:
 def _posterior(args) -> int:
 
     registry.require(*args.participants)
-    if (
-        args.walkers < 44
-        or args.steps < 4
-        or args.seeds < 1
-        or args.particles < 44
-        or args.mcmc_steps < 1
-        or args.map_starts < 1
-        or not 0 <= args.prior_refresh < 1
-    ):
-        raise UsageError(
-            "needs --walkers >= 44 (2 x 22), --steps >= 4, --particles >= 44, "
-            "--mcmc-steps >= 1, --map-starts >= 1, 0 <= --prior-refresh < 1 and --seeds >= 1"
-        )
+    if args.seeds < 1:
+        raise UsageError(f"needs --seeds >= 1, but got {args.seeds}")
+    settings = SamplerSettings(
+        args.sampler, args.walkers, args.steps, args.particles, args.mcmc_steps, args.map_starts, args.prior_refresh
+    )
 
     def report(post, loaded):
         how = (
@@ -94,17 +89,11 @@ def _posterior(args) -> int:
         args.participants,
         args.seeds,
         args.out,
-        walkers=args.walkers,
-        steps=args.steps,
+        settings,
         progress=not args.no_progress,
         on_run=report,
         report=args.report,
         trials="model" if args.model_trials else "built-in",
-        sampler=args.sampler,
-        particles=args.particles,
-        mcmc_steps=args.mcmc_steps,
-        map_starts=args.map_starts,
-        prior_refresh_share=args.prior_refresh,
     )
     if "coverage_90" in table:
         for participant, rows in table.groupby("participant", sort=False):
@@ -172,32 +161,38 @@ def add_commands(command: Callable[..., object]) -> None:
     )
     participants_argument(s)
     s.add_argument("--seeds", type=int, default=1, help="runs per participant, seeds 0 .. N-1 (default 1)")
-    s.add_argument("--walkers", type=int, default=bayes.WALKERS, help="ensemble walkers (default %(default)s; >= 44)")
-    s.add_argument("--steps", type=int, default=bayes.STEPS, help="ensemble steps (default %(default)s, ~12 min a run)")
+    s.add_argument(
+        "--walkers", type=int, default=DEFAULTS.walkers, help="ensemble walkers (default %(default)s; >= 44)"
+    )
+    s.add_argument(
+        "--steps", type=int, default=DEFAULTS.steps, help="ensemble steps (default %(default)s, ~12 min a run)"
+    )
     s.add_argument(
         "--sampler",
-        choices=bayes.SAMPLERS,
-        default=bayes.SAMPLERS[0],
+        choices=SAMPLERS,
+        default=DEFAULTS.sampler,
         help="emcee (ensemble MCMC from the MAP; default) or smc (SMCPy's adaptive tempered SMC from a "
         "heavy-tailed start around the MAP; files get a _smc suffix)",
     )
-    s.add_argument("--particles", type=int, default=bayes.PARTICLES, help="SMC particles (default %(default)s; >= 44)")
+    s.add_argument(
+        "--particles", type=int, default=DEFAULTS.particles, help="SMC particles (default %(default)s; >= 44)"
+    )
     s.add_argument(
         "--mcmc-steps",
         type=int,
-        default=bayes.MCMC_STEPS,
+        default=DEFAULTS.mcmc_steps,
         help="SMC random-walk steps per particle and stage (default %(default)s)",
     )
     s.add_argument(
         "--map-starts",
         type=int,
-        default=bayes.MAP_STARTS,
+        default=DEFAULTS.map_starts,
         help="Gauss-Newton starts of the MAP search that both samplers start from (default %(default)s)",
     )
     s.add_argument(
         "--prior-refresh",
         type=float,
-        default=bayes.PRIOR_REFRESH,
+        default=DEFAULTS.prior_refresh,
         help="emcee's share of moves that redraw one material from its prior (default %(default)s)",
     )
     out_option(s, "runs/posterior")

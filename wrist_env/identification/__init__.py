@@ -4,5 +4,6 @@
 - `sensitivity` (Morris, Sobol; SALib) and `fisher` (the Fisher matrix at the hidden truth): how much a
   trial says about each material.
 - The Bayesian calibrator: `map` (the MAP and its Laplace covariance), `mcmc` (emcee) or `smc` (SMCPy)
-  from there, `bayes.calibrate` (one run: a `posterior.Posterior`), `study` (runs, coverage, figures).
+  from there, `bayes.calibrate` (one run: a `posterior.Posterior`) with a `settings.SamplerSettings`,
+  `study` (runs, coverage, figures).
 """

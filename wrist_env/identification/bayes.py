@@ -41,10 +41,11 @@ from wrist_env import design
 from wrist_env.cost import COST_BONES
 from wrist_env.frames import pose_to_dof
 from wrist_env.identification import likelihood
-from wrist_env.identification.map import MAP_STARTS, laplace_covariance, map_estimate
-from wrist_env.identification.mcmc import PRIOR_REFRESH, STEPS, WALKERS, log_likelihood, log_probability, sample
+from wrist_env.identification.map import laplace_covariance, map_estimate
+from wrist_env.identification.mcmc import log_likelihood, log_probability, sample
 from wrist_env.identification.posterior import Posterior
-from wrist_env.identification.smc import MCMC_STEPS, PARTICLES, DefensiveStart, sample_smc
+from wrist_env.identification.settings import SamplerSettings
+from wrist_env.identification.smc import DefensiveStart, sample_smc
 from wrist_env.model import BONES
 from wrist_env.participants import builtin
 from wrist_env.task import Task, cost_poses, task
@@ -54,7 +55,6 @@ PREDICTIVE_DRAWS = 32
 
 
 TRIALS = ("built-in", "model")
-SAMPLERS = ("emcee", "smc")
 
 
 def model_trials(t: Task, seed: int) -> Task:
@@ -87,38 +87,33 @@ def _tasks(participant: str, trials: str, seed: int) -> tuple[Task, Task]:
 def calibrate(
     participant: str,
     seed: int = 0,
-    walkers: int = WALKERS,
-    steps: int = STEPS,
+    settings: SamplerSettings | None = None,
+    *,
     progress: bool = False,
     trials: str = "built-in",
-    sampler: str = "emcee",
-    particles: int = PARTICLES,
-    mcmc_steps: int = MCMC_STEPS,
-    map_starts: int = MAP_STARTS,
-    prior_refresh_share: float = PRIOR_REFRESH,
 ) -> Posterior:
-    """Sample the posterior of `participant`'s 22 materials given its calibration trial (see the module doc);
-    trials="model" calibrates against `model_trials` instead; sampler="smc" runs `sample_smc` from the
-    bridge from a `DefensiveStart` around the MAP with `particles` and `mcmc_steps` instead of emcee
-    (`walkers`, `steps`, `prior_refresh_share` of its moves `prior_refresh`); map_starts: Gauss–Newton
-    starts of the MAP search."""
-    if sampler not in SAMPLERS:
-        raise ValueError(f"sampler must be one of {SAMPLERS}, but got {sampler!r}")
+    """Sample the posterior of `participant`'s 22 materials given its calibration trial (see the module doc)
+    with the sampler and settings of `settings` (default `SamplerSettings()`: emcee at its defaults);
+    trials="model" calibrates against `model_trials` instead."""
+    settings = SamplerSettings() if settings is None else settings
+    if not isinstance(settings, SamplerSettings):
+        raise TypeError(f"settings must be a SamplerSettings, but got {type(settings).__name__}")
     start_time = time.perf_counter()
     calibration, held_out = _tasks(participant, trials, seed)
     rng = np.random.default_rng(seed)
-    map_z, r, J, runs = map_estimate(calibration, map_starts, seed=seed)
+    map_z, r, J, runs = map_estimate(calibration, settings.map_starts, seed=seed)
     counter, extra = [runs], {}
-    if sampler == "emcee":
-        start = rng.multivariate_normal(map_z, laplace_covariance(r, J), size=walkers)
+    if settings.sampler == "emcee":
+        start = rng.multivariate_normal(map_z, laplace_covariance(r, J), size=settings.walkers)
         start = np.clip(start, -0.99 * likelihood.BOUND_Z, 0.99 * likelihood.BOUND_Z)
-        out = sample(log_probability(calibration, counter), start, steps, seed, progress, prior_refresh_share)
+        log_prob_fn = log_probability(calibration, counter)
+        out = sample(log_prob_fn, start, settings.steps, seed, progress, settings.prior_refresh)
         samples, log_prob = out["chain"].reshape(-1, design.N_MATERIAL), out["log_prob"].ravel()
         diagnostics = out["autocorr"], out["ess"], out["rhat"], out["acceptance"]
     else:
         start = DefensiveStart(map_z, laplace_covariance(r, J))
         log_like = log_likelihood(calibration, counter)
-        out = sample_smc(log_like, design.N_MATERIAL, particles, mcmc_steps, seed, progress, start)
+        out = sample_smc(log_like, design.N_MATERIAL, settings.particles, settings.mcmc_steps, seed, progress, start)
         samples = out["samples"]
         log_prob = out["log_likelihood"] + likelihood.log_prior(samples)
         distinct = float(len(np.unique(samples, axis=0)))
@@ -149,25 +144,10 @@ def calibrate(
         np.stack(predictive),
         np.stack(observed),
         trials,
-        sampler,
+        settings.sampler,
         **extra,
-        settings=sampler_settings(sampler, walkers, steps, particles, mcmc_steps, map_starts, prior_refresh_share),
+        settings=settings.record(),
     )
-
-
-def sampler_settings(
-    sampler: str,
-    walkers: int = WALKERS,
-    steps: int = STEPS,
-    particles: int = PARTICLES,
-    mcmc_steps: int = MCMC_STEPS,
-    map_starts: int = MAP_STARTS,
-    prior_refresh_share: float = PRIOR_REFRESH,
-) -> dict:
-    """The settings that shape a run of `sampler` (a saved run records them; the study's table lists them)."""
-    if sampler == "emcee":
-        return {"walkers": walkers, "steps": steps, "map_starts": map_starts, "prior_refresh": prior_refresh_share}
-    return {"particles": particles, "mcmc_steps": mcmc_steps, "map_starts": map_starts}
 
 
 def _dof(t: Task, poses: np.ndarray) -> np.ndarray:

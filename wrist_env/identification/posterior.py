@@ -27,7 +27,7 @@ class Posterior:
     calibration and held-out trial; observed (2, 2, n_frames, 6) the trials' own DOF.
     trials: "built-in" (the participant's trials) or "model" (`model_trials`: no model error).
     sampler: "emcee" or "smc"; log_evidence and stages: SMC's log marginal likelihood and tempering stages.
-    settings: the sampler's settings (`sampler_settings`); None in files saved before they were recorded.
+    settings: the sampler's settings (`SamplerSettings.record`); None in files saved before they were recorded.
     """
 
     participant: str

@@ -12,9 +12,10 @@ import pandas as pd
 from wrist_env import design
 from wrist_env.errors import StoreError
 from wrist_env.figures.posterior import plot_intervals, plot_predictive
-from wrist_env.identification.bayes import _tasks, calibrate, sampler_settings
+from wrist_env.identification.bayes import _tasks, calibrate
 from wrist_env.identification.mcmc import log_probability
 from wrist_env.identification.posterior import Posterior
+from wrist_env.identification.settings import SamplerSettings
 from wrist_env.participants import builtin
 
 LEVELS = (0.5, 0.9)
@@ -24,13 +25,12 @@ def study(
     participants,
     seeds,
     out,
+    settings: SamplerSettings | None = None,
     *,
     progress: bool = True,
     on_run: Callable[[Posterior, bool], object] | None = None,
     report: str | Path | None = None,
     trials: str = "built-in",
-    sampler: str = "emcee",
-    **options,
 ):
     """A Bayesian calibration per participant and seed (`out/posterior_<P>_seed<s>.npz/.json`; a run
     already saved is loaded, not rerun), then the coverage table (one row per run: share of the 22 true
@@ -38,12 +38,12 @@ def study(
     population design, diagnostics) as `out/coverage.csv` and the figures; returns the table.
     on_run(posterior, loaded) is called after each run; report: the folder of the table and figures
     (default `out`); a saved run sampled with other settings is an error; trials: "built-in" or "model"
-    (`model_trials`; files and figures get a `_model` suffix); sampler: "emcee" (walkers, steps) or
-    "smc" (particles, mcmc_steps; suffix `_smc`); options: the sampler's settings, as `bayes.calibrate` takes
-    them (walkers, steps, particles, mcmc_steps, map_starts, prior_refresh_share)."""
+    (`model_trials`; files and figures get a `_model` suffix); settings: the sampler and its settings
+    (default `SamplerSettings()`, emcee; SMC's files get a `_smc` suffix)."""
     out = Path(out)
+    settings = SamplerSettings() if settings is None else settings
+    sampler = settings.sampler
     suffix = ("" if trials == "built-in" else f"_{trials}") + ("" if sampler == "emcee" else f"_{sampler}")
-    settings = sampler_settings(sampler, **options)
     rows, posteriors = [], {}
     for participant in participants:
         truth = design.z_scores(builtin.truth(participant)) if participant in builtin.BUILTIN else None
@@ -52,13 +52,13 @@ def study(
             loaded = path.exists()
             if loaded:
                 post = Posterior.load(path)
-                if post.settings is not None and post.settings != settings:
+                if post.settings is not None and post.settings != settings.record():
                     raise StoreError(
-                        f"{path} was sampled with {post.settings}, not the {settings} asked for: "
+                        f"{path} was sampled with {post.settings}, not the {settings.record()} asked for: "
                         "delete it or choose another output folder"
                     )
             else:
-                post = calibrate(participant, seed, progress=progress, trials=trials, sampler=sampler, **options)
+                post = calibrate(participant, seed, settings, progress=progress, trials=trials)
                 post.save(path)
             if on_run is not None:
                 on_run(post, loaded)
@@ -68,7 +68,7 @@ def study(
                 "trials": post.trials,
                 "seed": seed,
                 "sampler": post.sampler,
-                **settings,
+                **settings.record(),
                 "evaluations": post.evaluations,
                 "wall_seconds": round(post.wall_seconds, 1),
                 "acceptance": post.acceptance,

@@ -1,0 +1,67 @@
+"""The Bayesian calibrator's sampler settings: one frozen record that refuses values out of range."""
+
+from __future__ import annotations
+
+import numbers
+from dataclasses import dataclass
+
+from wrist_env.design import N_MATERIAL
+from wrist_env.errors import InputError
+from wrist_env.identification.map import MAP_STARTS
+from wrist_env.identification.mcmc import PRIOR_REFRESH, STEPS, WALKERS
+from wrist_env.identification.smc import MCMC_STEPS, PARTICLES
+
+SAMPLERS = ("emcee", "smc")
+
+# (field, least value, why): the ensemble and the particle cloud need two members per material to span
+# the 22 dimensions (emcee refuses fewer); half the steps are burn-in and split R-hat halves the rest
+_AT_LEAST = (
+    ("walkers", 2 * N_MATERIAL, f"2 per material, {N_MATERIAL} materials"),
+    ("steps", 4, "half burn-in, the kept half split in two for R-hat"),
+    ("particles", 2 * N_MATERIAL, f"2 per material, {N_MATERIAL} materials"),
+    ("mcmc_steps", 1, "one move per stage"),
+    ("map_starts", 1, "one Gauss-Newton run"),
+)
+
+
+@dataclass(frozen=True)
+class SamplerSettings:
+    """What shapes a run of the Bayesian calibrator.
+
+    sampler: "emcee" (`walkers` x `steps`, a share `prior_refresh` in [0, 1) of the moves redraws one
+    material from its prior) or "smc" (`particles`, `mcmc_steps` random-walk steps per particle and
+    stage); map_starts: Gauss-Newton starts of the MAP search both start from."""
+
+    sampler: str = "emcee"
+    walkers: int = WALKERS
+    steps: int = STEPS
+    particles: int = PARTICLES
+    mcmc_steps: int = MCMC_STEPS
+    map_starts: int = MAP_STARTS
+    prior_refresh: float = PRIOR_REFRESH
+
+    def __post_init__(self):
+        if self.sampler not in SAMPLERS:
+            raise InputError(f"SamplerSettings.sampler must be one of {SAMPLERS}, but got {self.sampler!r}")
+        for name, least, why in _AT_LEAST:
+            value = getattr(self, name)
+            if not isinstance(value, numbers.Integral) or isinstance(value, bool) or value < least:
+                raise InputError(f"SamplerSettings.{name} must be an integer >= {least} ({why}), but got {value!r}")
+            object.__setattr__(self, name, int(value))
+        share = self.prior_refresh
+        if not isinstance(share, numbers.Real) or isinstance(share, bool) or not 0 <= share < 1:
+            raise InputError(f"SamplerSettings.prior_refresh must be a share in [0, 1), but got {share!r}")
+        object.__setattr__(self, "prior_refresh", float(share))
+
+    def record(self) -> dict:
+        """The settings that shape a run of this sampler (a saved run records them; the study's table
+        lists them): emcee's walkers, steps, map_starts and prior_refresh, or SMC's particles,
+        mcmc_steps and map_starts."""
+        if self.sampler == "emcee":
+            return {
+                "walkers": self.walkers,
+                "steps": self.steps,
+                "map_starts": self.map_starts,
+                "prior_refresh": self.prior_refresh,
+            }
+        return {"particles": self.particles, "mcmc_steps": self.mcmc_steps, "map_starts": self.map_starts}
