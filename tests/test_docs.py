@@ -1,7 +1,9 @@
 """The README is one screen and its examples run; the docs site builds with warnings as errors, and its
-results pages carry the committed results files' numbers."""
+results pages carry the committed results files' numbers; the hand-written pages type no result of our runs
+(those are the results pages', rendered, or the dated development notes')."""
 
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -77,3 +79,92 @@ def test_the_sensitivity_page_ranks_the_calibration_trials_own_indices(site):
     morris = pd.read_csv(ROOT / "leaderboards" / "sensitivity" / "sensitivity_P1_morris.csv")
     top = morris.query("output == 'cost' and motion == 'calibrate'").nlargest(len(rows), "mu_star")
     assert [(m.strip(), v.strip()) for m, v in rows] == [(r.material, f"{r.mu_star:.3g}") for r in top.itertuples()]
+
+
+def test_the_identifiability_page_counts_the_calibration_trials_directions(site):
+    import pandas as pd
+
+    page = (ROOT / "docs" / "results" / "identifiability.md").read_text()  # rendered by the build (`site`)
+    p1 = next(line.split("|")[1:4] for line in page.splitlines() if line.startswith("| P1 "))
+    spectrum = pd.read_csv(ROOT / "leaderboards" / "identifiability" / "identifiability_spectrum.csv")
+    calibrate = spectrum.query("participant == 'P1' and trials == 'calibrate'")
+    assert [c.strip() for c in p1] == ["P1", str(int((calibrate.sd < 0.5).sum())), str(len(calibrate))]
+
+
+DOCS = ROOT / "docs"
+HISTORY = DOCS / "history.md"
+NARRATIVE = sorted(p for p in DOCS.glob("*.md") if p != HISTORY)  # results/ is rendered, not hand-written
+# The ways a measured result of our own runs gets typed into prose. Inputs are not caught: literature values,
+# bands, Table 1-2 values, defaults and test tolerances carry no such phrasing (a timing of a run, a rate, a
+# speed-up, a pass count, a coverage, a cost or recovery figure, R-hat, a "(measured)" section).
+RESULT_KINDS = {
+    "a timing": r"(?<![\w.-])\d+(?:[.,]\d+)*\s?(?:ms|µs|min|s)\b",
+    "a rate": r"\d\s*(?:simulations|runs|evaluations|sweeps|trials)/s\b",
+    "a speed-up or step ratio": r"(?<![≥≤<>] )(?<![\d.])\d+(?:\.\d+)?×\s+(?:fewer|faster|slower)\b",
+    "a pass count": r"\bpass(?:es|ed)?\s+\d+(?:–\d+)?\s+of\s+\d+|\b\d+(?:–\d+)?\s+of\s+\d+\s+checks\b",
+    "a coverage": r"\b(?:coverage|intervals? hold(?:s|ing)?)\b[^.\n]{0,40}?\d+(?:\.\d+)?\s?%",
+    "a cost or a recovery error": r"\b(?:costs?|recovery(?: error)?)\s+(?:of\s+)?\d+\.\d{2,}",
+    "an R-hat": r"R̂\s*(?:=\s*)?\d+\.\d+",
+    "a measured section": r"^#{1,6} .*\bmeasured\b",
+}
+
+
+def typed_results(text: str) -> list[str]:
+    """Each phrase of the text that reads as a measured result, with its kind."""
+    return [
+        f"{kind}: {m.group(0)!r}"
+        for kind, pattern in RESULT_KINDS.items()
+        for m in re.finditer(pattern, text, flags=re.MULTILINE)
+    ]
+
+
+def test_the_result_patterns_catch_what_the_old_pages_typed():
+    old = [
+        "took **19.1 min** on this 2-core machine at commit ca56483 (25,266 runs, 22.1 runs/s",
+        "the sweep, 3.8× fewer steps than --solver default",
+        "done; the default model passes 7–8 of 13 checks",
+        "coverage 32 % / 77 % against 27 % / 77 % at 300 steps",
+        "on P1's calibration trial: cost 1.14 at truth, 3.56 at the population means",
+        "split R̂ 1.28 (300 steps: 3.19)",
+        "### Speed (measured)",
+    ]
+    assert [len(typed_results(line)) > 0 for line in old] == [True] * len(old)
+    inputs = [
+        "Rainbow 2013 (46 % / 42 %)",
+        "semi-implicit Euler at a fixed step (6e-5 s) with mass scaling",
+        "net force ≤ 0.1 % of the largest bundle force and at least 0.01 N",
+        "in at most 1/2.5 of their steps; a 10× tighter equilibrium tolerance",
+        "Every test has a 20-minute timeout (pytest-timeout)",
+        "the preprint's mean RS pressure (Table 5's normalizer) is 0.65 MPa",
+    ]
+    assert [typed_results(line) for line in inputs] == [[]] * len(inputs)
+
+
+@pytest.mark.parametrize("page", NARRATIVE, ids=lambda p: p.name)
+def test_a_narrative_page_types_no_measured_result(page):
+    found = typed_results(page.read_text())
+    assert not found, (
+        f"{page.name} types measured results by hand: {found}. Link the results page that renders them "
+        "(docs/_ext/results.py), or move them, with their commit, to docs/history.md"
+    )
+
+
+def test_the_development_notes_are_in_the_site_and_dated():
+    index = (DOCS / "index.md").read_text()
+    toctrees = re.findall(r"```\{toctree\}(.*?)```", index, flags=re.DOTALL)
+    assert any(re.search(r"^history$", tree, flags=re.MULTILINE) for tree in toctrees)
+    text = HISTORY.read_text()
+    assert "not regenerated" in text.split("\n## ")[0] and "results/index.md" in text.split("\n## ")[0]
+    sections = text.split("\n## ")[1:]
+    assert len(sections) >= 10
+    commit = re.compile(r"\b(?=[0-9a-f]*\d)(?=[0-9a-f]*[a-f])[0-9a-f]{7,40}\b")
+    undated = [s.splitlines()[0] for s in sections if not commit.search(s.split("\n\n")[1])]
+    assert not undated, f"sections whose first paragraph names no commit: {undated}"
+    hashes = sorted(set(commit.findall(text)))
+    done = subprocess.run(
+        ["git", "cat-file", "--batch-check"], input="\n".join(hashes) + "\n", cwd=ROOT, capture_output=True, text=True
+    )
+    if done.returncode:  # not a git checkout (an installed copy)
+        pytest.skip("no git history to check the commits against")
+    missing = [h for h, line in zip(hashes, done.stdout.splitlines()) if line.endswith("missing")]
+    assert not missing, f"docs/history.md names commits this repository does not have: {missing}"

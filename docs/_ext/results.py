@@ -45,6 +45,11 @@ def committed(*paths: Path) -> str:
     return f" Last regenerated in commit {done.stdout.strip()}."
 
 
+def heading(title: str, source: str, *paths: Path) -> list[str]:
+    """A results page's title and the sentence naming what it is rendered from and when that was committed."""
+    return [f"# {title}", "", source + committed(*paths)]
+
+
 def figure(path: Path, alt: str) -> str:
     """An image reference relative to `docs/results/`."""
     if not path.is_file():
@@ -59,7 +64,7 @@ def embedded(report: Path, title: str, source: str) -> str:
 
     folder = report.parent.relative_to(ROOT).as_posix()
     text = re.sub(r"\]\(([^/)#:]+\.(?:png|gif))\)", rf"](../../{folder}/\1)", text)
-    return f"# {title}\n\nRendered from `{source}`.{committed(report)}\n\n{text}"
+    return "\n".join(heading(title, f"Rendered from `{source}`.", report)) + f"\n\n{text}"
 
 
 def benchmark() -> str:
@@ -77,13 +82,12 @@ def montecarlo() -> str:
 
 
 def sensitivity(top: int = 6) -> str:
-    parts = [
-        "# Sensitivity",
-        "",
+    parts = heading(
+        "Sensitivity",
         "Rendered from `leaderboards/sensitivity/*.csv`: the design variables the cost on the calibration trial "
-        f"moves most with, {top} per participant (Morris μ*, Sobol total index S_T)."
-        + committed(BOARDS / "sensitivity"),
-    ]
+        f"moves most with, {top} per participant (Morris μ*, Sobol total index S_T).",
+        BOARDS / "sensitivity",
+    )
     for p in PARTICIPANTS:
         morris = pd.read_csv(BOARDS / "sensitivity" / f"sensitivity_{p}_morris.csv").query(
             "output == 'cost' and motion == 'calibrate'"
@@ -105,16 +109,15 @@ def sensitivity(top: int = 6) -> str:
 
 def identifiability() -> str:
     spectrum = pd.read_csv(BOARDS / "identifiability" / "identifiability_spectrum.csv")
-    parts = [
-        "# Identifiability",
-        "",
+    parts = heading(
+        "Identifiability",
         "Rendered from `leaderboards/identifiability/identifiability_spectrum.csv`: the Fisher matrix of "
         "the calibration trial at the hidden truth, its directions with a posterior SD under 0.5 Table 2 SD "
-        "(what the trial pins), and the best-pinned three." + committed(BOARDS / "identifiability"),
-        "",
-    ]
+        "(what the trial pins), and the best-pinned three.",
+        BOARDS / "identifiability",
+    ) + [""]
     rows = []
-    for p, d in spectrum.groupby("participant"):
+    for p, d in spectrum[spectrum.trials == "calibrate"].groupby("participant"):
         best = d.nsmallest(3, "sd")
         rows.append([p, int((d.sd < 0.5).sum()), len(d), "; ".join(best.leading_materials)])
     parts += [table(["participant", "directions pinned", "of", "best-pinned directions"], rows), ""]
@@ -123,15 +126,13 @@ def identifiability() -> str:
 
 
 def posterior() -> str:
-    parts = [
-        "# Bayesian calibration: coverage",
-        "",
+    parts = heading(
+        "Bayesian calibration: coverage",
         "Rendered from `leaderboards/posterior/coverage*.csv`: the share of the 22 material truths inside "
         "the posterior's 50 % and 90 % intervals (well calibrated: 0.5 and 0.9), and the recovery error "
-        "(RMS, Table 2 SD) of the posterior mean, the MAP and the population design; means over seeds."
-        + committed(BOARDS / "posterior"),
-        "",
-    ]
+        "(RMS, Table 2 SD) of the posterior mean, the MAP and the population design; means over seeds.",
+        BOARDS / "posterior",
+    ) + [""]
     studies = [
         ("coverage.csv", "built-in trials, emcee"),
         ("coverage_model.csv", "the model's own trials, emcee"),
@@ -150,14 +151,12 @@ def posterior() -> str:
 
 
 def validation() -> str:
-    parts = [
-        "# Validation",
-        "",
+    parts = heading(
+        "Validation",
         "Rendered from `experiments/figures/validation_P*.json` (`wrist-bench validate P --json`): each "
-        "check of the population design against a published band."
-        + committed(*(FIGURES / f"validation_{p}.json" for p in PARTICIPANTS)),
-        "",
-    ]
+        "check of the population design against a published band.",
+        *(FIGURES / f"validation_{p}.json" for p in PARTICIPANTS),
+    ) + [""]
     reports = {p: json.loads((FIGURES / f"validation_{p}.json").read_text()) for p in PARTICIPANTS}
     first = reports[PARTICIPANTS[0]]["checks"]
     rows = []
