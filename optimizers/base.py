@@ -148,6 +148,13 @@ class Optimizer(ABC):
             return 0.5 * (self.lower + self.upper)
         return np.clip(np.broadcast_to(np.asarray(x0, dtype=np.float64), (self.dim,)), self.lower, self.upper)
 
+    def choice(self, name: str, choices: tuple[str, ...]) -> str:
+        """The option `name`, one of `choices` (default the first); a ValueError naming them if it is another."""
+        value = self.options.get(name, choices[0])
+        if value not in choices:
+            raise ValueError(f"{name} must be {' or '.join(repr(c) for c in choices)}, but got {value!r}")
+        return value
+
 
 def minimize(
     optimizer: Optimizer,

@@ -44,9 +44,7 @@ class CMAES(Optimizer):
     def __init__(self, dim: int, budget: int, seed: int = 0, lower=-1.0, upper=1.0, **options):
         super().__init__(dim, budget, seed, lower, upper, **options)
         self.x0 = self.start_point()
-        self.restart = options.get("restart", "ipop")
-        if self.restart not in ("ipop", "plain"):
-            raise ValueError(f"restart must be 'ipop' or 'plain', but got {self.restart!r}")
+        self.restart = self.choice("restart", ("ipop", "plain"))
         self.popsize = int(options.get("popsize", 4 + int(3 * np.log(self.dim))))
         self.restarts = 0
         self._np_state = None

@@ -101,9 +101,7 @@ class NelderMead(Optimizer):
     def __init__(self, dim: int, budget: int, seed: int = 0, lower=-1.0, upper=1.0, **options):
         super().__init__(dim, budget, seed, lower, upper, **options)
         self.x0 = self.start_point()
-        self.restart = options.get("restart", "random")
-        if self.restart not in ("random", "best"):
-            raise ValueError(f"restart must be 'random' or 'best', but got {self.restart!r}")
+        self.restart = self.choice("restart", ("random", "best"))
         self._scipy_options = {
             "xatol": float(options.get("xatol", 1e-4)),
             "fatol": float(options.get("fatol", 1e-4)),

@@ -1,6 +1,8 @@
-"""Shared fixtures: a hermetic model cache and the built-in participants, built once per session."""
+"""Shared fixtures: a hermetic model cache and the built-in participants, built once per session; killing a
+parent process to see its workers die with it."""
 
 import os
+import signal
 
 import pytest
 
@@ -46,3 +48,19 @@ def participant_registry():
     registry._FOLDERS.update(folders)
     registry._SOURCES.clear()
     registry._SOURCES.update(sources)
+
+
+@pytest.fixture
+def kill_parent():
+    """`kill_parent(proc, workers)`: SIGKILL the process `proc` (a Popen) and assert that its `workers` (psutil
+    processes) end with it, within 20 s."""
+
+    def kill(proc, workers) -> None:
+        import psutil
+
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait(timeout=30)
+        _, alive = psutil.wait_procs(workers, timeout=20)
+        assert not alive, f"workers outlived their parent: {[w.pid for w in alive]}"
+
+    return kill

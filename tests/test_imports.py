@@ -1,12 +1,24 @@
-"""Cheap, honest imports: the light modules pull in neither Gymnasium nor the model builder, and the
-built-in Gymnasium ids are registered whichever of `wrist_env` and `gymnasium` is imported first."""
+"""Cheap, honest imports: the light modules pull in neither Gymnasium nor the model builder, the
+built-in Gymnasium ids are registered whichever of `wrist_env` and `gymnasium` is imported first, and no
+library module chooses matplotlib's backend (the application does: wrist-bench sets MPLBACKEND)."""
 
+import ast
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
-HEAVY = ("gymnasium", "wrist_env.builder.pipeline", "trimesh", "igl", "numba", "scipy.optimize", "scipy.spatial")
+HEAVY = (
+    "gymnasium",
+    "wrist_env.builder.pipeline",
+    "trimesh",
+    "igl",
+    "numba",
+    "scipy.optimize",
+    "scipy.spatial",
+    "matplotlib",
+)
 
 
 def _run(code: str) -> str:
@@ -26,3 +38,15 @@ def test_builtin_ids_are_registered_in_either_import_order(order):
     assert ids.split() == sorted(
         f"wrist_env/{m}-{p}-v0" for m in ("Calibrate", "Validate", "Idealized") for p in ("P1", "P2", "P3")
     )
+
+
+def test_no_library_module_chooses_a_matplotlib_backend():
+    root = Path(__file__).resolve().parents[1]
+    choosers = ("matplotlib.use", "mpl.use", "plt.use", "plt.switch_backend", "matplotlib.pyplot.switch_backend")
+    calls = [
+        f"{path.relative_to(root)}:{node.lineno}: {ast.unparse(node)}"
+        for path in sorted([*(root / "wrist_env").rglob("*.py"), *(root / "optimizers").rglob("*.py")])
+        for node in ast.walk(ast.parse(path.read_text()))
+        if isinstance(node, ast.Call) and ast.unparse(node.func) in choosers
+    ]
+    assert not calls, calls

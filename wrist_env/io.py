@@ -5,6 +5,7 @@ JSON-able and goes to the `.json`, with the class name, a format version and
 the SHA-256 of the `.npz`. Both are written to a temporary name and moved into
 place, the `.npz` first, so a reader sees a whole pair or no `.json`; a load
 checks the hash and the fields and raises `StoreError` naming the file.
+`fields_equal` is such a dataclass's `__eq__` (arrays compared by value).
 """
 
 from __future__ import annotations
@@ -101,6 +102,14 @@ def load_dataclass(cls: type[_D], path: str | Path) -> _D:
         raise
     except InputError as e:  # a field of another layout (e.g. a model of another body count)
         raise StoreError(f"{path}: {e}; delete it to rebuild") from None
+
+
+def fields_equal(a: DataclassInstance, b: DataclassInstance, scalars: tuple[str, ...], arrays: tuple[str, ...]) -> bool:
+    """Whether `a` and `b` agree on the fields `scalars` (==) and `arrays` (np.array_equal): the `__eq__` of a
+    frozen dataclass of arrays (declared with eq=False: the generated one would compare arrays elementwise)."""
+    return all(getattr(a, k) == getattr(b, k) for k in scalars) and all(
+        np.array_equal(getattr(a, k), getattr(b, k)) for k in arrays
+    )
 
 
 def sha256_file(path: str | Path) -> str:

@@ -76,26 +76,16 @@ def _csvs(folder: Path) -> dict:
 
 
 def test_killed_benchmark_resumes_to_the_same_leaderboard(p1, tmp_path):
-    args = ["--participants", p1, "--optimizers", *TINY, "--seeds", "2", "--budget", "48"]
+    out = tmp_path / "killed"
+    args = ["benchmark", "--participants", p1, "--optimizers", *TINY, "--seeds", "2", "--budget", "48"]
+    args += ["--out", str(out), "--workers", "1", "--no-progress"]  # one command: killed, then run again
     reference = benchmark([p1], TINY, 2, 48, tmp_path / "reference", workers=1, progress=False)
     assert not reference.failed
     write_leaderboard(tmp_path / "reference", tmp_path / "lb_reference")
 
-    out = tmp_path / "killed"
     env = dict(os.environ, PYTHONPATH=str(REPO))
     proc = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "wrist_env.cli",
-            "benchmark",
-            *args,
-            "--out",
-            str(out),
-            "--workers",
-            "1",
-            "--no-progress",
-        ],
+        [sys.executable, "-m", "wrist_env.cli", *args],
         env=env,
         cwd=tmp_path,
         start_new_session=True,
@@ -115,22 +105,7 @@ def test_killed_benchmark_resumes_to_the_same_leaderboard(p1, tmp_path):
     assert 0 < logged < len(TINY) * 2 * 48
     assert list((out / "evals").glob("part-*.parquet")), "no cell was left half done"
 
-    assert (
-        main(
-            [
-                "benchmark",
-                *args,
-                "--out",
-                str(out),
-                "--workers",
-                "1",
-                "--no-progress",
-                "--leaderboard",
-                str(tmp_path / "lb_resumed"),
-            ]
-        )
-        == 0
-    )
+    assert main([*args, "--leaderboard", str(tmp_path / "lb_resumed")]) == 0
     rows = log.read(dedupe=False)
     assert len(rows) == len(TINY) * 2 * 48 and _duplicates(rows) == 0
     assert sum(s["replayed"] for s in log.summaries()) > 0  # the half-done cell resumed by replay

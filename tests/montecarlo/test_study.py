@@ -153,7 +153,7 @@ def test_a_damaged_part_is_named_then_resimulated(reference, tmp_path, damage):
     assert (tmp_path / "damaged" / part.name).is_file()  # kept for inspection
 
 
-def test_killing_the_parent_kills_its_workers(reference, tmp_path):
+def test_killing_the_parent_kills_its_workers(reference, tmp_path, kill_parent):
     import psutil
 
     proc = _start_cli_study(tmp_path, batch=2, workers=2)
@@ -161,10 +161,7 @@ def test_killing_the_parent_kills_its_workers(reference, tmp_path):
         _wait_for_parts(proc, tmp_path, 1)
         children = psutil.Process(proc.pid).children(recursive=True)
         assert len([c for c in children if "spawn" in " ".join(c.cmdline())]) >= 2
-        os.kill(proc.pid, signal.SIGKILL)
-        proc.wait(timeout=30)
-        _, alive = psutil.wait_procs(children, timeout=20)
-        assert not alive, f"workers outlived their parent: {[c.pid for c in alive]}"
+        kill_parent(proc, children)
     finally:
         if proc.poll() is None:
             proc.kill()

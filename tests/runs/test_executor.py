@@ -1,7 +1,5 @@
 """The executor both studies use: this process, local processes (dying with their parent), errors handed back."""
 
-import os
-import signal
 import subprocess
 import sys
 import textwrap
@@ -32,7 +30,7 @@ def test_executor_chooses_by_workers():
         assert isinstance(ex, Processes) and (ex.workers, ex.threads) == (2, 1)
 
 
-def test_local_workers_die_with_their_parent(tmp_path):
+def test_local_workers_die_with_their_parent(tmp_path, kill_parent):
     psutil = pytest.importorskip("psutil")
     script = textwrap.dedent("""
         import sys, time
@@ -53,10 +51,7 @@ def test_local_workers_die_with_their_parent(tmp_path):
             c for c in psutil.Process(proc.pid).children(recursive=True) if "spawn_main" in " ".join(c.cmdline())
         ]
         assert len(workers) == 2
-        os.kill(proc.pid, signal.SIGKILL)
-        proc.wait(timeout=30)
-        _, alive = psutil.wait_procs(workers, timeout=20)
-        assert not alive, f"workers outlived their parent: {[w.pid for w in alive]}"
+        kill_parent(proc, workers)
     finally:
         if proc.poll() is None:
             proc.kill()

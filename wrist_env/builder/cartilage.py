@@ -246,29 +246,19 @@ def build_cartilage(
     faces: dict,
     articulations: dict,
     *,
-    share: float = 0.5,
-    bandwidth_mm: float = 1.0,
-    min_thickness_mm: float = 0.1,
-    max_thickness_mm: float = 1.1,
     clearance_mm: float = 0.0,
     max_iter: int = 20,
+    **thickness_options: float,
 ) -> tuple[dict, dict]:
     """Thickness fields, overclosure removal and wedge meshes of every articulated bone.
 
-    Returns thickness (mm, shape (n,)) per bone and a JSON-able report {"cartilage": ...}: per
-    articulation the thickness min/mean/max on each side, joint space (median bone-to-bone gap
-    over covered vertices, mm), overclosure before and after (mm); per bone the wedge quality.
+    thickness_options: `thickness_fields`' keywords (share, bandwidth_mm, min_thickness_mm, max_thickness_mm;
+    its defaults where not given). Returns thickness (mm, shape (n,)) per bone and a JSON-able report
+    {"cartilage": ...}: per articulation the thickness min/mean/max on each side, joint space (median
+    bone-to-bone gap over covered vertices, mm), overclosure before and after (mm); per bone the wedge quality.
     """
     v, f, arts = _articulations(vertices, faces, articulations)
-    first = thickness_fields(
-        v,
-        f,
-        arts,
-        share=share,
-        bandwidth_mm=bandwidth_mm,
-        min_thickness_mm=min_thickness_mm,
-        max_thickness_mm=max_thickness_mm,
-    )
+    first = thickness_fields(v, f, arts, **thickness_options)
     thickness, overclosure = remove_overclosure(v, f, first, arts, clearance_mm=clearance_mm, max_iter=max_iter)
     per_articulation = {}
     for (a, b), (mask_a, mask_b) in arts.items():

@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
 from wrist_env.errors import InputError, MeshError
+from wrist_env.io import fields_equal
 
 # Non-rigid ICP stages (stiffness ws, landmark weight wl, normal weight wn,
 # max iterations), stiff to flexible. Stiffness is in trimesh's units (source
@@ -55,13 +56,8 @@ class MorphResult:
     def __eq__(self, other) -> bool:
         if not isinstance(other, MorphResult):
             return NotImplemented
-        return (
-            self.error_mean_mm == other.error_mean_mm
-            and self.error_max_mm == other.error_max_mm
-            and all(
-                np.array_equal(getattr(self, k), getattr(other, k))
-                for k in ("vertices", "surface_error_mm", "alignment")
-            )
+        return fields_equal(
+            self, other, ("error_mean_mm", "error_max_mm"), ("vertices", "surface_error_mm", "alignment")
         )
 
     __hash__ = None

@@ -20,6 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from wrist_env.errors import InputError, MeshError
+from wrist_env.io import fields_equal
 
 _GRADIENT_PEAK = float(np.exp(-0.5))  # σ · max_x |∇ exp(−|x − c|² / (2σ²))|
 
@@ -90,13 +91,7 @@ class Warp:
     def __eq__(self, other) -> bool:
         if not isinstance(other, Warp):
             return NotImplemented
-        return (
-            self.scale == other.scale
-            and self.width_mm == other.width_mm
-            and all(
-                np.array_equal(getattr(self, k), getattr(other, k)) for k in ("centre", "rbf_centres", "rbf_weights")
-            )
-        )
+        return fields_equal(self, other, ("scale", "width_mm"), ("centre", "rbf_centres", "rbf_weights"))
 
     __hash__ = None
 

@@ -9,14 +9,15 @@ from pathlib import Path
 
 from wrist_env import figures, validation
 from wrist_env.builder.params import BuildParams, add_anatomy_arguments, anatomy_params
-from wrist_env.cli.options import PARTICIPANT_HELP, json_option, out_option, participant_argument
+from wrist_env.cli.options import PARTICIPANT_HELP, json_option, load_direction_option, out_option, participant_argument
 from wrist_env.cli.participant_commands import FIGURES_HELP, add_solver_argument
 from wrist_env.errors import UsageError
 from wrist_env.figures.draw import FIGURES as figures_dir
+from wrist_env.figures.validation import validation_figure
 from wrist_env.io import write_json
 from wrist_env.participants import registry
 from wrist_env.solver.arrays import solver_settings
-from wrist_env.solver.drivers import DEFAULT_LOADS, IDEALIZED_LOAD_N, LOAD_DIRECTIONS
+from wrist_env.solver.drivers import DEFAULT_LOADS, IDEALIZED_LOAD_N
 
 
 def _validate(args) -> int:
@@ -39,7 +40,7 @@ def _validate(args) -> int:
     variant = "" if default else "_variant"
 
     out = Path(args.out or figures_dir) / f"validation_{report.participant}{variant}.png"
-    figure = validation.validation_figure(report, out)
+    figure = validation_figure(report, out)
     write_json(out.with_suffix(".json"), report.to_dict())  # the record the docs' validation page renders
     if args.json:
         print(json.dumps(dict(report.to_dict(), figure=str(figure)), indent=1, allow_nan=False))
@@ -89,11 +90,9 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         help="compressive load on the capitate in the sweeps, N (default: the idealized "
         "driver's; the load-share check always takes 100 N)",
     )
-    s.add_argument(
-        "--load-direction",
-        choices=LOAD_DIRECTIONS,
-        default=DEFAULT_LOADS,
-        help="the loads' direction: along the radius (default), or the resultant at neutral of a tendon "
+    load_direction_option(
+        s,
+        "the loads' direction: along the radius (default), or the resultant at neutral of a tendon "
         "rig's tensions along myo-sim's tendon paths (Erhart 2020; see anatomy/tendons.py)",
     )
     add_solver_argument(s)

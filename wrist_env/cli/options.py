@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from wrist_env.solver.drivers import DEFAULT_LOADS, LOAD_DIRECTIONS
+
 
 def out_option(s: argparse.ArgumentParser, default: str | None = None, what: str = "output folder") -> None:
     """`--out`: where the command writes (`what`), its default shown in the help."""
@@ -29,6 +31,11 @@ def participant_argument(s: argparse.ArgumentParser, help: str = PARTICIPANT_HEL
 def participants_argument(s: argparse.ArgumentParser, help: str = PARTICIPANTS_HELP) -> None:
     """The positional `participants` (one or more)."""
     s.add_argument("participants", nargs="+", help=help)
+
+
+def load_direction_option(s: argparse.ArgumentParser, help: str) -> None:
+    """`--load-direction`: the direction of the loads (`LOAD_DIRECTIONS`, default along the radius)."""
+    s.add_argument("--load-direction", choices=LOAD_DIRECTIONS, default=DEFAULT_LOADS, help=help)
 
 
 def json_option(s: argparse.ArgumentParser, what: str) -> None:

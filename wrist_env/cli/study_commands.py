@@ -17,6 +17,7 @@ from wrist_env.bench.leaderboard import reference, write_leaderboard
 from wrist_env.bench.runner import benchmark, make_cells
 from wrist_env.cli.options import (
     json_option,
+    load_direction_option,
     out_option,
     participant_argument,
     participants_argument,
@@ -30,7 +31,6 @@ from wrist_env.montecarlo.report import write_report
 from wrist_env.montecarlo.sampler import EXCLUDE_ABOVE_MPA, TEAR_PROBABILITY
 from wrist_env.montecarlo.study import StudyConfig, run_study
 from wrist_env.participants import builtin, registry
-from wrist_env.solver.drivers import DEFAULT_LOADS, LOAD_DIRECTIONS
 from wrist_env.trial import TRIAL_MOTIONS
 
 
@@ -186,9 +186,10 @@ def _montecarlo_report(args) -> int:
     return 0
 
 
-def _run_log_arguments(s: argparse.ArgumentParser, *, out: str) -> None:
-    """--runs (a benchmark run log) and --out (an output folder, default `out`) of a command that reads a log."""
-    s.add_argument("--runs", default="runs/benchmark", help="run-log folder (default runs/benchmark)")
+def _run_log_arguments(s: argparse.ArgumentParser, *, out: str, runs: str = "runs/benchmark") -> None:
+    """--runs (a run log, default `runs`: the benchmark's) and --out (an output folder, default `out`) of a
+    command that reads a log."""
+    s.add_argument("--runs", default=runs, help=f"run-log folder (default {runs})")
     out_option(s, out)
 
 
@@ -292,12 +293,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         default=TEAR_PROBABILITY,
         help=f"chance of each tear (default {TEAR_PROBABILITY:g})",
     )
-    s.add_argument(
-        "--load-direction",
-        choices=LOAD_DIRECTIONS,
-        default=DEFAULT_LOADS,
-        help="the sweeps' load: along the radius (default), or a tendon rig's resultant (see validate)",
-    )
+    load_direction_option(s, "the sweeps' load: along the radius (default), or a tendon rig's resultant (see validate)")
     out_option(s, "runs/montecarlo", "run-log folder")
     scheduler_option(s, "batch")
     s.add_argument(
@@ -322,7 +318,6 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "(Table 6), with a random intercept per run; tables as Markdown and CSV, figures "
         "as PNG, summary.json and report.md.",
     )
-    s.add_argument("--runs", default="runs/montecarlo", help="run-log folder (default runs/montecarlo)")
-    out_option(s, "runs/montecarlo-report")
+    _run_log_arguments(s, out="runs/montecarlo-report", runs="runs/montecarlo")
     s.add_argument("--max-runs", type=int, help="fit on a seeded random subset of this many runs (default: all)")
     s.set_defaults(run=_montecarlo_report)

@@ -1,4 +1,6 @@
-"""Figures (matplotlib, PNG; a GIF): the model's geometry (`geometry`), its simulations (`simulation`), an animated sweep (`animation`)."""
+"""Figures (matplotlib, PNG; a GIF): the model's geometry (`geometry`), its simulations (`simulation`), an animated sweep
+(`animation`); the validation report (`validation`), the leaderboards (`leaderboard`), the Monte Carlo study
+(`montecarlo`), sensitivity, identifiability and the posterior. The library never chooses a matplotlib backend."""
 
 from wrist_env.figures.animation import animation_figure
 from wrist_env.figures.draw import FIGURES

@@ -29,36 +29,61 @@ def _reference_line(ax, cost: float, text: str, color: str, style: str, *, right
     ax.text(x, cost, text, color=color, fontsize=8, ha=ha, va=va, transform=ax.get_yaxis_transform())
 
 
-def convergence_figure(path: str | os.PathLike, board: Leaderboard, colors: dict[str, _RGBA]) -> None:
-    """Best cost so far against evaluations: median and IQR band per calibrator, a panel per participant."""
+def _panels(n: int, ncols: int, height: float, **kwargs):
+    """A figure of `n` panels, `ncols` a row (4.6 wide, `height` tall each), the spare axes hidden: (fig, axes 2-D)."""
     import matplotlib.pyplot as plt
 
-    runs_frame, curves, refs, participants, labels, budgets = (
-        board.runs_frame,
-        board.curves,
-        board.refs,
-        board.participants,
-        board.labels,
-        board.budgets,
-    )
-
-    n = len(participants)
-    ncols = min(n, 3)
     nrows = -(-n // ncols)
     fig, axes = plt.subplots(
-        nrows, ncols, figsize=(4.6 * ncols + 0.4, 4.0 * nrows + 0.5), squeeze=False, constrained_layout=True
+        nrows,
+        ncols,
+        figsize=(4.6 * ncols + 0.4, height * nrows + 0.5),
+        squeeze=False,
+        constrained_layout=True,
+        **kwargs,
     )
     for ax in axes.flat[n:]:
         ax.set_visible(False)
+    return fig, axes
+
+
+def _run_curves(board: Leaderboard, participant: str, label: str) -> list:
+    """The best-so-far cost curves of one participant's runs with one calibrator (label), in the runs' order."""
+    keys = [
+        (r.participant, r.optimizer, r.seed, r.budget)
+        for r in runs_of(board.runs_frame, participant, label).itertuples()
+    ]
+    return [board.curves[k] for k in keys if k in board.curves]
+
+
+def _save(fig, axes, path: str | os.PathLike, ylabel: str, legend_columns: int) -> None:
+    """`ylabel` on each row's first panel, the first panel's legend below the panels; written to `path`, closed."""
+    import matplotlib.pyplot as plt
+
+    for row in axes:
+        row[0].set_ylabel(ylabel)
+    handles, names = axes[0, 0].get_legend_handles_labels()
+    fig.legend(
+        handles,
+        names,
+        loc="outside lower center",
+        ncol=min(legend_columns, max(1, len(names))),
+        fontsize=9,
+        frameon=False,
+    )
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def convergence_figure(path: str | os.PathLike, board: Leaderboard, colors: dict[str, _RGBA]) -> None:
+    """Best cost so far against evaluations: median and IQR band per calibrator, a panel per participant."""
+    refs, participants = board.refs, board.participants
+    n = len(participants)
+    fig, axes = _panels(n, min(n, 3), 4.0)
     for ax, p in zip(axes.flat, participants):
         lows = []
-        for label in labels:
-            sub = runs_of(runs_frame, p, label)
-            cs = [
-                curves[(r.participant, r.optimizer, r.seed, r.budget)]
-                for r in sub.itertuples()
-                if (r.participant, r.optimizer, r.seed, r.budget) in curves
-            ]
+        for label in board.labels:
+            cs = _run_curves(board, p, label)
             if not cs:
                 continue
             length = max(len(c) for c in cs)
@@ -79,13 +104,8 @@ def convergence_figure(path: str | os.PathLike, board: Leaderboard, colors: dict
         ax.set_title(f"{p}: calibration trial")
         ax.set_xlabel("evaluations")
         ax.grid(True, which="both", alpha=0.25)
-        ax.set_xlim(1, max(budgets))
-    for row in axes:
-        row[0].set_ylabel("best cost so far (median, IQR band over seeds)")
-    handles, names = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles, names, loc="outside lower center", ncol=min(4, max(1, len(names))), fontsize=9, frameon=False)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+        ax.set_xlim(1, max(board.budgets))
+    _save(fig, axes, path, "best cost so far (median, IQR band over seeds)", 4)
 
 
 def _plain_log_ticks(axis, subs=(1.0, 2.0, 5.0)) -> None:
@@ -99,44 +119,19 @@ def _plain_log_ticks(axis, subs=(1.0, 2.0, 5.0)) -> None:
 
 def ecdf_figure(path: str | os.PathLike, board: Leaderboard, colors: dict[str, _RGBA]) -> None:
     """COCO-style ECDF of (run, target) pairs solved against evaluations (`tables.ECDF_TARGETS` per participant)."""
-    import matplotlib.pyplot as plt
-
-    runs_frame, targets, curves, participants, labels, budgets = (
-        board.runs_frame,
-        board.ecdf_targets,
-        board.curves,
-        board.participants,
-        board.labels,
-        board.budgets,
-    )
-
+    targets, participants = board.ecdf_targets, board.participants
     groups = [("all participants", participants)] + ([(p, [p]) for p in participants] if len(participants) > 1 else [])
     n = len(groups)
-    ncols = n if n <= 3 else 2 if n == 4 else 3
-    nrows = -(-n // ncols)
-    fig, axes = plt.subplots(
-        nrows,
-        ncols,
-        figsize=(4.6 * ncols + 0.4, 3.9 * nrows + 0.5),
-        squeeze=False,
-        constrained_layout=True,
-        sharey=True,
-    )
-    for ax in axes.flat[n:]:
-        ax.set_visible(False)
-    top = max(budgets)
+    fig, axes = _panels(n, n if n <= 3 else 2 if n == 4 else 3, 3.9, sharey=True)
+    top = max(board.budgets)
     grid = np.unique(np.round(np.geomspace(1, top, 200)).astype(int))
     for ax, (name, members) in zip(axes.flat, groups):
         n_targets = 0
-        for label in labels:
+        for label in board.labels:
             hits, pairs = [], 0
             for p in members:
-                sub = runs_of(runs_frame, p, label)
                 ts = targets[targets.participant == p]
-                for r in sub.itertuples():
-                    curve = curves.get((r.participant, r.optimizer, r.seed, r.budget))
-                    if curve is None:
-                        continue
+                for curve in _run_curves(board, p, label):
                     for t in ts.itertuples():
                         pairs += 1
                         h = hit(curve, t.value)
@@ -156,9 +151,5 @@ def ecdf_figure(path: str | os.PathLike, board: Leaderboard, colors: dict[str, _
         ax.set_title(f"{name} ({n_targets} targets)")
         ax.grid(True, which="both", alpha=0.25)
     for row in axes:
-        row[0].set_ylabel("fraction of (run, target) pairs solved")
         row[0].tick_params(labelleft=True)
-    handles, names = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles, names, loc="outside lower center", ncol=min(5, max(1, len(names))), fontsize=9, frameon=False)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _save(fig, axes, path, "fraction of (run, target) pairs solved", 5)

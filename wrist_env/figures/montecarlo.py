@@ -1,4 +1,4 @@
-"""Figures 8–10 of the Monte Carlo study (PNG, matplotlib Agg), from `stats.frame_table` rows.
+"""Figures 8–10 of the Monte Carlo study (PNG, matplotlib), from `stats.frame_table` rows.
 
 figure8: radioscaphoid mean pressure against the wrist angle — (A) every run
     as dots (a seeded subset when there are many), the per-angle medians of

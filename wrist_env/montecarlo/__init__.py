@@ -1,4 +1,4 @@
-"""Monte Carlo injury study (preprint 2.3.2): sampler, run log, study runner, statistics, figures.
+"""Monte Carlo injury study (preprint 2.3.2): sampler, run log, study runner, statistics, report.
 
 `run_study(StudyConfig(("P1", "P2"), n=12500, seed=0), "runs/montecarlo")` runs it
 (`wrist-bench montecarlo`); `wrist_env.montecarlo.report.write_report` writes Tables 5–6 and

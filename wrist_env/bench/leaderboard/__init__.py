@@ -26,7 +26,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from wrist_env.bench.leaderboard import plots
 from wrist_env.bench.leaderboard.board import Leaderboard, build, write_csvs
 from wrist_env.bench.leaderboard.readme import readme
 from wrist_env.bench.leaderboard.reference import Reference, reference
@@ -45,9 +44,11 @@ def write_leaderboard(
     out.mkdir(parents=True, exist_ok=True)
     board = build(runs, references)
     write_csvs(board, out)
-    colors = plots.colors(board.labels)
-    plots.convergence_figure(out / "convergence.png", board, colors)
-    plots.ecdf_figure(out / "ecdf.png", board, colors)
+    from wrist_env.figures import leaderboard as figures  # here, not above: it imports this package
+
+    colors = figures.colors(board.labels)
+    figures.convergence_figure(out / "convergence.png", board, colors)
+    figures.ecdf_figure(out / "ecdf.png", board, colors)
     path = out / "README.md"
     path.write_text(readme(board, title))
     return path

@@ -23,6 +23,18 @@ def md_table(frame: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
+def _median_iqr(frame: pd.DataFrame, participants: list, labels: list) -> pd.DataFrame:
+    """A column of labels (calibrators), then one per participant: its row's "median [q25, q75]" in `frame`, or —."""
+    wide = {"calibrator": labels}
+    for p in participants:
+        col = []
+        for label in labels:
+            r = frame[(frame.participant == p) & (frame.calibrator == label)]
+            col.append("—" if r.empty else f"{fmt(r['median'].iloc[0])} [{fmt(r.q25.iloc[0])}, {fmt(r.q75.iloc[0])}]")
+        wide[p] = col
+    return pd.DataFrame(wide)
+
+
 def readme(board: Leaderboard, title: str | None = None) -> str:
     """The leaderboard's README.md text (Markdown)."""
     b = board
@@ -55,14 +67,7 @@ def readme(board: Leaderboard, title: str | None = None) -> str:
     ]
 
     lines += ["## Best cost at the budget", "", "Median [IQR] of each run's best calibration cost.", ""]
-    wide = {"calibrator": labels}
-    for p in participants:
-        col = []
-        for label in labels:
-            r = best[(best.participant == p) & (best.calibrator == label)]
-            col.append("—" if r.empty else f"{fmt(r['median'].iloc[0])} [{fmt(r.q25.iloc[0])}, {fmt(r.q75.iloc[0])}]")
-        wide[p] = col
-    table = pd.DataFrame(wide)
+    table = _median_iqr(best, participants, labels)
     ref_rows = [
         {
             "calibrator": "*population design*",
@@ -144,16 +149,7 @@ def readme(board: Leaderboard, title: str | None = None) -> str:
             "over seeds. The population design's error is the baseline (the truth's own z-scores).",
             "",
         ]
-        wide = {"calibrator": labels}
-        for p in participants:
-            col = []
-            for label in labels:
-                r = recovery[(recovery.participant == p) & (recovery.calibrator == label)]
-                col.append(
-                    "—" if r.empty else f"{fmt(r['median'].iloc[0])} [{fmt(r.q25.iloc[0])}, {fmt(r.q75.iloc[0])}]"
-                )
-            wide[p] = col
-        table = pd.DataFrame(wide)
+        table = _median_iqr(recovery, participants, labels)
         base = {"calibrator": "*population design*"}
         for p in participants:
             r = recovery[recovery.participant == p]
