@@ -221,6 +221,22 @@ def from_action(action: ArrayLike) -> Design:
     return Design.from_vector(values)
 
 
+def from_actions(actions: ArrayLike) -> list[Design]:
+    """Physical designs of a batch of normalized actions (n, 27) in [-1, 1]; a DesignError names the row."""
+    raw = np.asarray(actions)
+    if raw.size == 0:
+        return []
+    if raw.ndim != 2 or raw.shape[1] != N_DESIGN:
+        raise DesignError(f"a batch of actions must have shape (n, {N_DESIGN}), but got {raw.shape}.")
+    designs = []
+    for row, action in enumerate(raw):
+        try:
+            designs.append(from_action(action))
+        except DesignError as e:
+            raise DesignError(f"row {row} of the actions: {e}") from None
+    return designs
+
+
 def to_action(design: Design) -> np.ndarray:
     """Normalized action of a physical design (injury scalars clipped to [-1, 1])."""
     v = design.vector

@@ -8,8 +8,8 @@ designs in, rewards and JSON-ready outputs out. Simulation is `simulate` /
 from __future__ import annotations
 
 import functools
-from collections.abc import Iterable
-from dataclasses import dataclass
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -35,6 +35,28 @@ class Evaluation:
     failed: bool
     info: dict
     result: Result
+
+
+@dataclass(frozen=True)
+class Evaluations(Sequence):
+    """The outcomes of a batch of designs: each `Evaluation` by index, and as arrays over the batch
+    reward and cost (n,) and failed (n,) bool."""
+
+    each: tuple[Evaluation, ...]
+    reward: np.ndarray = field(init=False)
+    cost: np.ndarray = field(init=False)
+    failed: np.ndarray = field(init=False)
+
+    def __post_init__(self):
+        object.__setattr__(self, "reward", np.array([e.reward for e in self.each], dtype=np.float64))
+        object.__setattr__(self, "cost", np.array([e.cost for e in self.each], dtype=np.float64))
+        object.__setattr__(self, "failed", np.array([e.failed for e in self.each], dtype=bool))
+
+    def __len__(self) -> int:
+        return len(self.each)
+
+    def __getitem__(self, i):
+        return self.each[i]
 
 
 class Task:
@@ -79,14 +101,19 @@ class Task:
         """Simulate one design and score it."""
         return self._score(design, simulate(self.model, design, self.driver, prepared=self.prepared))
 
-    def evaluate_batch(self, designs: Iterable[Design]) -> list[Evaluation]:
+    def evaluate_batch(self, designs: Iterable[Design]) -> Evaluations:
         """Simulate many designs at once (Numba prange); the same numbers as one at a time."""
         designs = list(designs)
         results = simulate_batch(self.model, designs, self.driver, prepared=self.prepared)
-        return [self._score(d, r) for d, r in zip(designs, results)]
+        return Evaluations(tuple(self._score(d, r) for d, r in zip(designs, results)))
 
     def evaluate_action(self, action: ArrayLike) -> Evaluation:
+        """Simulate and score one normalized action (27,) in [-1, 1] (`design.from_action`)."""
         return self.evaluate(design_vars.from_action(action))
+
+    def evaluate_actions(self, actions: ArrayLike) -> Evaluations:
+        """`evaluate_batch` of normalized actions (n, 27) in [-1, 1] (`design.from_actions`)."""
+        return self.evaluate_batch(design_vars.from_actions(actions))
 
     def _score(self, design: Design, result: Result) -> Evaluation:
         if self.reference is None:

@@ -36,6 +36,7 @@ from wrist_env.solver import arrays
 from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.drivers import idealized, static, trial_driver
 from wrist_env.solver.forces import pair_transform, rebuild_active, sample_lookup, sample_lookup_smooth
+from wrist_env.solver.rigid import pose_state
 from wrist_env.solver.simulate import simulate, simulate_batch
 
 PREPRINT_SECONDS = 45.0  # one Abaqus simulation
@@ -98,8 +99,7 @@ def efficiency(model, steps_per_sim: float, seconds_per_sim: float) -> tuple[flo
     s = arrays.SolverSettings()
     settled = simulate(model, design.population(), static(model, 2))
     pose = settled.poses[-1]
-    R = np.ascontiguousarray(pose[:, :3, :3])
-    x = np.ascontiguousarray(np.einsum("bij,bj->bi", R, model.com) + pose[:, :3, 3])
+    R, x = pose_state(pose, model.com)
     grids = arrays.grids(model, s.smooth_normals)
     active = np.zeros(len(grids.points), np.int64)
     n_active = np.zeros(len(grids.pair_bones), np.int64)

@@ -26,6 +26,7 @@ from wrist_env.participants.registry import load_model
 from wrist_env.solver import arrays
 from wrist_env.solver.drivers import idealized, loaded
 from wrist_env.solver.forces import sample_pressures
+from wrist_env.solver.rigid import pose_state
 from wrist_env.solver.simulate import simulate, simulate_batch
 from wrist_env.validation import NEUTRAL_LOAD_N, validate
 
@@ -65,8 +66,7 @@ def distal_row_forces(model) -> dict:
     """Contact force (N) on each part of the capitate body at neutral under `NEUTRAL_LOAD_N`."""
     result = simulate(model, design.population(), loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N))
     poses = result.poses[0]
-    R = np.ascontiguousarray(poses[:, :3, :3])
-    x = np.ascontiguousarray(np.einsum("bij,bj->bi", R, model.com) + poses[:, :3, 3])
+    R, x = pose_state(poses, model.com)
     pressure = np.zeros(len(model.sample_points))
     sample_pressures(R, x, model.com, arrays.grids(model), np.ascontiguousarray(model.contact_law, float), pressure)
     c = BONES.index("capitate")

@@ -50,6 +50,7 @@ from wrist_env.participants import builtin, registry
 from wrist_env.participants.builtin import TRACKING_NOISE_DEG, TRACKING_NOISE_MM
 from wrist_env.solver import equilibrium
 from wrist_env.solver.drivers import experimental
+from wrist_env.solver.rigid import pose_translation
 from wrist_env.solver.simulate import simulate, stiffness
 from wrist_env.task import Task, task
 
@@ -97,7 +98,7 @@ def response(t: Task, d: design.Design, result) -> np.ndarray:
             R, x, _ = equilibrium.moved_state(eps * dq[:, k], R0, x0, nodes0, free, False)
             poses = result.poses.copy()
             poses[f, :, :3, :3] = R
-            poses[f, :, :3, 3] = x - np.einsum("bij,bj->bi", R, p.bodies.com0)
+            poses[f, :, :3, 3] = pose_translation(R, x, p.bodies.com0)
             D[f, :, k] = ((likelihood.residuals(t, poses)[:, f] - base[:, f]) / eps).ravel()
     return D
 

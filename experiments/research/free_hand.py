@@ -24,6 +24,7 @@ from wrist_env.participants.registry import load_model
 from wrist_env.solver import drivers, kernel
 from wrist_env.solver import simulate as sim
 from wrist_env.solver.outputs import articulation_forces
+from wrist_env.solver.rigid import pose_state
 from wrist_env.validation import NEUTRAL_LOAD_N, load_shares_pct
 
 STEP_RAD = 0.02  # the finite-difference turn (1.1 deg)
@@ -34,8 +35,7 @@ def distal_row_moment(model, d, driver, result) -> np.ndarray:
     driver's lines on the distal row at the run's first frame: what the driver holds."""
     p = sim.prepare(model, None, driver.mode)
     poses = result.poses[0]
-    R = np.ascontiguousarray(poses[:, :3, :3])
-    x = np.ascontiguousarray(np.einsum("bij,bj->bi", R, model.com) + poses[:, :3, 3])
+    R, x = pose_state(poses, model.com)
     nodes = np.ascontiguousarray(result.membrane_nodes[0])
     state = kernel.State(R, x, np.zeros_like(x), np.zeros_like(x), nodes, np.zeros_like(nodes))
     work = kernel.new_work(p.grids, nodes)

@@ -255,14 +255,14 @@ def calibrate(
             return logged_y[n : n + k]
         designs = [design_vars.from_action(a) for a in action(x)]
         evaluations = calibration.evaluate_batch(designs)
-        cost = np.array([e.cost for e in evaluations], dtype=np.float64)
+        cost = evaluations.cost
         y = cost
         if prior:
             y = np.array([map_objective(calibration, e, design_vars.z_scores(d)) for e, d in zip(evaluations, designs)])
         state["new"] = True
         state["pending"] = (
             cost,
-            np.array([e.failed for e in evaluations]),
+            evaluations.failed,
             np.stack([rmse_vector(e.info) for e in evaluations]),
             [unsettled_frames(e) for e in evaluations],
         )

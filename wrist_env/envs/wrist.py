@@ -15,7 +15,6 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from numpy.typing import ArrayLike
 
 from wrist_env import design
-from wrist_env.errors import DesignError
 from wrist_env.limits import MAX_BATCH, check_int
 from wrist_env.solver.drivers import DEFAULT_LOADS
 from wrist_env.task import task
@@ -54,14 +53,6 @@ class WristEnv(gym.Env):
         return OBSERVATION.copy(), float(evaluation.reward), True, False, evaluation.info
 
 
-def _row_design(row: int, action: np.ndarray) -> design.Design:
-    """The design of one row of a batch of actions; `DesignError` naming the row."""
-    try:
-        return design.from_action(action)
-    except DesignError as e:
-        raise DesignError(f"row {row} of the actions: {e}") from None
-
-
 class WristVectorEnv(VectorEnv):
     """`num_envs` designs per `step`, simulated in one batched call (same numbers as `WristEnv`)."""
 
@@ -93,10 +84,10 @@ class WristVectorEnv(VectorEnv):
         actions = np.asarray(actions)
         if actions.shape != (self.num_envs, design.N_DESIGN):
             raise ValueError(f"actions must have shape ({self.num_envs}, {design.N_DESIGN}), but got {actions.shape}")
-        evaluations = self.task.evaluate_batch([_row_design(i, a) for i, a in enumerate(actions)])
+        evaluations = self.task.evaluate_actions(actions)
         infos = {}
         for i, e in enumerate(evaluations):
             infos = self._add_info(infos, e.info, i)
-        rewards = np.array([e.reward for e in evaluations], dtype=np.float64)
+        rewards = evaluations.reward
         done = np.ones(self.num_envs, dtype=bool)
         return self._observations(), rewards, done, np.zeros(self.num_envs, dtype=bool), infos

@@ -82,7 +82,7 @@ def evaluate(participant: str, motion: str, X: np.ndarray, batch: int = BATCH) -
     failed = np.zeros(len(X), bool)
     for start in tqdm(range(0, len(X), batch), desc=f"{participant} {motion}", unit="batch", leave=False):
         chunk = actions[start : start + batch]
-        for i, e in enumerate(motion_task.evaluate_batch([design.from_action(a) for a in chunk]), start=start):
+        for i, e in enumerate(motion_task.evaluate_actions(chunk), start=start):
             Y[i, 0] = e.cost
             for j, name in enumerate(OUTPUTS[1:], start=1):
                 bone, dof = name.split(".", 1)

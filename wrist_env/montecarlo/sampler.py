@@ -176,7 +176,7 @@ def run_chunk(
     actions = np.asarray(actions, dtype=np.float64)
     k = len(actions)
     idealized = task(participant, "idealized", load_direction)
-    designs = [design.from_action(a) for a in actions]
+    designs = design.from_actions(actions)
     infos = [e.info for e in idealized.evaluate_batch(designs)]
     angle = np.asarray(idealized.driver.angle_deg, dtype=np.float64)
     n_frames = len(angle)

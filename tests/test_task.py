@@ -1,0 +1,32 @@
+"""`Task`: a batch's `Evaluations` are the single evaluations, as arrays and one by one."""
+
+import numpy as np
+import pytest
+
+from wrist_env import design
+from wrist_env.errors import DesignError
+from wrist_env.task import Evaluations, task
+
+
+def test_a_batch_of_actions_is_its_rows_evaluated_one_at_a_time():
+    calibrate = task("P1", "calibrate")
+    actions = np.random.default_rng(4).uniform(-0.8, 0.8, (3, design.N_DESIGN))
+    batch = calibrate.evaluate_actions(actions)
+    single = [calibrate.evaluate_action(a) for a in actions]
+    assert isinstance(batch, Evaluations) and len(batch) == 3 and batch.failed.dtype == bool
+    np.testing.assert_array_equal(batch.cost, [e.cost for e in single])
+    np.testing.assert_array_equal(batch.reward, -batch.cost)
+    np.testing.assert_array_equal(batch.failed, [e.failed for e in single])
+    for e, one in zip(batch, single):
+        np.testing.assert_array_equal(e.result.poses, one.result.poses)
+    assert batch[-1].cost == batch.cost[2] and [e.cost for e in batch[1:]] == list(batch.cost[1:])
+
+
+def test_a_bad_row_or_shape_is_named():
+    actions = np.zeros((3, design.N_DESIGN))
+    actions[2, 5] = np.nan
+    with pytest.raises(DesignError, match=rf"row 2 of the actions: .*{design.NAMES[5]}=nan"):
+        task("P1", "calibrate").evaluate_actions(actions)
+    with pytest.raises(DesignError, match=r"shape \(n, 27\), but got \(27,\)"):
+        design.from_actions(np.zeros(design.N_DESIGN))
+    assert design.from_actions(np.zeros((0, design.N_DESIGN))) == []
