@@ -12,8 +12,11 @@ The free bones' masses are their (scaled) physical ones or, with
 
 Read `run` → `_run`: per stage (settle, move, each frame) it stages the capitate's targets
 (`_stage`, or the secant predictor's state: `_predicted`), holds (`_ramp_and_hold`, which calls
-`_step`, which calls `net_forces`), checks (`_failure`) and records the frame (`_record`). Every
-kernel reads the model through one `arrays.System` and a design through one `Stiffness`.
+`_step`, which calls `net_forces`), checks (`_failure`) and records the frame (`_record`); those
+three are inlined into `_run` (each separately compiled layer over the force kernels cost its own
+link and optimization of their code: +25 s of a cold compile). Every kernel reads the model through
+one `arrays.System` and a design through one `Stiffness`; the entry points (`run`, `run_from`,
+`run_batch`) take the System flat, as they take `Frames`.
 """
 
 from __future__ import annotations
@@ -237,26 +240,28 @@ def _stage(f, R0, x0, frame_R, frame_x, frame_load, st):
 
 
 @njit(cache=True, error_model="numpy")
-def run(system, stiffness, frames, out):
-    """Simulate one design (`Stiffness`) of `system` (`arrays.System`) through the capitate's `Frames`;
-    fills `out` (`Outputs`) and out.status[0] (0 ok, 1 NaN, 2 diverged). Steps per frame count those
-    since the previous frame (frame 0: settling and the move included).
-    Each stage ramps the capitate over its ramp steps, then holds until
-    `_converged` (at least min_hold_steps, at most max_hold_steps; settling
-    at most settle_steps).
-    """
+def run(bod, grids, law, fib, mem, st, stiffness, frames, out):
+    """Simulate one design (`Stiffness`) of the model whose `arrays.System` is (bod, grids, law, fib,
+    mem, st) through the capitate's `Frames`; fills `out` (`Outputs`) and out.status[0] (0 ok, 1 NaN,
+    2 diverged). Steps per frame count those since the previous frame (frame 0: settling and the move
+    included). Each stage ramps the capitate over its ramp steps, then holds until `converged` (at
+    least min_hold_steps, at most max_hold_steps; settling at most settle_steps).
+    The entry points take the System flat, as `Frames` is: `run_batch`'s parallel loop takes no
+    nested tuples."""
     R = np.zeros((N_BONES, 3, 3))
     for b in range(N_BONES):
         R[b] = np.eye(3)
-    _run(system, stiffness, frames, out, R, system.bodies.com0.copy(), system.membrane.rest.copy(), SETTLE)
+    system = System(bod, grids, law, fib, mem, st)
+    _run(system, stiffness, frames, out, R, bod.com0.copy(), mem.rest.copy(), SETTLE)
 
 
 @njit(cache=True, error_model="numpy")
-def run_from(system, stiffness, frames, out, R, x, nodes):
+def run_from(bod, grids, law, fib, mem, st, stiffness, frames, out, R, x, nodes):
     """`run` from a given state at frame 0 instead of from rest: rotations R (5, 3, 3), centres of mass
     x (5, 3) mm (the capitate at frame 0's pose) and membrane nodes (M, 3) mm, at rest; no settling or
     move, frame 0's outputs left unfilled, each later frame as in `run` (for a frame-local comparison:
     `experiments/verification/solver_accuracy.py --frame-local`)."""
+    system = System(bod, grids, law, fib, mem, st)
     _run(system, stiffness, frames, out, R.copy(), x.copy(), nodes.copy(), 1)
 
 
@@ -311,7 +316,7 @@ def _run(system, stiffness, frames, out, R, x, nodes, first):
         taken = 0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _ramp_and_hold(
     state, work, system, stiffness, Ra, xa, la, axis, shift, lb, ramp, most, load, step, fire, m, scratch
 ):
@@ -336,7 +341,7 @@ def _ramp_and_hold(
     return k, False
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _failure(R, x, com0, st):
     """The run's status at this state: `FAILED_NAN` if a solved body's centre is not finite,
     `FAILED_DIVERGED` if a free bone dislocated (`displacement` beyond max_disp_mm, or turned beyond
@@ -355,7 +360,7 @@ def _failure(R, x, com0, st):
     return status
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _record(f, state, work, system, stiffness, load, m, out, taken, settled):
     """Fill frame f of `out` at the state reached (the last step's forces were those before it, so they
     are evaluated again here under the stage's end `load`); `taken` steps since the previous frame."""
@@ -391,25 +396,20 @@ def _record(f, state, work, system, stiffness, load, m, out, taken, settled):
 
 @njit(cache=True, error_model="numpy", parallel=True)
 def run_batch(bod, grids, law, fib, mem, st, stiffness, frames, out):
-    """`run` for many designs: `Stiffness` and `Outputs` arrays with a leading design axis; the
-    `arrays.System` comes flat (bod, grids, law, fib, mem, st): a parallel loop takes no nested tuples."""
+    """`run` for many designs: `Stiffness` and `Outputs` arrays with a leading design axis."""
     for i in prange(stiffness.f_l0.shape[0]):
-        _run_design(i, bod, grids, law, fib, mem, st, stiffness, frames, out)
-
-
-@njit(cache=True, error_model="numpy")
-def _run_design(i, bod, grids, law, fib, mem, st, stiffness, frames, out):
-    """`run` on design i of `run_batch`'s arrays."""
-    design = Stiffness(stiffness.f_l0[i], stiffness.f_K[i], stiffness.m_l0[i], stiffness.m_K[i], stiffness.node_mass[i])
-    filled = Outputs(
-        out.poses[i],
-        out.contact[i],
-        out.bundle[i],
-        out.energy[i],
-        out.residual[i],
-        out.steps[i],
-        out.settled[i],
-        out.nodes[i],
-        out.status[i],
-    )
-    run(System(bod, grids, law, fib, mem, st), design, frames, filled)
+        design = Stiffness(
+            stiffness.f_l0[i], stiffness.f_K[i], stiffness.m_l0[i], stiffness.m_K[i], stiffness.node_mass[i]
+        )
+        filled = Outputs(
+            out.poses[i],
+            out.contact[i],
+            out.bundle[i],
+            out.energy[i],
+            out.residual[i],
+            out.steps[i],
+            out.settled[i],
+            out.nodes[i],
+            out.status[i],
+        )
+        run(bod, grids, law, fib, mem, st, design, frames, filled)

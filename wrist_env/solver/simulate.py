@@ -149,7 +149,7 @@ def simulate(
     prepared: `prepare(model, settings, driver.mode)`, to skip rebuilding the kernel arrays."""
     p = _prepared(model, settings, driver, prepared)
     out = _outputs(0, len(driver.rotation), len(model.membrane_nodes))
-    kernel.run(p.system, stiffness(p, design), _frames(driver), out)
+    kernel.run(*p.system, stiffness(p, design), _frames(driver), out)
     return _result(out, driver, int(out.status[0]))
 
 
@@ -181,7 +181,7 @@ def simulate_frame(
     R, x = pose_state(poses, model.com)
     out = _outputs(0, 2, len(model.membrane_nodes))
     frames = _frames(two)
-    kernel.run_from(p.system, stiffness(p, design), frames, out, R, x, np.ascontiguousarray(nodes, dtype=np.float64))
+    kernel.run_from(*p.system, stiffness(p, design), frames, out, R, x, np.ascontiguousarray(nodes, dtype=np.float64))
     return _result(out, two, int(out.status[0]))
 
 
@@ -200,7 +200,7 @@ def simulate_batch(
     out = _outputs(len(per), len(driver.rotation), len(model.membrane_nodes))
     previous = numba.set_parallel_chunksize(1)  # designs differ in cost: hand them out one at a time
     try:
-        kernel.run_batch(*p.system, stacked, _frames(driver), out)  # flat: see `kernel.run_batch`
+        kernel.run_batch(*p.system, stacked, _frames(driver), out)  # the System flat: see `kernel.run`
     finally:
         numba.set_parallel_chunksize(previous)
     return [_result(kernel.Outputs(*(o[i] for o in out)), driver, int(out.status[i, 0])) for i in range(len(per))]
