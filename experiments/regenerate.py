@@ -9,8 +9,9 @@ Monte Carlo study (P1 + P2, 2 × 12,500) with its report, what a trial identifie
 sensitivity and the Fisher matrix at the hidden truth, P1–P3), the best calibrators with and without
 the prior (`leaderboards/prior/`) and the Bayesian calibrator's coverage on the trials and on the
 model's own trials (`leaderboards/posterior/`: emcee at 300 steps with the default 24 MAP starts
-and prior refresh, and on the model's trials at the default 1,200 steps too, ~2.3 h, in
-`leaderboards/posterior/steps1200/`; SMC on the model's trials; where the built-in trials' model error comes from,
+and prior refresh, and on the model's trials at the default 1,200 steps too, ~5 h, in
+`leaderboards/posterior/steps1200/`, its saved runs committed in `steps1200/runs/` so that it resumes
+across sessions; SMC on the model's trials; where the built-in trials' model error comes from,
 `experiments/research/model_error.py`, and the truth's standing under other likelihoods,
 `experiments/research/capitate_likelihood.py`). The studies' run logs go to a fresh
 folder `runs/regenerate-<commit>/` (a killed run resumes there when rerun at the same commit: the steps
@@ -31,6 +32,9 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURES = "experiments/figures"  # the README's figures (the commands' own default is runs/figures)
+# the 1,200-step study's saved runs are committed (~2.7 MB a run): at ~35 min a run it spans sessions,
+# and a saved run is loaded, not rerun, unless it was sampled on another model (`Posterior.model_hash`)
+STEPS1200_RUNS = "leaderboards/posterior/steps1200/runs"
 
 
 def _commit() -> str:
@@ -82,7 +86,7 @@ def steps(runs: Path, figures_only: bool) -> list[list[str]]:
         [
             "posterior",
             *("P1", "P2", "P3", "--seeds", "3", "--model-trials"),
-            *("--out", str(runs / "posterior1200"), "--report", "leaderboards/posterior/steps1200"),
+            *("--out", STEPS1200_RUNS, "--report", "leaderboards/posterior/steps1200"),
         ],
         [
             "posterior",

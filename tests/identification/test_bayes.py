@@ -14,6 +14,7 @@ from wrist_env.identification import bayes, mcmc, posterior, smc
 from wrist_env.identification import map as map_
 from wrist_env.identification import study as study_
 from wrist_env.identification.settings import SamplerSettings
+from wrist_env.participants.registry import load_model
 
 
 def _linear_gaussian():
@@ -117,6 +118,14 @@ def test_the_command_samples_p1_and_writes_coverage_and_figures(built, tmp_path,
     assert "loaded" in capsys.readouterr().out
     assert main([*args, "--prior-refresh", "0"]) == 2  # a saved run is not taken for one with other settings
     assert "posterior_P1_seed0.npz was sampled with" in capsys.readouterr().err
+    # nor for a run on another model: the saved run names the model it was sampled on
+    saved = tmp_path / "posterior_P1_seed0.json"
+    record = json.loads(saved.read_text())
+    assert record["fields"]["model_hash"] == load_model("P1").source_hash
+    record["fields"]["model_hash"] = "0123456789abcdef"
+    saved.write_text(json.dumps(record))
+    assert main(args) == 2
+    assert "posterior_P1_seed0.npz was sampled on P1's model 0123456789abcdef, not today's" in capsys.readouterr().err
 
 
 def test_smc_from_a_defensive_start_off_the_mode_recovers_the_same_posterior():

@@ -147,6 +147,7 @@ def calibrate(
         settings.sampler,
         **extra,
         settings=settings.record(),
+        model_hash=calibration.model.source_hash,
     )
 
 

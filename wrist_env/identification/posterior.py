@@ -28,6 +28,7 @@ class Posterior:
     trials: "built-in" (the participant's trials) or "model" (`model_trials`: no model error).
     sampler: "emcee" or "smc"; log_evidence and stages: SMC's log marginal likelihood and tempering stages.
     settings: the sampler's settings (`SamplerSettings.record`); None in files saved before they were recorded.
+    model_hash: the calibration model's `Model.source_hash`; None in files saved before it was recorded.
     """
 
     participant: str
@@ -49,6 +50,7 @@ class Posterior:
     log_evidence: float = float("nan")
     stages: int = 0
     settings: dict | None = None
+    model_hash: str | None = None
 
     ARRAYS = ("samples", "log_prob", "map_z", "autocorr", "ess", "rhat", "noise", "predictive", "observed")
 

@@ -17,6 +17,7 @@ from wrist_env.identification.mcmc import log_probability
 from wrist_env.identification.posterior import Posterior
 from wrist_env.identification.settings import SamplerSettings
 from wrist_env.participants import builtin
+from wrist_env.participants.registry import load_model
 
 LEVELS = (0.5, 0.9)
 
@@ -39,7 +40,8 @@ def study(
     on_run(posterior, loaded) is called after each run; report: the folder of the table and figures
     (default `out`); a saved run sampled with other settings is an error; trials: "built-in" or "model"
     (`model_trials`; files and figures get a `_model` suffix); settings: the sampler and its settings
-    (default `SamplerSettings()`, emcee; SMC's files get a `_smc` suffix)."""
+    (default `SamplerSettings()`, emcee; SMC's files get a `_smc` suffix). A saved run sampled on
+    another model (`Posterior.model_hash`, the model's `source_hash`) is an error too."""
     out = Path(out)
     settings = SamplerSettings() if settings is None else settings
     sampler = settings.sampler
@@ -55,6 +57,12 @@ def study(
                 if post.settings is not None and post.settings != settings.record():
                     raise StoreError(
                         f"{path} was sampled with {post.settings}, not the {settings.record()} asked for: "
+                        "delete it or choose another output folder"
+                    )
+                model_hash = load_model(participant).source_hash
+                if post.model_hash is not None and post.model_hash != model_hash:
+                    raise StoreError(
+                        f"{path} was sampled on {participant}'s model {post.model_hash}, not today's {model_hash}: "
                         "delete it or choose another output folder"
                     )
             else:
