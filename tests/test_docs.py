@@ -70,6 +70,20 @@ def test_a_results_page_shows_the_committed_numbers(site):
         assert cost.strip() in board
 
 
+def test_the_posterior_page_dates_each_study_by_its_own_commit(site):
+    """The studies are regenerated one at a time: each section names the commit of its own table."""
+    text = (site / "results" / "posterior.html").read_text()
+    sections = text.split("<h2")[1:]
+    tables = ["coverage.csv", "coverage_model.csv", "steps1200/coverage_model.csv", "coverage_model_smc.csv"]
+    assert len(sections) == len(tables)
+    for section, name in zip(sections, tables, strict=True):
+        done = subprocess.run(
+            ["git", "log", "-1", "--format=%h", "--", f"leaderboards/posterior/{name}"],
+            cwd=ROOT, capture_output=True, text=True, check=True,
+        )  # fmt: skip
+        assert f"Last regenerated in commit {done.stdout.strip()}," in section, name
+
+
 def test_the_sensitivity_page_ranks_the_calibration_trials_own_indices(site):
     import pandas as pd
 

@@ -126,13 +126,15 @@ def identifiability() -> str:
 
 
 def posterior() -> str:
-    parts = heading(
-        "Bayesian calibration: coverage",
+    parts = [
+        "# Bayesian calibration: coverage",
+        "",
         "Rendered from `leaderboards/posterior/coverage*.csv`: the share of the 22 material truths inside "
         "the posterior's 50 % and 90 % intervals (well calibrated: 0.5 and 0.9), and the recovery error "
-        "(RMS, Table 2 SD) of the posterior mean, the MAP and the population design; means over seeds.",
-        BOARDS / "posterior",
-    ) + [""]
+        "(RMS, Table 2 SD) of the posterior mean, the MAP and the population design; means over seeds. "
+        "Each study names the commit it was last regenerated in.",
+        "",
+    ]
     studies = [
         ("coverage.csv", "built-in trials, emcee"),
         ("coverage_model.csv", "the model's own trials, emcee"),
@@ -145,7 +147,9 @@ def posterior() -> str:
         steps = f", {int(d.steps.iloc[0])} steps" if "steps" in d else ""
         rows = [[p, len(g), *(float(g[c].mean()) for c in cols)] for p, g in d.groupby("participant")]
         header = ["participant", "seeds", "50 % coverage", "90 % coverage", "mean", "MAP", "population"]
-        parts += [f"## {label}{steps}", "", table(header, rows), ""]
+        # the studies are regenerated one by one (the 1,200-step study spans sessions): each names its commit
+        when = committed(BOARDS / "posterior" / name).strip()
+        parts += [f"## {label}{steps}", "", *([when, ""] if when else []), table(header, rows), ""]
     parts.append(figure(BOARDS / "posterior" / "posterior_intervals_P1.png", "posterior intervals, P1"))
     return "\n".join(parts) + "\n"
 
