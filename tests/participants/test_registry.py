@@ -122,8 +122,10 @@ def test_the_shipped_model_is_what_a_build_gives(tmp_path, monkeypatch):
     floating-point detail. Library releases move a few values (a fresh install with NumPy 2.4, SciPy
     1.17, Numba 0.68, trimesh 5.2 moved 6 % of the contact grid by ≤ 0.026 mm, 134 of 2,343 contact
     samples by ≤ 0.0015 mm and two samples' cartilage thickness by ≤ 0.03 mm; the per-vertex
-    thickness differed in one run and not in another), so: every value within 0.05 (mm, mm², unit
-    vectors), at least 90 % of each array identical."""
+    thickness differed in one run and not in another). Three builds on 2026-12-06 (the same libraries):
+    the per-vertex thickness 25 of 24,642 values by up to 0.10 mm in one and none in another; 2 of 3,300
+    sample-normal components by up to 0.136 and 2 of 1,100 sample thicknesses by up to 0.052 mm. So:
+    99.5 % of each array's values within 0.05 (mm, mm², unit vectors), at least 90 % identical."""
     from dataclasses import fields
 
     from wrist_env.model import Model
@@ -138,6 +140,9 @@ def test_the_shipped_model_is_what_a_build_gives(tmp_path, monkeypatch):
         if isinstance(a, np.ndarray):
             assert a.shape == b.shape, f.name
             same = np.isclose(a, b, rtol=1e-9, atol=1e-9, equal_nan=True)
-            assert np.allclose(a, b, rtol=0, atol=0.05, equal_nan=True) and same.mean() >= 0.9, (
+            close = np.isclose(a, b, rtol=0, atol=0.05, equal_nan=True)
+            # a value at a threshold of the build (the overclosure pass's, a sample's face) flips from
+            # build to build: 0.5 % of an array may differ more than 0.05
+            assert close.mean() >= 0.995 and same.mean() >= 0.9, (
                 f"{f.name}: {int((~same).sum())} of {same.size} differ, by up to {np.nanmax(np.abs(a - b)):.3g}"
             )
