@@ -9,7 +9,7 @@ Monte Carlo study (P1 + P2, 2 × 12,500) with its report, what a trial identifie
 sensitivity and the Fisher matrix at the hidden truth, P1–P3), the best calibrators with and without
 the prior (`leaderboards/prior/`) and the Bayesian calibrator's coverage on the trials and on the
 model's own trials (`leaderboards/posterior/`: emcee at 300 steps with the default 24 MAP starts
-and prior refresh, and on the model's trials at the default 1,200 steps too, ~5 h, in
+and prior refresh, and on the model's trials at the default 1,200 steps too, ~5 h estimated, in
 `leaderboards/posterior/steps1200/`, its saved runs committed in `steps1200/runs/` so that it resumes
 across sessions; SMC on the model's trials; where the built-in trials' model error comes from,
 `experiments/research/model_error.py`, and the truth's standing under other likelihoods,
@@ -32,7 +32,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURES = "experiments/figures"  # the README's figures (the commands' own default is runs/figures)
-# the 1,200-step study's saved runs are committed (~2.7 MB a run): at ~35 min a run it spans sessions,
+# the 1,200-step study's saved runs are committed (~2.7 MB a run: 600 kept steps x 48 walkers x 22 float32):
+# estimated at 30-40 min a run on the issue-33 model (the 300-step runs' 10-12 min, x3 simulations), it spans sessions,
 # and a saved run is loaded, not rerun, unless it was sampled on another model (`Posterior.model_hash`)
 STEPS1200_RUNS = "leaderboards/posterior/steps1200/runs"
 

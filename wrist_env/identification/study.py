@@ -17,7 +17,7 @@ from wrist_env.identification.mcmc import log_probability
 from wrist_env.identification.posterior import Posterior
 from wrist_env.identification.settings import SamplerSettings
 from wrist_env.participants import builtin
-from wrist_env.participants.registry import load_model
+from wrist_env.task import task
 
 LEVELS = (0.5, 0.9)
 
@@ -59,7 +59,7 @@ def study(
                         f"{path} was sampled with {post.settings}, not the {settings.record()} asked for: "
                         "delete it or choose another output folder"
                     )
-                model_hash = load_model(participant).source_hash
+                model_hash = task(participant, "calibrate").model.source_hash  # cached: truth_rank's task
                 if post.model_hash is not None and post.model_hash != model_hash:
                     raise StoreError(
                         f"{path} was sampled on {participant}'s model {post.model_hash}, not today's {model_hash}: "
