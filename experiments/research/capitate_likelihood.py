@@ -27,7 +27,7 @@ A likelihood that accounts for the model error would put the truth where a poste
 log density ~11 ± 3 nats below the mode in 22 dimensions (χ²₂₂ / 2). Writes
 `leaderboards/posterior/capitate_likelihood.csv` (deficits) and `capitate_response.csv` (the check).
 
-Run: `python experiments/research/capitate_likelihood.py [P1 P2 P3]` (~4 min a participant: the MAP search
+Run: `python experiments/research/capitate_likelihood.py [P1 P2 P3]` (~10 min a participant: the MAP search
 and 1,024 runs).
 """
 
