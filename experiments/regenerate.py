@@ -32,8 +32,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURES = "experiments/figures"  # the README's figures (the commands' own default is runs/figures)
-# the 1,200-step study's saved runs are committed (~2.7 MB a run: 600 kept steps x 48 walkers x 22 float32):
-# estimated at 30-40 min a run on the issue-33 model (the 300-step runs' 10-12 min, x3 simulations), it spans sessions,
+# the 1,200-step study's saved runs are committed (0.37 MB a run, compressed): at 45 min a run on the issue-33 model
+# (P1 seed 0 on a free machine: 24 MAP starts, then 61,614 simulations), its 9 runs span sessions,
 # and a saved run is loaded, not rerun, unless it was sampled on another model (`Posterior.model_hash`)
 STEPS1200_RUNS = "leaderboards/posterior/steps1200/runs"
 
