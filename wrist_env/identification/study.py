@@ -53,18 +53,7 @@ def study(
             path = out / f"posterior_{participant}_seed{seed}{suffix}.npz"
             loaded = path.exists()
             if loaded:
-                post = Posterior.load(path)
-                if post.settings is not None and post.settings != settings.record():
-                    raise StoreError(
-                        f"{path} was sampled with {post.settings}, not the {settings.record()} asked for: "
-                        "delete it or choose another output folder"
-                    )
-                model_hash = task(participant, "calibrate").model.source_hash  # cached: truth_rank's task
-                if post.model_hash is not None and post.model_hash != model_hash:
-                    raise StoreError(
-                        f"{path} was sampled on {participant}'s model {post.model_hash}, not today's {model_hash}: "
-                        "delete it or choose another output folder"
-                    )
+                post = _saved(path, participant, settings)
             else:
                 post = calibrate(participant, seed, settings, progress=progress, trials=trials)
                 post.save(path)
@@ -103,6 +92,22 @@ def study(
         plot_intervals(posts, truth, report / f"posterior_intervals_{participant}{suffix}.png")
         plot_predictive(posts[0], report / f"posterior_predictive_{participant}{suffix}.png")
     return table
+
+
+def _saved(path: Path, participant: str, settings: SamplerSettings) -> Posterior:
+    """The run saved at `path`; a StoreError if it was sampled with other settings or on another model
+    than today's (`Posterior.model_hash` against the model's `source_hash`)."""
+    post = Posterior.load(path)
+    model_hash = task(participant, "calibrate").model.source_hash  # cached: truth_rank's task
+    for what, saved, today in (
+        ("with", post.settings, settings.record()),
+        (f"on {participant}'s model", post.model_hash, model_hash),
+    ):
+        if saved is not None and saved != today:
+            raise StoreError(
+                f"{path} was sampled {what} {saved}, not today's {today}: delete it or choose another output folder"
+            )
+    return post
 
 
 def truth_rank(post: Posterior, z_true: np.ndarray) -> dict:
