@@ -9,7 +9,7 @@ Monte Carlo study (P1 + P2, 2 × 12,500) with its report, what a trial identifie
 sensitivity and the Fisher matrix at the hidden truth, P1–P3), the best calibrators with and without
 the prior (`leaderboards/prior/`) and the Bayesian calibrator's coverage on the trials and on the
 model's own trials (`leaderboards/posterior/`: emcee at 300 steps with the default 24 MAP starts
-and prior refresh, and on the model's trials at the default 1,200 steps too, ~7 h (45-47 min a run measured), in
+and prior refresh, and on the model's trials at the default 1,200 steps too, ~6-7 h (34-51 min a run measured), in
 `leaderboards/posterior/steps1200/`, its saved runs committed in `steps1200/runs/` so that it resumes
 across sessions; SMC on the model's trials; where the built-in trials' model error comes from,
 `experiments/research/model_error.py`, and the truth's standing under other likelihoods,
@@ -32,8 +32,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURES = "experiments/figures"  # the README's figures (the commands' own default is runs/figures)
-# the 1,200-step study's saved runs are committed (0.4-0.5 MB a run, compressed): at 45-47 min a run on the issue-33
-# model (P1 seeds 0 and 1 on a free machine: 24 MAP starts, then ~62,000 simulations), its 9 runs span sessions,
+# the 1,200-step study's saved runs are committed (0.4-0.5 MB a run, compressed): at 34-51 min a run on the issue-33
+# model (P1 and P2 on a free machine: 24 MAP starts, then 58,000-63,000 simulations), its 9 runs span sessions,
 # and a saved run is loaded, not rerun, unless it was sampled on another model (`Posterior.model_hash`)
 STEPS1200_RUNS = "leaderboards/posterior/steps1200/runs"
 
