@@ -259,9 +259,36 @@ def test_a_model_trials_study_keeps_its_own_files_and_says_so(built, tmp_path, m
     assert (
         np.isfinite(table.truth_log_prob).all() and (table.truth_log_prob < 0).all() and (table.truth_rank == 0).all()
     )
+    assert (table.mode_log_prob == 0).all() and (table.samples_deficit_median == 0).all()
+    assert np.allclose(table.truth_deficit, -table.truth_log_prob) and np.isfinite(table.mahalanobis2).all()
     assert (tmp_path / "coverage_model.csv").exists() and not (tmp_path / "coverage.csv").exists()
     assert posterior.Posterior.load(tmp_path / "posterior_P1_seed1_model.npz").trials == "model"
     assert (tmp_path / "posterior_intervals_P1_model.png").exists()
+
+
+def test_against_truth_places_the_truth_in_a_gaussian_posterior_as_closed_form_says(monkeypatch):
+    """With a standard-normal log posterior in 22 dimensions and 40,000 draws from it: the draws sit
+    a median χ²₂₂/2 below the mode (scipy's quantile), the truth ½|t|² below it, and its squared
+    Mahalanobis distance is |t|²."""
+    from scipy.stats import chi2
+
+    rng = np.random.default_rng(3)
+    dim = design.N_MATERIAL
+    draws = rng.normal(size=(40_000, dim))
+    truth = np.linspace(-1.5, 1.5, dim)
+    monkeypatch.setattr(study_, "_tasks", lambda *args: (None, None))
+    monkeypatch.setattr(study_, "log_probability", lambda calibration: lambda Z: -0.5 * np.sum(Z**2, axis=1))
+    zeros = np.zeros(dim)
+    post = posterior.Posterior(
+        "P1", 0, draws, -0.5 * np.sum(draws**2, axis=1), zeros, zeros + 1, zeros + 400, zeros + 1, 0.3,
+        np.array([0.1, 0.3]), 40_000, 1.0, np.zeros((2, 3, 2, 4, 6)), np.zeros((2, 2, 4, 6)), "model",
+    )  # fmt: skip
+    at = study_.against_truth(post, truth)
+    assert at["mode_log_prob"] == 0.0  # the MAP (zeros) is above every draw
+    assert at["samples_deficit_median"] == pytest.approx(chi2.ppf(0.5, dim) / 2, abs=0.1)
+    assert at["truth_deficit"] == pytest.approx(0.5 * truth @ truth)
+    assert at["mahalanobis2"] == pytest.approx(truth @ truth, rel=0.03)
+    assert at["truth_rank"] == pytest.approx(chi2.sf(truth @ truth, dim), abs=0.01)
 
 
 @pytest.mark.parametrize(

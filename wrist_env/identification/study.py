@@ -35,7 +35,7 @@ def study(
 ):
     """A Bayesian calibration per participant and seed (`out/posterior_<P>_seed<s>.npz/.json`; a run
     already saved is loaded, not rerun), then the coverage table (one row per run: share of the 22 true
-    z inside the 50 % and 90 % intervals, `truth_rank`, recovery of the posterior mean, the MAP and the
+    z inside the 50 % and 90 % intervals, `against_truth`, recovery of the posterior mean, the MAP and the
     population design, diagnostics) as `out/coverage.csv` and the figures; returns the table.
     on_run(posterior, loaded) is called after each run; report: the folder of the table and figures
     (default `out`); a saved run sampled with other settings is an error; trials: "built-in" or "model"
@@ -78,7 +78,7 @@ def study(
             if truth is not None:
                 for level in LEVELS:
                     row[f"coverage_{int(level * 100)}"] = float(post.covers(truth, level).mean())
-                row.update(truth_rank(post, truth))
+                row.update(against_truth(post, truth))
                 row["recovery_mean"] = _rms(post.mean - truth)
                 row["recovery_map"] = _rms(post.map_z - truth)
                 row["recovery_population"] = _rms(truth)
@@ -98,7 +98,7 @@ def _saved(path: Path, participant: str, settings: SamplerSettings) -> Posterior
     """The run saved at `path`; a StoreError if it was sampled with other settings or on another model
     than today's (`Posterior.model_hash` against the model's `source_hash`)."""
     post = Posterior.load(path)
-    model_hash = task(participant, "calibrate").model.source_hash  # cached: truth_rank's task
+    model_hash = task(participant, "calibrate").model.source_hash  # cached: against_truth's task
     for what, saved, today in (
         ("with", post.settings, settings.record()),
         (f"on {participant}'s model", post.model_hash, model_hash),
@@ -110,14 +110,28 @@ def _saved(path: Path, participant: str, settings: SamplerSettings) -> Posterior
     return post
 
 
-def truth_rank(post: Posterior, z_true: np.ndarray) -> dict:
-    """{"truth_log_prob": the log posterior of the hidden truth on the run's calibration task,
-    "truth_rank": the share of the kept samples whose log posterior is lower}. A rank near 1 says
-    the chains missed the truth's region although it is as probable as any they visited (a mode
-    the sampler did not find), not that the truth is implausible."""
+def against_truth(post: Posterior, z_true: np.ndarray) -> dict:
+    """Where the hidden truth and the kept samples sit in the run's posterior (on its calibration task):
+    truth_log_prob; truth_rank, the share of the kept samples whose log posterior is lower (near 1:
+    a mode the chains did not find; near 0: the samples sit higher than the typical set);
+    mode_log_prob, the higher of the MAP's and the best sample's; truth_deficit and
+    samples_deficit_median, the truth's and the samples' median log posterior below the mode
+    (nats; for a calibrated Gaussian 22-dim posterior a draw sits χ²₂₂/2 below it, a median 10.7);
+    mahalanobis2, the truth's squared Mahalanobis distance from the posterior mean in the samples'
+    covariance (for a calibrated Gaussian posterior χ²₂₂, mean 22)."""
     calibration, _ = _tasks(post.participant, post.trials, post.seed)
-    value = float(log_probability(calibration)(z_true[None])[0])
-    return {"truth_log_prob": value, "truth_rank": float(np.mean(post.log_prob < value))}
+    truth, at_map = (float(v) for v in log_probability(calibration)(np.stack([z_true, post.map_z])))
+    mode = max(at_map, float(post.log_prob.max()))
+    samples = post.samples.astype(float)
+    offset = z_true - samples.mean(axis=0)
+    return {
+        "truth_log_prob": truth,
+        "truth_rank": float(np.mean(post.log_prob < truth)),
+        "mode_log_prob": mode,
+        "truth_deficit": mode - truth,
+        "samples_deficit_median": float(np.median(mode - post.log_prob)),
+        "mahalanobis2": float(offset @ np.linalg.solve(np.cov(samples.T), offset)),
+    }
 
 
 def _rms(v: np.ndarray) -> float:
