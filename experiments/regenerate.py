@@ -33,7 +33,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 FIGURES = "experiments/figures"  # the README's figures (the commands' own default is runs/figures)
 # the 1,200-step study's saved runs are committed (0.4-0.5 MB a run, compressed): at 34-51 min a run on the issue-33
-# model (P1 and P2 on a free machine: 24 MAP starts, then 58,000-63,000 simulations), its 9 runs span sessions,
+# model (P1-P3, nine runs: 24 MAP starts, then 58,000-63,000 simulations), its 9 runs span sessions,
 # and a saved run is loaded, not rerun, unless it was sampled on another model (`Posterior.model_hash`)
 STEPS1200_RUNS = "leaderboards/posterior/steps1200/runs"
 

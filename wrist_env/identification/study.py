@@ -114,7 +114,7 @@ def against_truth(post: Posterior, z_true: np.ndarray) -> dict:
     """Where the hidden truth and the kept samples sit in the run's posterior (on its calibration task):
     truth_log_prob; truth_rank, the share of the kept samples whose log posterior is lower (near 1:
     a mode the chains did not find; near 0: the samples sit higher than the typical set);
-    mode_log_prob, the higher of the MAP's and the best sample's; truth_deficit and
+    map_log_prob, the MAP's; mode_log_prob, the higher of the MAP's and the best sample's; truth_deficit and
     samples_deficit_median, the truth's and the samples' median log posterior below the mode
     (nats; for a calibrated Gaussian 22-dim posterior a draw sits χ²₂₂/2 below it, a median 10.7);
     mahalanobis2, the truth's squared Mahalanobis distance from the posterior mean in the samples'
@@ -127,6 +127,7 @@ def against_truth(post: Posterior, z_true: np.ndarray) -> dict:
     return {
         "truth_log_prob": truth,
         "truth_rank": float(np.mean(post.log_prob < truth)),
+        "map_log_prob": at_map,
         "mode_log_prob": mode,
         "truth_deficit": mode - truth,
         "samples_deficit_median": float(np.median(mode - post.log_prob)),
