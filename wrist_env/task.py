@@ -102,7 +102,7 @@ class Task:
         return self._score(design, simulate(self.model, design, self.driver, prepared=self.prepared))
 
     def evaluate_batch(self, designs: Iterable[Design]) -> Evaluations:
-        """Simulate many designs at once (Numba prange); the same numbers as one at a time."""
+        """Simulate many designs at once (`simulate_batch`: one thread per core); the same numbers as one at a time."""
         designs = list(designs)
         results = simulate_batch(self.model, designs, self.driver, prepared=self.prepared)
         return Evaluations(tuple(self._score(d, r) for d, r in zip(designs, results)))

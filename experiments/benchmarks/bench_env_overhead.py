@@ -38,10 +38,10 @@ def main(participant: str = "P1", n: int = 500) -> None:
 
     def capture(*args):
         run(*args)
-        stored["out"] = [np.array(x, copy=True) for x in args[-1]]  # the run's Outputs
+        stored["out"] = [np.array(x, copy=True) for x in args[8]]  # the run's Outputs (`kernel.run`: its 9th argument)
 
     def replay(*args):
-        for dst, src in zip(args[-1], stored["out"]):
+        for dst, src in zip(args[8], stored["out"]):
             dst[...] = src
 
     kernel.run = capture

@@ -12,8 +12,8 @@ after a warm-up chunk that loads the model and Numba's cache, and prints:
   beside the preprint's 13 days.
 
 Run: `python experiments/benchmarks/bench_montecarlo.py [--n 500] [--batch 64] [--workers 0]
-[--participants P1] [--scheduler ADDRESS]`. Compare `--workers 0` (one process, Numba's prange
-on every core) with `--workers 2` (two processes, one thread each). On a shared machine expect
+[--participants P1] [--scheduler ADDRESS]`. Compare `--workers 0` (one process, a batch's designs on
+one thread per core) with `--workers 2` (two processes, one thread each). On a shared machine expect
 ±15 %.
 """
 

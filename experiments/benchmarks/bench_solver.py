@@ -6,7 +6,7 @@ side by side in one run — today's defaults and the block mass
 - steps, µs per step and ms per simulation on one core: the idealized
   flexion–extension sweep (17 frames, ±40°) with the population design, and
   the participant's 15-frame calibration trial (the capitate's 6 DOF prescribed);
-- simulations per second batched (`simulate_batch`, Numba prange) on all
+- simulations per second batched (`simulate_batch`, one thread per core) on all
   cores, for Monte Carlo designs (Table 2 normals truncated at ±3 SD, each
   injurable ligament torn with probability 0.3), their mean steps and share ok;
 - what that makes of the Monte Carlo study (2 × 12,500 sweeps) and the full

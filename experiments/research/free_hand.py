@@ -40,7 +40,7 @@ def distal_row_moment(model, d, driver, result) -> np.ndarray:
     state = kernel.State(R, x, np.zeros_like(x), np.zeros_like(x), nodes, np.zeros_like(nodes))
     work = kernel.new_work(p.grids, nodes)
     st = sim.stiffness(p, d)
-    kernel.net_forces(state, work, p.system, st, driver.kernel_load(0), True)
+    kernel.net_forces(state, work, p.system, st, driver.kernel_load(0), True, True, p.settings.smooth_normals)
     return work.T[CAPITATE].copy()
 
 

@@ -49,7 +49,7 @@ def test_a_line_adds_its_force_and_its_moment_about_the_centre_of_mass(p1):
         state = kernel.State(R.copy(), x.copy(), np.zeros_like(x), np.zeros_like(x), nodes, np.zeros_like(nodes))
         work = kernel.new_work(p.grids, nodes)
         load = with_line.kernel_load(0)._replace(tension=np.array([tension]))
-        kernel.net_forces(state, work, p.system, design_arrays, load, True)
+        kernel.net_forces(state, work, p.system, design_arrays, load, True, True, p.settings.smooth_normals)
         return work.F.copy(), work.T.copy()
 
     F0, T0 = forces(0.0)
@@ -64,8 +64,9 @@ def test_a_line_adds_its_force_and_its_moment_about_the_centre_of_mass(p1):
 
 def test_lines_on_the_driven_capitate_act_as_their_resultant_and_the_columns_do_not(p1):
     """The Erhart lines on the capitate body, whose rotations the driver prescribes, end where their
-    resultant on the capitate ends (their moments go to the driver), to 1e-4 mm and 1e-3 N (float sums
-    in another order); the radial column's lines (1st and 2nd rays) load a free body, so moving them to
+    resultant on the capitate ends (their moments go to the driver), to 1e-3 mm and 1e-3 N: the same
+    forces summed in another order change a hold's last steps, and a hold stops at a net force of
+    0.01 N, which a soft direction (~10 N/mm) leaves 1e-3 mm from its balance; the radial column's lines (1st and 2nd rays) load a free body, so moving them to
     the capitate as a resultant changes the answer (the STT joint's force by more than 1 N). Each run
     balances (every free body's net force under 0.05 N)."""
     from dataclasses import replace
@@ -96,7 +97,7 @@ def test_lines_on_the_driven_capitate_act_as_their_resultant_and_the_columns_do_
         if body == TRAPEZIUM:
             assert abs(a.contact[0, stt, 3] - b.contact[0, stt, 3]) > 1.0, (a.contact[0, stt], b.contact[0, stt])
         else:
-            assert np.abs(a.poses - b.poses).max() < 1e-4
+            assert np.abs(a.poses - b.poses).max() < 1e-3
             assert np.abs(a.contact[..., 3] - b.contact[..., 3]).max() < 1e-3
 
 

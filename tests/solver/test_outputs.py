@@ -79,6 +79,8 @@ def test_pressure_map_sums_to_the_solver_contact_force_at_the_same_state(p1, swe
             np.zeros((N_BODIES, 3)),
             np.zeros((N_BODIES, 3)),
             stats,
+            True,
+            False,
         )
         assert n_active.sum() == n
         p = pressure_map(p1, sweep.poses[f])

@@ -46,7 +46,7 @@ def test_membrane_eigenvalue_matches_the_force_kernels_jacobian(p1):
         moved[free] += q.reshape(-1, 3)
         out = np.zeros_like(nodes)
         membrane_forces(
-            R, x, p1.com, mem, moved, m_l0, m_K, 0.0, np.zeros((N_BODIES, 3)), np.zeros((N_BODIES, 3)), out, False
+            R, x, p1.com, mem, moved, m_l0, m_K, 0.0, np.zeros((N_BODIES, 3)), np.zeros((N_BODIES, 3)), out, False, True
         )
         return out[free].ravel()
 

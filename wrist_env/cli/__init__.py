@@ -6,14 +6,58 @@ import argparse
 import os
 import sys
 from collections.abc import Sequence
+from importlib import import_module
 
-from wrist_env.cli import figure_commands, identification_commands, participant_commands, study_commands
 from wrist_env.errors import WristEnvError
-from wrist_env.participants import registry
+
+COMMANDS = {
+    "participants": ("participant_commands", "list the known participants"),
+    "build": ("participant_commands", "build (or load from cache) a participant model"),
+    "export": (
+        "participant_commands",
+        "write a built-in participant as a participant folder (a template for your own)",
+    ),
+    "simulate": ("participant_commands", "simulate a participant and print the per-frame outputs"),
+    "evaluate": ("participant_commands", "score one design on a participant's task (cost, per-DOF errors)"),
+    "validate": (
+        "figure_commands",
+        "check the model against published wrist measurements (exit 1 if any check fails)",
+    ),
+    "figure": ("figure_commands", "write a figure (PNG)"),
+    "calibrate": ("study_commands", "calibrate a participant's ligament materials with one calibrator"),
+    "benchmark": (
+        "study_commands",
+        "run participants x calibrators x seeds into a resumable run log, then the leaderboard",
+    ),
+    "leaderboard": ("study_commands", "write the leaderboards of a benchmark run log"),
+    "iohanalyzer": ("study_commands", "write a benchmark run log in IOHanalyzer's format (through ioh's logger)"),
+    "montecarlo": (
+        "study_commands",
+        "Monte Carlo injury study: n successful idealized sweeps per participant (preprint 2.3.2)",
+    ),
+    "montecarlo-report": ("study_commands", "Tables 5-6 and Figures 8-10 of a Monte Carlo run log"),
+    "sensitivity": (
+        "identification_commands",
+        "global sensitivity of the cost and the 12 DOF errors to the 22 materials (SALib)",
+    ),
+    "identifiability": (
+        "identification_commands",
+        "what the calibration and held-out trials identify at the hidden truth (Fisher matrix)",
+    ),
+    "posterior": (
+        "identification_commands",
+        "Bayesian calibration: the posterior of the 22 materials given the calibration trial (emcee or SMC)",
+    ),
+}
+"""Every `wrist-bench` command: the module of `wrist_env.cli` that declares and runs it, and its one-line
+help. A command's module (and what it imports) is loaded only when that command is named, so
+`wrist-bench --help` loads none of them."""
 
 
-def parser() -> argparse.ArgumentParser:
-    """The `wrist-bench` argument parser: every command, each with `--folder`."""
+def parser(selected: str | None = None) -> argparse.ArgumentParser:
+    """The `wrist-bench` argument parser, every command with `--folder`: each command's own arguments
+    from its module, for every command (`selected` None) or only for the commands of `selected`'s module
+    (the others listed by name and help alone, their modules not imported; "" for none)."""
     p = argparse.ArgumentParser(prog="wrist-bench", description=__doc__)
     sub = p.add_subparsers(dest="command", required=True)
     folders = argparse.ArgumentParser(add_help=False)
@@ -24,23 +68,40 @@ def parser() -> argparse.ArgumentParser:
     )
 
     def command(name: str, *, folders_option: bool = True, **kwargs) -> argparse.ArgumentParser:
+        kwargs.setdefault("help", COMMANDS[name][1])
         return sub.add_parser(name, parents=[folders] if folders_option else [], **kwargs)
 
-    participant_commands.add_commands(command)
-    figure_commands.add_commands(command)
-    study_commands.add_commands(command)
-    identification_commands.add_commands(command)
+    loaded = set()
+    for name, (module, help) in COMMANDS.items():
+        if selected is None or (selected and module == COMMANDS[selected][0]):
+            if module not in loaded:
+                import_module(f"wrist_env.cli.{module}").add_commands(command)
+                loaded.add(module)
+        else:
+            sub.add_parser(name, help=help, add_help=False)
     return p
+
+
+def _named(argv: Sequence[str]) -> str | None:
+    """The command named on the command line, if it is one."""
+    for token in argv:
+        if not token.startswith("-"):
+            return token if token in COMMANDS else None
+    return None
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run one `wrist-bench` command; returns the exit status (2 for a project or file-system error: one line on
     stderr)."""
-    args = parser().parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    name = _named(argv)
+    args = parser(name or "").parse_args(argv)
     os.environ.setdefault("MPLBACKEND", "Agg")  # the commands save figures; none is shown
 
     try:
         if getattr(args, "folder", None):
+            from wrist_env.participants import registry  # only when a folder is named: it loads the builder
+
             for folder in args.folder:
                 registry.add_folder(folder)
         return args.run(args)

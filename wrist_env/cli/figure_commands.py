@@ -73,7 +73,6 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     """Add validate and figure."""
     s = command(
         "validate",
-        help="check the model against published wrist measurements (exit 1 if any check fails)",
         description="Simulate the population design (idealized +-40 deg sweep intact and with all three SLIL bundles "
         "torn, and the capitate held at neutral) and compare carpal kinematics, radiocarpal load share, "
         "SL gap after SLIL tear, radioscaphoid pressure and SLIL force with published bands (each row "
@@ -100,7 +99,6 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
 
     s = command(
         "figure",
-        help="write a figure (PNG)",
         description="model: bones, cartilage, ligaments; annotations: the template; pressure: "
         "contact pressure at the neutral pose viewed from distal (population design); "
         "kinematics: scaphoid and lunate rotations over an idealized sweep; animation: a GIF of that sweep "

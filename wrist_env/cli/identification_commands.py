@@ -114,7 +114,6 @@ def add_commands(command: Callable[..., object]) -> None:
 
     s = command(
         "sensitivity",
-        help="global sensitivity of the cost and the 12 DOF errors to the 22 materials (SALib)",
         description="Morris screening (n trajectories, n x 23 runs per motion) or Sobol first and total "
         "indices (Saltelli, base n a power of 2, n x 24 runs per motion) of the kinematic cost and the "
         "scaphoid and lunate DOF errors to the 22 ligament materials over the action box (Table 2 mean "
@@ -136,7 +135,6 @@ def add_commands(command: Callable[..., object]) -> None:
 
     s = command(
         "identifiability",
-        help="what the calibration and held-out trials identify at the hidden truth (Fisher matrix)",
         description="The Gauss-Newton (Fisher) matrix of the per-frame scaphoid and lunate DOF residuals over "
         "the 4DCT noise (0.2 mm, 0.5 deg), in Table 2 SD units, at each built-in participant's hidden truth "
         "(central differences, 45 runs per trial): its spectrum and each material's posterior SD with the "
@@ -148,7 +146,6 @@ def add_commands(command: Callable[..., object]) -> None:
 
     s = command(
         "posterior",
-        help="Bayesian calibration: the posterior of the 22 materials given the calibration trial (emcee or SMC)",
         description="Samples the posterior of the 22 ligament materials (Table 2 prior, z units) given the "
         "participant's calibration trial, with the translation and rotation noise scales integrated out, from "
         "the MAP (the best of --map-starts trust-region Gauss-Newton runs): by emcee's ensemble MCMC (one batched "

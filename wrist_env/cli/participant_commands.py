@@ -227,7 +227,6 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
 
     s = command(
         "participants",
-        help="list the known participants",
         description="List the participants this command can use: the built-in P1-P3 (synthetic, with their "
         "Table 1 facts) and the participant folders registered with --folder.",
     )
@@ -235,7 +234,6 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
 
     s = command(
         "build",
-        help="build (or load from cache) a participant model",
         description="Build a participant's model (morph the template, cartilage, ligament fibres, contact law, "
         "signed-distance grids; ~30-45 s on first use) and cache it by the hash of its inputs; later "
         "calls load the cache. Prints the build summary.",
@@ -247,7 +245,6 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
 
     s = command(
         "export",
-        help="write a built-in participant as a participant folder (a template for your own)",
         description="Write a built-in participant (its five bone meshes as STL, RCS mm; its trials as CSV; "
         "participant.toml) as a participant folder that build, evaluate, calibrate and "
         "wrist_env.register_participant accept unchanged: the starting point for a folder of your own. "
@@ -260,7 +257,6 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
 
     s = command(
         "simulate",
-        help="simulate a participant and print the per-frame outputs",
         description="Simulate one participant and design; print per-frame kinematics, contact, ligament "
         "forces and the wall time of the simulate call. The first call in a fresh environment "
         "includes Numba compilation (later calls read Numba's on-disk cache; each new process "
@@ -287,7 +283,6 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
 
     s = command(
         "evaluate",
-        help="score one design on a participant's task (cost, per-DOF errors)",
         description="Simulate one design on a participant's task and print its kinematic cost with the 75th "
         "percentile |error| and the RMSE of each scaphoid and lunate DOF (mm, deg) against the "
         "reference: the calibration trial (default), the held-out validation trial, or the idealized "

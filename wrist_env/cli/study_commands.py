@@ -198,7 +198,6 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
 
     s = command(
         "calibrate",
-        help="calibrate a participant's ligament materials with one calibrator",
         description="Search the 22 ligament material variables (injury scalars intact) to minimize the kinematic "
         "cost on the participant's calibration trial, with a registered calibrator "
         "(`optimizers.available()`); then score the calibrated design on the held-out resisted trial "
@@ -225,7 +224,6 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
 
     s = command(
         "benchmark",
-        help="run participants x calibrators x seeds into a resumable run log, then the leaderboard",
         description="Cross participants x calibrators x seeds, one cell each, on local processes (default) or a "
         "dask.distributed scheduler; every evaluation is logged to Parquet in --out as its batch "
         "finishes. Run the same command again to resume after an interruption: finished cells are "
@@ -255,7 +253,6 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
 
     s = command(
         "leaderboard",
-        help="write the leaderboards of a benchmark run log",
         description="Tables (Markdown, CSV) and figures (PNG) from a benchmark run log: best cost "
         "at the budget, evaluations to cost targets, ECDF and convergence plots, "
         "parameter recovery, the held-out trial, the preprint's Tables 3-4.",
@@ -266,7 +263,6 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
 
     s = command(
         "iohanalyzer",
-        help="write a benchmark run log in IOHanalyzer's format (through ioh's logger)",
         description="Replays every logged evaluation through ioh's Analyzer logger (nothing is simulated): "
         "one folder per calibrator, one problem per participant (wrist-<participant>), one run per seed. "
         "Zip the output folder and upload it to IOHanalyzer. Needs the [ioh] extra.",
@@ -276,7 +272,6 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
 
     s = command(
         "montecarlo",
-        help="Monte Carlo injury study: n successful idealized sweeps per participant (preprint 2.3.2)",
         description=f"Latin hypercube over the 27 design variables (materials from Table 2's normals truncated at "
         f"+-{SPAN_SD:g} SD, each of {', '.join(INJURABLE)} torn with probability {TEAR_PROBABILITY:g}), "
         f"simulated through the Idealized environment; runs whose radioscaphoid mean pressure exceeds "
@@ -312,7 +307,6 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     s = command(
         "montecarlo-report",
         folders_option=False,
-        help="Tables 5-6 and Figures 8-10 of a Monte Carlo run log",
         description="Mixed-effects fits (statsmodels MixedLM) of radioscaphoid pressure on a 2-df "
         "angle spline and the tears (Table 5) and of SLIL bundle forces in intact runs "
         "(Table 6), with a random intercept per run; tables as Markdown and CSV, figures "

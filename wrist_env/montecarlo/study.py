@@ -20,8 +20,8 @@ tear probability or threshold in the same folder is refused, and so is a
 second run while one is writing to the folder (`<out>/locks/store.lock`).
 
 Where chunks run (`wrist_env.runs.executor`, the benchmark's too): in this
-process (`workers` 0 or 1: one batched call at a time, Numba's prange on every
-core — the default, measured fastest on this 2-core machine), in `workers`
+process (`workers` 0 or 1: one batched call at a time, its designs on one thread
+per core — the default, measured fastest on this 2-core machine), in `workers`
 local processes (each with cores / workers Numba threads; they die with this
 process), or on a `dask.distributed` scheduler (`scheduler="tcp://…"`, or a
 `distributed.Client`); workers only compute, this process writes the log.

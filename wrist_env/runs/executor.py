@@ -6,7 +6,8 @@ process logs): `submit(fn, *args, **kwargs)` returns a handle, `results(handles)
 yields `(handle, value, error)` as tasks finish — a task's exception is handed
 back, never raised, so one failure does not stop the others.
 
-Local workers are spawned (no fork after Numba's threads started), run with
+Local workers are spawned (no fork after Numba's threads started) after this process has compiled the
+kernel (`simulate.warm`: they load it from Numba's cache instead of each compiling it), run with
 ⌊cores / workers⌋ Numba threads each, and die with their parent: a killed
 study leaves no process computing or logging (Linux: PR_SET_PDEATHSIG; the
 worker also exits at start if its parent is already gone).
@@ -136,6 +137,9 @@ class Processes(Executor):
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
+        from wrist_env.solver.simulate import warm
+
+        warm()  # compile once here; the workers load it from Numba's cache instead of each compiling it
         self.workers = max(1, int(workers))
         self.threads = threads if threads is not None else max(1, (os.cpu_count() or 1) // self.workers)
         self.pool = ProcessPoolExecutor(

@@ -61,7 +61,7 @@ def _residual(q, R0, x0, nodes0, free_nodes, system, stiffness, load, out):
     n_bones = R.shape[0]
     state = kernel.State(R, x, np.zeros((n_bones, 3)), np.zeros((n_bones, 3)), nodes, np.zeros_like(nodes))
     work = kernel.new_work(system.grids, nodes)
-    kernel.net_forces(state, work, system, stiffness, load, True)
+    kernel.net_forces(state, work, system, stiffness, load, True, True, system.settings.smooth_normals)
     F, T, node_force = work.F, work.T, work.node_force
     k = 0
     for b in FREE:
@@ -268,8 +268,8 @@ def block_mass(
     )
     work = kernel.new_work(g, nodes0)
     load = driver.kernel_load(frame)
-    kernel.net_forces(state, work, p.system, st, load, True)
+    kernel.net_forces(state, work, p.system, st, load, True, True, p.settings.smooth_normals)
     m = preconditioner.metric()
-    tangent(state.R, state.x, state.nodes, p.system, st, work.active, work.n_active, m)
+    tangent(state.R, state.x, state.nodes, p.system, st, work.active, work.n_active, m, p.settings.smooth_normals)
     preconditioner.block_mass(state.R, p.bodies, p.settings, m)
     return BlockMass(m.stiffness[:n_bones, :n_bones].copy(), m.mass[:n_bones, :n_bones].copy())

@@ -182,7 +182,7 @@ def sample_pressures(R, x, com0, grids, law, pressure):
 
 
 @njit(cache=True, error_model="numpy")
-def contact_forces(R, x, com0, grids, law, band_mm, active, n_active, ref, F, T, stats, want_energy=True, smooth=False):
+def contact_forces(R, x, com0, grids, law, band_mm, active, n_active, ref, F, T, stats, want_energy, smooth):
     """Contact forces of all pairs' active samples; returns contact energy (N·mm; 0 unless `want_energy`).
 
     A pair's active samples (within `band_mm` of contact) are refilled when its
@@ -262,7 +262,7 @@ def contact_forces(R, x, com0, grids, law, band_mm, active, n_active, ref, F, T,
 
 
 @njit(cache=True, error_model="numpy")
-def fibre_forces(R, x, v, w, com0, fibres, l0, K, damping_s, F, T, bundle_force, want_energy=True):
+def fibre_forces(R, x, v, w, com0, fibres, l0, K, damping_s, F, T, bundle_force, want_energy):
     """Blankevoort fibre forces; returns strain energy (N·mm; 0 unless `want_energy`).
 
     l0, K: per-fibre zero-load length (mm) and scale (N per unit strain), K = 0 if torn.

@@ -73,10 +73,11 @@ def mix_metric(v, w, F, T, st, m, a):
 
 
 @njit(cache=True, error_model="numpy")
-def fire_step(v, w, nv, F, T, node_force, mem, st, fire, m):
+def fire_step(v, w, nv, F, T, node_force, mem, st, fire, m, preconditioned):
     """FIRE relaxation (Bitzek et al. 2006) at a fixed step: mix velocities towards the
     forces while the power is positive, stop everything when it turns negative.
-    fire = [alpha, steps with positive power, 1 after a restart (the caller clears it)]."""
+    fire = [alpha, steps with positive power, 1 after a restart (the caller clears it)];
+    `preconditioned` (a compile-time constant, `kernel._run`): whether st.block_mass may be on."""
     power = 0.0
     for k in range(3):
         for b in FREE:
@@ -87,7 +88,7 @@ def fire_step(v, w, nv, F, T, node_force, mem, st, fire, m):
             power += node_force[i, k] * nv[i, k]
     if power > 0.0:
         a = fire[0]
-        if st.block_mass:
+        if preconditioned and st.block_mass:
             mix_metric(v, w, F, T, st, m, a)
         else:
             for b in FREE:
@@ -171,11 +172,11 @@ def move_blocks(R, x, v, w, F, T, st, m):
 
 
 @njit(cache=True, error_model="numpy")
-def kinetic_energy(R, v, w, nv, bod, st, node_mass, m):
+def kinetic_energy(R, v, w, nv, bod, st, node_mass, m, preconditioned):
     """Kinetic energy (N·mm) of the free bodies and membrane nodes of mass `node_mass` (t) (mass-scaled;
-    with st.block_mass, in the block mass m)."""
+    with st.block_mass, in the block mass m; `preconditioned` as in `fire_step`)."""
     ke = 0.0
-    if st.block_mass:
+    if preconditioned and st.block_mass:
         for b in SOLVED:
             i0, nb = dof(st, b)
             for i in range(nb if i0 >= 0 else 0):

@@ -10,13 +10,13 @@ The free bones' masses are their (scaled) physical ones or, with
 `Settings.block_mass`, one block each from the tangent stiffness
 (`preconditioner`): the answer is the same equilibrium, reached in fewer steps.
 
-Read `run` → `_run`: per stage (settle, move, each frame) it stages the capitate's targets
+Read `run`: per stage (settle, move, each frame) it stages the capitate's targets
 (`_stage`, or the secant predictor's state: `_predicted`), holds (`_ramp_and_hold`, which calls
 `_step`, which calls `net_forces`), checks (`_failure`) and records the frame (`_record`); those
-three are inlined into `_run` (each separately compiled layer over the force kernels cost its own
+three are inlined into `run` (each separately compiled layer over the force kernels cost its own
 link and optimization of their code: +25 s of a cold compile). Every kernel reads the model through
-one `arrays.System` and a design through one `Stiffness`; the entry points (`run`, `run_from`,
-`run_batch`) take the System flat, as they take `Frames`.
+one `arrays.System` and a design through one `Stiffness`; the one entry point, `run`, takes the
+System flat, as it takes `Frames`.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ from __future__ import annotations
 from collections import namedtuple
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from wrist_env.design import ALL_LIGAMENT_NAMES, RSC_INDEX
 from wrist_env.model import BONES, CAPITATE, FREE, PAIRS
@@ -46,12 +46,7 @@ from wrist_env.solver.integrator import fire_step, kinetic_energy, move_blocks, 
 from wrist_env.solver.membrane import membrane_forces, new_scratch, place_nodes, substep
 from wrist_env.solver.preconditioner import SOLVED, block_mass, metric
 from wrist_env.solver.predictor import capitate_move, history, predict, record
-from wrist_env.solver.rigid import (
-    interpolate_pose,
-    matrix_to_rotvec,
-    orthonormalize,
-    smoothstep,
-)
+from wrist_env.solver.rigid import copy_into, interpolate_pose, orthonormalize, rotvec_between, smoothstep
 from wrist_env.solver.stopping import converged, displacement, residual
 from wrist_env.solver.tangent import tangent
 
@@ -62,20 +57,7 @@ OK, FAILED_NAN, FAILED_DIVERGED = 0, 1, 2
 
 
 @njit(cache=True, error_model="numpy")
-def _contact(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, want_energy, smooth):
-    """`contact_forces` with its two flags passed as constants, so Numba compiles one loop per
-    combination (flags read at run time in its inner loop made a step 2× slower: `bench_solver.py`)."""
-    if smooth:
-        if want_energy:
-            return contact_forces(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, True, True)
-        return contact_forces(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, False, True)
-    if want_energy:
-        return contact_forces(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, True, False)
-    return contact_forces(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, False, False)
-
-
-@njit(cache=True, error_model="numpy")
-def net_forces(state, work, system, stiffness, load, rebuild, want_energy=True):
+def net_forces(state, work, system, stiffness, load, rebuild, want_energy, smooth):
     """Forces F (N), torques T (N·mm), contact stats and bundle forces (all in `work`) at `state`
     (`State`) of `system` (`arrays.System`) under a design's `stiffness` and the driver's `load`; with
     `rebuild`, every pair's active contact samples are refilled first (otherwise a pair refills when
@@ -92,13 +74,10 @@ def net_forces(state, work, system, stiffness, load, rebuild, want_energy=True):
     T[:] = 0.0
     bundle[:] = 0.0
     band = st.active_band_mm
-    energy = _contact(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, want_energy, st.smooth_normals)
+    energy = contact_forces(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, want_energy, smooth)
     energy += fibre_forces(R, x, v, w, com0, fib, f_l0, f_K, st.fibre_damping_s, F, T, bundle, want_energy)
     k_mem = st.membrane_contact_stiffness
-    if st.smooth_normals:
-        e_mem, rsc = membrane_forces(R, x, com0, mem, nodes, m_l0, m_K, k_mem, F, T, node_force, want_energy, True)
-    else:
-        e_mem, rsc = membrane_forces(R, x, com0, mem, nodes, m_l0, m_K, k_mem, F, T, node_force, want_energy, False)
+    e_mem, rsc = membrane_forces(R, x, com0, mem, nodes, m_l0, m_K, k_mem, F, T, node_force, want_energy, smooth)
     energy += e_mem
     bundle[RSC] += rsc
     tension = load.tension
@@ -111,8 +90,10 @@ def net_forces(state, work, system, stiffness, load, rebuild, want_energy=True):
     return energy
 
 
-@njit(cache=True, error_model="numpy")
-def _step(state, work, system, stiffness, capR, capx, load, step_index, fire, m, refresh, scratch):
+@njit(cache=True, error_model="numpy", inline="always")
+def _step(
+    state, work, system, stiffness, capR, capx, load, step_index, fire, m, refresh, scratch, smooth, preconditioned
+):
     """One explicit step with the capitate at target (capR, capx), or, for the loaded
     driver, at rotation capR; `load` (`Load`) the driver's lines of action at this step's tensions; with st.block_mass and
     `refresh`, the block mass m (`preconditioner.Metric`) is rebuilt at this state first; with
@@ -121,20 +102,23 @@ def _step(state, work, system, stiffness, capR, capx, load, step_index, fire, m,
     bod, _, _, _, mem, st = system
     R, x, v, w, nodes, nv = state
     active, n_active, _, F, T, node_force, _, _ = work
-    R[CAPITATE] = capR
+    copy_into(R[CAPITATE], capR)
     if st.driver == EXPERIMENTAL:
         x[CAPITATE, 0], x[CAPITATE, 1], x[CAPITATE, 2] = capx
         v[CAPITATE] = 0.0
     w[CAPITATE] = 0.0
-    net_forces(state, work, system, stiffness, load, False, False)
-    if st.block_mass and refresh:
-        tangent(R, x, nodes, system, stiffness, active, n_active, m)
-        block_mass(R, bod, st, m)
+    net_forces(state, work, system, stiffness, load, np.bool_(False), np.bool_(False), smooth)
+    blocks = False
+    if preconditioned:  # a compile-time constant: see `_run`
+        blocks = st.block_mass
+        if blocks and refresh:
+            tangent(R, x, nodes, system, stiffness, active, n_active, m, smooth)
+            block_mass(R, bod, st, m)
     if st.fire_alpha0 > 0.0:
-        fire_step(v, w, nv, F, T, node_force, mem, st, fire, m)
+        fire_step(v, w, nv, F, T, node_force, mem, st, fire, m, preconditioned)
     dt = st.dt
     lin = 1.0 / (1.0 + st.damping * dt)
-    if st.block_mass:
+    if blocks:
         move_blocks(R, x, v, w, F, T, st, m)
     else:
         move_diagonal(R, x, v, w, F, T, bod, st)
@@ -144,16 +128,30 @@ def _step(state, work, system, stiffness, capR, capx, load, step_index, fire, m,
                 for k in range(3):
                     nv[i, k] = (nv[i, k] + dt / stiffness.node_mass * node_force[i, k]) * lin
                     nodes[i, k] += dt * nv[i, k]
-        if st.membrane_substeps > 0:
-            place_nodes(R, x, bod.com0, mem, nodes)
-            substep(R, x, bod.com0, mem, nodes, nv, stiffness.m_l0, stiffness.m_K, stiffness.node_mass, st, scratch)
+        if preconditioned:
+            if st.membrane_substeps > 0:
+                place_nodes(R, x, bod.com0, mem, nodes)
+                substep(
+                    R,
+                    x,
+                    bod.com0,
+                    mem,
+                    nodes,
+                    nv,
+                    stiffness.m_l0,
+                    stiffness.m_K,
+                    stiffness.node_mass,
+                    st,
+                    scratch,
+                    smooth,
+                )
     if step_index % 100 == 0:
         for b in FREE:
-            R[b] = orthonormalize(R[b])
+            orthonormalize(R[b])
 
 
 @njit(cache=True, error_model="numpy")
-def _predicted(state, work, system, stiffness, hist, capR, capx, load, move):
+def _predicted(state, work, system, stiffness, hist, capR, capx, load, move, smooth):
     """Start the next stage, whose capitate pose is (capR, capx) under `load`, from the secant
     predictor's state (`predictor.predict`) if the free bodies' residual there, with the capitate
     already at that pose, is below their residual left where they are; True if so (the state is
@@ -162,19 +160,26 @@ def _predicted(state, work, system, stiffness, hist, capR, capx, load, move):
     mem, st = system.membrane, system.settings
     R, x, v, w, nodes, nv = state
     keep_R, keep_x, keep_nodes = R.copy(), x.copy(), nodes.copy()
-    R[CAPITATE] = capR
+    copy_into(R[CAPITATE], capR)
     if st.driver == EXPERIMENTAL:
-        x[CAPITATE] = capx
-    net_forces(state, work, system, stiffness, load, True, False)
+        copy_into(x[CAPITATE], capx)
+    net_forces(state, work, system, stiffness, load, np.bool_(True), np.bool_(False), smooth)
     before = residual(work.F, work.T, st)
     if not predict(hist, R, x, v, w, nodes, nv, mem, st, move):
-        R[:], x[:], nodes[:] = keep_R, keep_x, keep_nodes
+        _restore(R, x, nodes, keep_R, keep_x, keep_nodes)
         return False
-    net_forces(state, work, system, stiffness, load, True, False)
+    net_forces(state, work, system, stiffness, load, np.bool_(True), np.bool_(False), smooth)
     if residual(work.F, work.T, st) < before:
         return True
-    R[:], x[:], nodes[:] = keep_R, keep_x, keep_nodes
+    _restore(R, x, nodes, keep_R, keep_x, keep_nodes)
     return False
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _restore(R, x, nodes, keep_R, keep_x, keep_nodes):
+    copy_into(R, keep_R)
+    copy_into(x, keep_x)
+    copy_into(nodes, keep_nodes)
 
 
 State = namedtuple("State", ["R", "x", "v", "w", "nodes", "nv"])
@@ -239,37 +244,63 @@ def _stage(f, R0, x0, frame_R, frame_x, frame_load, st):
     return frame_R[a], frame_x[a], frame_load[a], frame_R[f], frame_x[f], frame_load[f], ramp, st.max_hold_steps
 
 
-@njit(cache=True, error_model="numpy")
-def run(bod, grids, law, fib, mem, st, stiffness, frames, out):
+@njit(cache=True, error_model="numpy", nogil=True)
+def run(bod, grids, law, fib, mem, st, stiffness, frames, out, R, x, nodes, first):
     """Simulate one design (`Stiffness`) of the model whose `arrays.System` is (bod, grids, law, fib,
-    mem, st) through the capitate's `Frames`; fills `out` (`Outputs`) and out.status[0] (0 ok, 1 NaN,
-    2 diverged). Steps per frame count those since the previous frame (frame 0: settling and the move
-    included). Each stage ramps the capitate over its ramp steps, then holds until `converged` (at
-    least min_hold_steps, at most max_hold_steps; settling at most settle_steps).
-    The entry points take the System flat, as `Frames` is: `run_batch`'s parallel loop takes no
-    nested tuples."""
-    R = np.zeros((N_BONES, 3, 3))
-    for b in range(N_BONES):
-        R[b] = np.eye(3)
-    system = System(bod, grids, law, fib, mem, st)
-    _run(system, stiffness, frames, out, R, bod.com0.copy(), mem.rest.copy(), SETTLE)
+    mem, st) through the capitate's `Frames` from the state (R, x, nodes), its stages from `first`
+    (`_run`): smooth contact normals, the scaled physical mass (`SolverSettings()`).
+
+    One compiled entry point serves single runs and batches alike (`simulate.simulate_batch` runs
+    designs on threads: `nogil`); it takes the System flat, as it takes `Frames`. `entry(settings)`
+    picks it or one of its three siblings, each compiled only when first used."""
+    _run(System(bod, grids, law, fib, mem, st), stiffness, frames, out, R, x, nodes, first, True, False)
 
 
-@njit(cache=True, error_model="numpy")
-def run_from(bod, grids, law, fib, mem, st, stiffness, frames, out, R, x, nodes):
-    """`run` from a given state at frame 0 instead of from rest: rotations R (5, 3, 3), centres of mass
-    x (5, 3) mm (the capitate at frame 0's pose) and membrane nodes (M, 3) mm, at rest; no settling or
-    move, frame 0's outputs left unfilled, each later frame as in `run` (for a frame-local comparison:
-    `experiments/verification/solver_accuracy.py --frame-local`)."""
-    system = System(bod, grids, law, fib, mem, st)
-    _run(system, stiffness, frames, out, R.copy(), x.copy(), nodes.copy(), 1)
+@njit(cache=True, error_model="numpy", nogil=True)
+def run_preconditioned(bod, grids, law, fib, mem, st, stiffness, frames, out, R, x, nodes, first):
+    """`run` with the block mass, the membrane's substeps and the predictor compiled in (each on where
+    its setting says: `SolverSettings.preconditioned()`)."""
+    _run(System(bod, grids, law, fib, mem, st), stiffness, frames, out, R, x, nodes, first, True, True)
 
 
-@njit(cache=True, error_model="numpy")
-def _run(system, stiffness, frames, out, R, x, nodes, first):
-    """`run` from the state (R, x, nodes), its stages from `first` (`SETTLE`, or 1 from a frame-0 state):
-    per stage, stage (its capitate targets, from the predictor's state if that is closer) → hold
-    (`_ramp_and_hold`) → check (`_failure`) → record (`_record`)."""
+@njit(cache=True, error_model="numpy", nogil=True)
+def run_trilinear(bod, grids, law, fib, mem, st, stiffness, frames, out, R, x, nodes, first):
+    """`run` with the trilinear interpolant's own gradient as the contact normal
+    (`SolverSettings(smooth_normals=False)`)."""
+    _run(System(bod, grids, law, fib, mem, st), stiffness, frames, out, R, x, nodes, first, False, False)
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def run_trilinear_preconditioned(bod, grids, law, fib, mem, st, stiffness, frames, out, R, x, nodes, first):
+    """`run_preconditioned` with the trilinear interpolant's own gradient as the contact normal."""
+    _run(System(bod, grids, law, fib, mem, st), stiffness, frames, out, R, x, nodes, first, False, True)
+
+
+def entry(settings):
+    """The compiled entry point for kernel `Settings`: smooth normals or not, the preconditioner's parts
+    (block mass, membrane substeps, predictor) compiled in or not."""
+    preconditioned = bool(settings.block_mass or settings.membrane_substeps > 0 or settings.predict)
+    if settings.smooth_normals:
+        return run_preconditioned if preconditioned else run
+    return run_trilinear_preconditioned if preconditioned else run_trilinear
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _run(system, stiffness, frames, out, R, x, nodes, first, smooth, preconditioned):
+    """Simulate one design (`Stiffness`) of the model whose `arrays.System` is (bod, grids, law, fib,
+    mem, st) through the capitate's `Frames` from the state (R (5, 3, 3), centres of mass x (5, 3) mm,
+    membrane nodes (M, 3) mm; all overwritten), its stages from `first`: `SETTLE` from rest, or 1 from
+    a frame-0 state (frame 0's outputs then left unfilled). Fills `out` (`Outputs`) and out.status[0]
+    (0 ok, 1 NaN, 2 diverged). Steps per frame count those since the previous frame (frame 0: settling
+    and the move included). Per stage: stage (its capitate targets, from the predictor's state if that
+    is closer) → hold (`_ramp_and_hold`: ramp the capitate, then hold until `converged`, at least
+    min_hold_steps, at most max_hold_steps; settling at most settle_steps) → check (`_failure`) →
+    record (`_record`).
+
+    `smooth` (`Settings.smooth_normals`) and `preconditioned` are compile-time constants: the contact
+    loops are compiled for one kind of normal (read at run time in the inner loop, the flag cost a step
+    1.4×), and the preconditioner's parts only where they can run (they are half a cold compile).
+    Inlined into the entry points (`entry`)."""
     st = system.settings
     frame_R, frame_x, frame_load, body, point, direction = frames
     status = out.status
@@ -289,19 +320,38 @@ def _run(system, stiffness, frames, out, R, x, nodes, first):
     for f in range(first, n_frames):
         Ra, xa, la, Rb, xb, lb, ramp, most = _stage(f, R0, x0, frame_R, frame_x, frame_load, st)
         at_end = Load(body, point, direction, lb)  # the loads at the stage's end
-        axis = matrix_to_rotvec(Rb @ Ra.T)
+        axis = rotvec_between(Rb, Ra)
         shift = xb - xa
         move = capitate_move(axis, shift)
-        if (
-            st.predict
-            and st.driver == LOADED
-            and f > 0
-            and _predicted(state, work, system, stiffness, hist, Rb, xb, at_end, move)
-        ):
-            ramp = st.predict_ramp_steps
-            fire[0], fire[1], fire[2] = st.fire_alpha0, 0.0, 1.0
+        if preconditioned:
+            if (
+                st.predict
+                and st.driver == LOADED
+                and f > 0
+                and _predicted(state, work, system, stiffness, hist, Rb, xb, at_end, move, smooth)
+            ):
+                ramp = st.predict_ramp_steps
+                fire[0], fire[1], fire[2] = st.fire_alpha0, 0.0, 1.0
         k, settled = _ramp_and_hold(
-            state, work, system, stiffness, Ra, xa, la, axis, shift, lb, ramp, most, load, step, fire, m, scratch
+            state,
+            work,
+            system,
+            stiffness,
+            Ra,
+            xa,
+            la,
+            axis,
+            shift,
+            lb,
+            ramp,
+            most,
+            load,
+            step,
+            fire,
+            m,
+            scratch,
+            smooth,
+            preconditioned,
         )
         step += k
         taken += k
@@ -310,15 +360,34 @@ def _run(system, stiffness, frames, out, R, x, nodes, first):
             return
         if f < 0:  # SETTLE and MOVE have no output frame
             continue
-        if st.predict:
-            record(hist, R, x, nodes, move)
-        _record(f, state, work, system, stiffness, at_end, m, out, taken, settled)
+        if preconditioned:
+            if st.predict:
+                record(hist, R, x, nodes, move)
+        _record(f, state, work, system, stiffness, at_end, m, out, taken, settled, smooth, preconditioned)
         taken = 0
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _ramp_and_hold(
-    state, work, system, stiffness, Ra, xa, la, axis, shift, lb, ramp, most, load, step, fire, m, scratch
+    state,
+    work,
+    system,
+    stiffness,
+    Ra,
+    xa,
+    la,
+    axis,
+    shift,
+    lb,
+    ramp,
+    most,
+    load,
+    step,
+    fire,
+    m,
+    scratch,
+    smooth,
+    preconditioned,
 ):
     """One stage's steps: the capitate ramps from (Ra, xa) by the rotation vector `axis` and `shift`
     (mm), the lines' tensions from la to lb (N), over `ramp` steps, then holds until `converged` (after
@@ -334,7 +403,22 @@ def _ramp_and_hold(
             load.tension[i] = la[i] + s * (lb[i] - la[i])
         refresh = k % st.block_refresh_steps == 0 or (st.block_refresh_restart and fire[2] > 0.0)
         fire[2] = 0.0
-        _step(state, work, system, stiffness, capR, capx, load, step + k, fire, m, refresh, scratch)
+        _step(
+            state,
+            work,
+            system,
+            stiffness,
+            capR,
+            capx,
+            load,
+            step + k,
+            fire,
+            m,
+            refresh,
+            scratch,
+            smooth,
+            preconditioned,
+        )
         k += 1
         if k >= ramp + st.min_hold_steps and converged(work.F, work.T, work.bundle, st):
             return k, True
@@ -354,26 +438,31 @@ def _failure(R, x, com0, st):
     for b in FREE:
         if displacement(R, x, com0, b) > st.max_disp_mm:
             status = FAILED_DIVERGED
-        rel = matrix_to_rotvec(R[b] @ R[CAPITATE].T)
-        if np.linalg.norm(rel) > st.max_rot_rad:
+        rel = rotvec_between(R[b], R[CAPITATE])
+        if np.sqrt(rel[0] ** 2 + rel[1] ** 2 + rel[2] ** 2) > st.max_rot_rad:
             status = FAILED_DIVERGED
     return status
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _record(f, state, work, system, stiffness, load, m, out, taken, settled):
+def _record(f, state, work, system, stiffness, load, m, out, taken, settled, smooth, preconditioned):
     """Fill frame f of `out` at the state reached (the last step's forces were those before it, so they
     are evaluated again here under the stage's end `load`); `taken` steps since the previous frame."""
     bod, st = system.bodies, system.settings
     R, x, v, w, nodes, nv = state
     F, T, stats = work.F, work.T, work.stats
     com0 = bod.com0
-    energy = net_forces(state, work, system, stiffness, load, True)
+    energy = net_forces(state, work, system, stiffness, load, np.bool_(True), np.bool_(True), smooth)
+    poses = out.poses
     for b in range(N_BONES):
-        out.poses[f, b, :3, :3] = R[b]
-        out.poses[f, b, :3, 3] = x[b] - R[b] @ com0[b]
-        out.poses[f, b, 3, :3] = 0.0
-        out.poses[f, b, 3, 3] = 1.0
+        for i in range(3):
+            t = x[b, i]
+            for j in range(3):
+                poses[f, b, i, j] = R[b, i, j]
+                t -= R[b, i, j] * com0[b, j]
+            poses[f, b, i, 3] = t
+            poses[f, b, 3, i] = 0.0
+        poses[f, b, 3, 3] = 1.0
     contact = out.contact
     for p in range(stats.shape[0]):
         area = stats[p, C_AREA]
@@ -381,35 +470,14 @@ def _record(f, state, work, system, stiffness, load, m, out, taken, settled):
         contact[f, p, R_PEAK] = stats[p, C_PEAK]
         contact[f, p, R_AREA] = area
         contact[f, p, R_FORCE] = stats[p, C_FORCE]
-    out.bundle[f] = work.bundle
-    out.energy[f, 0] = kinetic_energy(R, v, w, nv, bod, st, stiffness.node_mass, m)
+    copy_into(out.bundle[f], work.bundle)
+    out.energy[f, 0] = kinetic_energy(R, v, w, nv, bod, st, stiffness.node_mass, m, preconditioned)
     out.energy[f, 1] = energy
     out.residual[f, 0] = 0.0
     out.residual[f, 1] = 0.0
     for b in FREE:
-        out.residual[f, 0] = max(out.residual[f, 0], np.linalg.norm(F[b]))
-        out.residual[f, 1] = max(out.residual[f, 1], np.linalg.norm(T[b]))
+        out.residual[f, 0] = max(out.residual[f, 0], np.sqrt(F[b, 0] ** 2 + F[b, 1] ** 2 + F[b, 2] ** 2))
+        out.residual[f, 1] = max(out.residual[f, 1], np.sqrt(T[b, 0] ** 2 + T[b, 1] ** 2 + T[b, 2] ** 2))
     out.steps[f] = taken
     out.settled[f] = 1 if settled else 0
-    out.nodes[f] = nodes
-
-
-@njit(cache=True, error_model="numpy", parallel=True)
-def run_batch(bod, grids, law, fib, mem, st, stiffness, frames, out):
-    """`run` for many designs: `Stiffness` and `Outputs` arrays with a leading design axis."""
-    for i in prange(stiffness.f_l0.shape[0]):
-        design = Stiffness(
-            stiffness.f_l0[i], stiffness.f_K[i], stiffness.m_l0[i], stiffness.m_K[i], stiffness.node_mass[i]
-        )
-        filled = Outputs(
-            out.poses[i],
-            out.contact[i],
-            out.bundle[i],
-            out.energy[i],
-            out.residual[i],
-            out.steps[i],
-            out.settled[i],
-            out.nodes[i],
-            out.status[i],
-        )
-        run(bod, grids, law, fib, mem, st, design, frames, filled)
+    copy_into(out.nodes[f], nodes)

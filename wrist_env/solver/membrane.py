@@ -112,7 +112,7 @@ def connector_forces(mem, nodes, l0, K, force, want_energy):
 
 
 @njit(cache=True, error_model="numpy")
-def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node_force, want_energy=True, smooth=False):
+def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node_force, want_energy, smooth):
     """RSC membrane: connector tension and node–scaphoid contact.
 
     nodes (M, 3): world positions (attached nodes already placed on their bones).
@@ -164,7 +164,7 @@ def _substep_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, gap, trave
     """force (M, 3) N ← connector tensions and the scaphoid's contact, looked up only on the free nodes that
     may touch it (gap − √3·travel < 0: `LIPSCHITZ`), whose gap and travel then restart there."""
     force[:] = 0.0
-    connector_forces(mem, nodes, l0, K, force, False)
+    connector_forces(mem, nodes, l0, K, force, np.bool_(False))
     for i in range(nodes.shape[0]):
         if not gap[i] - LIPSCHITZ * travel[i] < 0.0:
             continue
@@ -178,7 +178,7 @@ def _substep_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, gap, trave
 
 
 @njit(cache=True, error_model="numpy")
-def substep(R, x, com0, mem, nodes, nv, l0, K, node_mass, st, scratch):
+def substep(R, x, com0, mem, nodes, nv, l0, K, node_mass, st, scratch, smooth):
     """Move the free nodes (M, 3) mm, velocities nv (M, 3) mm/s, through st.membrane_substeps steps of
     st.dt with the bones held; scratch: (2, M, 3) arrays (`new_scratch`)."""
     force = scratch[0]
@@ -187,9 +187,7 @@ def substep(R, x, com0, mem, nodes, nv, l0, K, node_mass, st, scratch):
     dt = st.dt
     lin = 1.0 / (1.0 + st.membrane_substep_damping * dt)
     for _ in range(st.membrane_substeps):
-        _substep_forces(
-            R, x, com0, mem, nodes, l0, K, st.membrane_contact_stiffness, gap, travel, force, st.smooth_normals
-        )
+        _substep_forces(R, x, com0, mem, nodes, l0, K, st.membrane_contact_stiffness, gap, travel, force, smooth)
         for i in range(nodes.shape[0]):
             if mem.bone[i] < 0:
                 step2 = 0.0

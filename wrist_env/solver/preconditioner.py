@@ -28,6 +28,7 @@ from numba import njit
 
 from wrist_env.model import CAPITATE, FREE, N_BODIES
 from wrist_env.solver.arrays import LOADED
+from wrist_env.solver.rigid import copy_into
 
 N_FREE_DOF = 6 * len(FREE)
 N_DOF = N_FREE_DOF + 3
@@ -61,7 +62,7 @@ def metric():
     )
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def dof(st, b):
     """(first unknown, number of unknowns) of body b; (-1, 0) if it is not free or b < 0 (a membrane's
     free node: `add_point`'s convention; a negative index would read the last body's entry)."""
@@ -108,7 +109,7 @@ def _spd_inverse(A, i0, n, out):
     return True
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _matvec(A, lo, hi, v, out):
     """out ← A[lo:hi, lo:hi] v."""
     for i in range(hi - lo):
@@ -130,15 +131,22 @@ def _top(K, M, Minv, lo, hi):
     for _ in range(POWER_ITERATIONS):
         _matvec(K, lo, hi, v, Kv)
         _matvec(M, lo, hi, v, Mv)
-        vMv = v @ Mv
+        vMv = vKv = 0.0
+        for i in range(n):
+            vMv += v[i] * Mv[i]
+            vKv += v[i] * Kv[i]
         if not vMv > 0.0:
             return 0.0
-        top = (v @ Kv) / vMv
+        top = vKv / vMv
         _matvec(Minv, lo, hi, Kv, v)
-        norm = np.sqrt(v @ v)
+        norm = 0.0
+        for i in range(n):
+            norm += v[i] * v[i]
+        norm = np.sqrt(norm)
         if norm == 0.0:
             return 0.0
-        v /= norm
+        for i in range(n):
+            v[i] /= norm
     return top
 
 
@@ -198,8 +206,8 @@ def block_mass(R, bod, st, m):
         if not _spd_inverse(D, i0, nb, Dinv):
             ok = False
     if not ok:  # no stiffness (or a block not positive definite): the physical mass
-        D[:] = M0
-        Dinv[:] = M0inv
+        copy_into(D, M0)
+        copy_into(Dinv, M0inv)
         return
     scale = _top(K, D, Dinv, 0, n) * (st.dt / st.block_courant) ** 2
     if not scale > 0.0:

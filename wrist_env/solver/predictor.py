@@ -19,7 +19,7 @@ from numba import njit
 
 from wrist_env.model import CAPITATE, FREE
 from wrist_env.solver.arrays import LOADED
-from wrist_env.solver.rigid import LEVER_MM, matrix_to_rotvec, rotate_in_place
+from wrist_env.solver.rigid import LEVER_MM, copy_into, rotate_in_place, rotvec_between
 
 MAX_RATIO = 2.0
 """The most the last frame's change is extrapolated by (a frame whose capitate moves more than twice the
@@ -53,13 +53,13 @@ def capitate_move(axis, shift):
 @njit(cache=True, error_model="numpy")
 def record(h, R, x, nodes, move):
     """Store the equilibrium (R, x, nodes) reached by a stage whose capitate moved `move` (mm)."""
-    h.rotation[0] = h.rotation[1]
-    h.centre[0] = h.centre[1]
-    h.nodes[0] = h.nodes[1]
+    copy_into(h.rotation[0], h.rotation[1])
+    copy_into(h.centre[0], h.centre[1])
+    copy_into(h.nodes[0], h.nodes[1])
     h.move[0] = h.move[1]
-    h.rotation[1] = R
-    h.centre[1] = x
-    h.nodes[1] = nodes
+    copy_into(h.rotation[1], R)
+    copy_into(h.centre[1], x)
+    copy_into(h.nodes[1], nodes)
     h.move[1] = move
     h.count[0] = min(h.count[0] + 1, 2)
 
@@ -73,8 +73,8 @@ def predict(h, R, x, v, w, nodes, nv, mem, st, move):
         return False
     ratio = min(move / h.move[1], MAX_RATIO)
     for b in FREE:
-        turn = matrix_to_rotvec(h.rotation[1, b] @ h.rotation[0, b].T)
-        R[b] = h.rotation[1, b]
+        turn = rotvec_between(h.rotation[1, b], h.rotation[0, b])
+        copy_into(R[b], h.rotation[1, b])
         rotate_in_place(R[b], ratio * turn[0], ratio * turn[1], ratio * turn[2])
         for k in range(3):
             x[b, k] = h.centre[1, b, k] + ratio * (h.centre[1, b, k] - h.centre[0, b, k])

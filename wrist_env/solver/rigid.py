@@ -25,35 +25,58 @@ def pose_translation(R: np.ndarray, x: np.ndarray, com0: np.ndarray) -> np.ndarr
 @njit(cache=True, error_model="numpy")
 def matrix_to_rotvec(R):
     """Rotation vector (3,), radians, of a rotation matrix (3, 3)."""
+    out = np.empty(3)
     c = (R[0, 0] + R[1, 1] + R[2, 2] - 1.0) * 0.5
     c = min(1.0, max(-1.0, c))
     theta = np.arccos(c)
-    v = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
-    s = np.sin(theta)
-    if theta < 1e-8:
-        return 0.5 * v
     if np.pi - theta < 1e-6:
-        # near pi: axis from the symmetric part
-        B = 0.5 * (R + np.eye(3))
-        i = np.argmax(np.array([B[0, 0], B[1, 1], B[2, 2]]))
-        axis = B[:, i] / np.sqrt(max(B[i, i], 1e-300))
-        return axis * theta
-    return v * (theta / (2.0 * s))
+        # near pi: the axis is the largest column of the symmetric part (R + I) / 2
+        i = 0
+        for k in range(1, 3):
+            if R[k, k] > R[i, i]:
+                i = k
+        scale = theta / np.sqrt(max(0.5 * (R[i, i] + 1.0), 1e-300))
+        for k in range(3):
+            out[k] = 0.5 * (R[k, i] + (1.0 if k == i else 0.0)) * scale
+        return out
+    scale = 0.5 if theta < 1e-8 else theta / (2.0 * np.sin(theta))
+    out[0] = (R[2, 1] - R[1, 2]) * scale
+    out[1] = (R[0, 2] - R[2, 0]) * scale
+    out[2] = (R[1, 0] - R[0, 1]) * scale
+    return out
+
+
+@njit(cache=True, error_model="numpy")
+def rotvec_between(A, B):
+    """Rotation vector (3,), radians, of A Bᵀ (rotations (3, 3)): B's turn to A."""
+    C = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            C[i, j] = A[i, 0] * B[j, 0] + A[i, 1] * B[j, 1] + A[i, 2] * B[j, 2]
+    return matrix_to_rotvec(C)
 
 
 @njit(cache=True, error_model="numpy")
 def orthonormalize(R):
-    """Nearest rotation to R by Gram–Schmidt on its columns (R is (3, 3))."""
-    x = R[:, 0] / np.linalg.norm(R[:, 0])
-    column = np.ascontiguousarray(R[:, 1])  # np.dot of a strided column warns (NumbaPerformanceWarning)
-    y = column - np.dot(x, column) * x
-    y = y / np.linalg.norm(y)
-    z = np.cross(x, y)
-    out = np.empty((3, 3))
-    out[:, 0] = x
-    out[:, 1] = y
-    out[:, 2] = z
-    return out
+    """R (3, 3) ← the nearest rotation by Gram–Schmidt on its columns, in place."""
+    n = np.sqrt(R[0, 0] ** 2 + R[1, 0] ** 2 + R[2, 0] ** 2)
+    x0, x1, x2 = R[0, 0] / n, R[1, 0] / n, R[2, 0] / n
+    d = x0 * R[0, 1] + x1 * R[1, 1] + x2 * R[2, 1]
+    y0, y1, y2 = R[0, 1] - d * x0, R[1, 1] - d * x1, R[2, 1] - d * x2
+    n = np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
+    y0, y1, y2 = y0 / n, y1 / n, y2 / n
+    R[0, 0], R[1, 0], R[2, 0] = x0, x1, x2
+    R[0, 1], R[1, 1], R[2, 1] = y0, y1, y2
+    R[0, 2], R[1, 2], R[2, 2] = x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0
+
+
+@njit(cache=True, error_model="numpy")
+def copy_into(dst, src):
+    """dst ← src for C-contiguous arrays of one size, element by element (an array assignment makes
+    Numba compile its broadcasting checks and their messages: seconds of a cold start each)."""
+    d, s = dst.reshape(-1), src.reshape(-1)
+    for i in range(d.shape[0]):
+        d[i] = s[i]
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -87,7 +110,9 @@ def rotate_in_place(R, wx, wy, wz):
 def interpolate_pose(R0, t0, axis, R, t, s):
     """Pose a fraction s in [0, 1] from (R0, t0) along the rotation vector `axis` = log(R1 R0ᵀ)
     and to t0 + `t` (mm): written into R (3, 3); returns the translation as a tuple."""
-    R[:, :] = R0
+    for i in range(3):
+        for j in range(3):
+            R[i, j] = R0[i, j]
     rotate_in_place(R, s * axis[0], s * axis[1], s * axis[2])
     return t0[0] + s * t[0], t0[1] + s * t[1], t0[2] + s * t[2]
 

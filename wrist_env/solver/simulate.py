@@ -5,16 +5,17 @@ kernel → a `Result`), and its batched form. The drivers are `drivers`'.
 from __future__ import annotations
 
 from collections.abc import Iterable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numba
 import numpy as np
 
-from wrist_env.design import ALL_LIGAMENT_NAMES, Design
+from wrist_env.design import ALL_LIGAMENT_NAMES, Design, population
 from wrist_env.model import N_BODIES, PAIRS, Model
 from wrist_env.solver import arrays, kernel
-from wrist_env.solver.drivers import Driver
+from wrist_env.solver.drivers import Driver, static
 from wrist_env.solver.rigid import pose_state
 
 if TYPE_CHECKING:
@@ -149,8 +150,17 @@ def simulate(
     prepared: `prepare(model, settings, driver.mode)`, to skip rebuilding the kernel arrays."""
     p = _prepared(model, settings, driver, prepared)
     out = _outputs(0, len(driver.rotation), len(model.membrane_nodes))
-    kernel.run(*p.system, stiffness(p, design), _frames(driver), out)
+    _run(p, stiffness(p, design), _frames(driver), out)
     return _result(out, driver, int(out.status[0]))
+
+
+def _run(p: Prepared, design: kernel.Stiffness, frames: kernel.Frames, out: kernel.Outputs) -> None:
+    """`kernel.run` of one design from rest (rotations identity, bones and membrane nodes at their
+    neutral places), filling `out`."""
+    R = np.repeat(np.eye(3)[None], N_BODIES, axis=0)
+    kernel.entry(p.settings)(
+        *p.system, design, frames, out, R, p.bodies.com0.copy(), p.membrane.rest.copy(), kernel.SETTLE
+    )
 
 
 def simulate_frame(
@@ -181,7 +191,8 @@ def simulate_frame(
     R, x = pose_state(poses, model.com)
     out = _outputs(0, 2, len(model.membrane_nodes))
     frames = _frames(two)
-    kernel.run_from(*p.system, stiffness(p, design), frames, out, R, x, np.ascontiguousarray(nodes, dtype=np.float64))
+    nodes = np.array(nodes, dtype=np.float64)  # a copy: the kernel moves it
+    kernel.entry(p.settings)(*p.system, stiffness(p, design), frames, out, R.copy(), x.copy(), nodes, 1)
     return _result(out, two, int(out.status[0]))
 
 
@@ -193,17 +204,21 @@ def simulate_batch(
     *,
     prepared: Prepared | None = None,
 ) -> list[Result]:
-    """Simulate many designs in parallel (Numba prange); same results as one at a time."""
+    """Simulate many designs in parallel, on `numba.get_num_threads()` threads (the kernel releases the
+    GIL), handed out one at a time (designs differ in cost); same results as one at a time."""
     p = _prepared(model, settings, driver, prepared)
     per = [stiffness(p, d) for d in designs]
-    stacked = kernel.Stiffness(*(np.ascontiguousarray(np.stack(a)) for a in zip(*per)))
+    frames = _frames(driver)
     out = _outputs(len(per), len(driver.rotation), len(model.membrane_nodes))
-    previous = numba.set_parallel_chunksize(1)  # designs differ in cost: hand them out one at a time
-    try:
-        kernel.run_batch(*p.system, stacked, _frames(driver), out)  # the System flat: see `kernel.run`
-    finally:
-        numba.set_parallel_chunksize(previous)
-    return [_result(kernel.Outputs(*(o[i] for o in out)), driver, int(out.status[i, 0])) for i in range(len(per))]
+    mine = [kernel.Outputs(*(o[i] for o in out)) for i in range(len(per))]
+    threads = min(numba.get_num_threads(), len(per))
+    if threads <= 1:
+        for design, filled in zip(per, mine):
+            _run(p, design, frames, filled)
+    else:
+        with ThreadPoolExecutor(threads) as pool:
+            list(pool.map(lambda i: _run(p, per[i], frames, mine[i]), range(len(per))))
+    return [_result(filled, driver, int(filled.status[0])) for filled in mine]
 
 
 def _frames(driver: Driver) -> kernel.Frames:
@@ -230,3 +245,13 @@ def _result(out: kernel.Outputs, driver: Driver, status: int) -> Result:
         status,
         STATUS[status],
     )
+
+
+def warm(settings: arrays.SolverSettings | None = None) -> None:
+    """Compile (or load from Numba's cache) the kernel entry point for `settings` (default
+    `SolverSettings()`) by simulating built-in P1 held at neutral for one frame: called before local
+    worker processes start, so that they load the compiled kernel instead of each compiling it."""
+    from wrist_env.participants.registry import load_model  # the registry builds on the solver
+
+    model = load_model("P1")
+    simulate(model, population(), static(model, 1), settings)

@@ -18,9 +18,17 @@ def displacement(R, x, com0, b):
     """How far (mm) free body b has moved from its place: the proximal row's (scaphoid, lunate) from its
     neutral place on the radius; the radial column's from where the capitate carries it (the distal
     row moves as one, Akhbari 2019; at ±40° the capitate carries the column's centre 15–18 mm)."""
-    if b == TRAPEZIUM:
-        return np.linalg.norm(x[b] - x[CAPITATE] - R[CAPITATE] @ (com0[b] - com0[CAPITATE]))
-    return np.linalg.norm(x[b] - com0[b])
+    d2 = 0.0
+    for i in range(3):
+        if b == TRAPEZIUM:
+            carried = 0.0
+            for j in range(3):
+                carried += R[CAPITATE, i, j] * (com0[b, j] - com0[CAPITATE, j])
+            d = x[b, i] - x[CAPITATE, i] - carried
+        else:
+            d = x[b, i] - com0[b, i]
+        d2 += d * d
+    return np.sqrt(d2)
 
 
 @njit(cache=True, error_model="numpy")

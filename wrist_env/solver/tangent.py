@@ -20,7 +20,7 @@ from wrist_env.solver.ligaments import blankevoort_force, blankevoort_slope
 from wrist_env.solver.preconditioner import dof
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _cross(r, p, q):
     """[r]× entry (p, q)."""
     if p == q:
@@ -32,7 +32,7 @@ def _cross(r, p, q):
     return -r[1] if q == 0 else r[0]
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _lever(G, r):
     """G (6, 3) ← [I; [r]×]: a force at lever r (mm) as the force and moment on a body."""
     G[:] = 0.0
@@ -72,7 +72,7 @@ def add_point(K, st, a, ra, b, rb, m):
         _add_block(K, ib, nb, G[1], k, ia, na, G[0], H, -1.0)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _axial(k, ux, uy, uz, along, across):
     """k ← along·uuᵀ + across·(I − uuᵀ) (N/mm)."""
     u = (ux, uy, uz)
@@ -81,7 +81,7 @@ def _axial(k, ux, uy, uz, along, across):
             k[p, q] = (along - across) * u[p] * u[q] + (across if p == q else 0.0)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _product6(A, B, transposed):
     """A B (6×6), or A Bᵀ if `transposed` (explicit loops: a BLAS call costs more than the work)."""
     out = np.zeros((6, 6))
@@ -157,7 +157,7 @@ def _pair_sums(grids, b, M, samples, law, com0, S, J, smooth):
 
 
 @njit(cache=True, error_model="numpy")
-def tangent(R, x, nodes, system, stiffness, active, n_active, m):
+def tangent(R, x, nodes, system, stiffness, active, n_active, m, smooth):
     """Assemble m.stiffness, the Gauss–Newton tangent of `system` (`arrays.System`) under a design's
     `stiffness` at the state (R, x, nodes) over the active contact samples (as the last force evaluation
     left them)."""
@@ -172,10 +172,7 @@ def tangent(R, x, nodes, system, stiffness, active, n_active, m):
             continue
         M = pair_transform(R, x, com0, a, b)
         start = grids.sample_offsets[p]
-        if st.smooth_normals:  # the flag as a constant: one compiled loop each (see `kernel._contact`)
-            _pair_sums(grids, b, M, active[start : start + n_active[p]], law, com0, S, J, True)
-        else:
-            _pair_sums(grids, b, M, active[start : start + n_active[p]], law, com0, S, J, False)
+        _pair_sums(grids, b, M, active[start : start + n_active[p]], law, com0, S, J, smooth)
         for u in range(6):
             for v in range(u):
                 S[u, v] = S[v, u]
@@ -201,7 +198,7 @@ def tangent(R, x, nodes, system, stiffness, active, n_active, m):
     _membrane_contact(K, st, m, R, x, com0, mem, nodes, ra, rb)
 
 
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(cache=True, error_model="numpy")
 def _element(K, st, m, a, pa, b, pb, x, scale, l0, ra, rb):
     """A Blankevoort element of scale `scale` (N) and zero-load length l0 (mm) between world points pa on
     body a and pb on body b (a body < 0: a membrane's free node, not an unknown); nothing if slack."""
