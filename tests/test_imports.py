@@ -50,3 +50,31 @@ def test_no_library_module_chooses_a_matplotlib_backend():
         if isinstance(node, ast.Call) and ast.unparse(node.func) in choosers
     ]
     assert not calls, calls
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["no-such-command"]])
+def test_the_command_line_answers_without_importing_a_command(argv):
+    """`wrist-bench --help` and an unknown command load no command's module, no solver and no builder
+    (each command's module is imported when that command is named: `wrist_env.cli.COMMANDS`)."""
+    code = (
+        "import sys\nfrom wrist_env.cli import main\ntry:\n    main(%r)\nexcept SystemExit:\n    pass\n"
+        "print('loaded:', *(m for m in sys.modules if m.startswith('wrist_env.cli.') or m in %r))"
+    ) % (argv, HEAVY)
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.stdout.strip().splitlines()[-1] == "loaded:", done.stdout[-2000:]
+
+
+def test_every_command_is_declared_by_the_module_the_table_names():
+    """`cli.COMMANDS` names, for each command, the module whose `add_commands` declares it (and no
+    module declares a command the table lacks)."""
+    import argparse
+    from importlib import import_module
+
+    from wrist_env.cli import COMMANDS
+
+    for module in sorted({m for m, _ in COMMANDS.values()}):
+        declared = []
+        import_module(f"wrist_env.cli.{module}").add_commands(
+            lambda name, folders_option=True, **kw: declared.append(name) or argparse.ArgumentParser()
+        )
+        assert sorted(declared) == sorted(n for n, (m, _) in COMMANDS.items() if m == module), module
