@@ -10,13 +10,14 @@ The free bones' masses are their (scaled) physical ones or, with
 `Settings.block_mass`, one block each from the tangent stiffness
 (`preconditioner`): the answer is the same equilibrium, reached in fewer steps.
 
-Read `run`: per stage (settle, move, each frame) it stages the capitate's targets
+Read `run` → `_run`: per stage (settle, move, each frame) it stages the capitate's targets
 (`_stage`, or the secant predictor's state: `_predicted`), holds (`_ramp_and_hold`, which calls
-`_step`, which calls `net_forces`), checks (`_failure`) and records the frame (`_record`); those
-three are inlined into `run` (each separately compiled layer over the force kernels cost its own
-link and optimization of their code: +25 s of a cold compile). Every kernel reads the model through
-one `arrays.System` and a design through one `Stiffness`; the one entry point, `run`, takes the
-System flat, as it takes `Frames`.
+`_step`, which calls `net_forces`), checks (`_failure`) and records the frame (`_record`). `_run`
+and those it calls once per stage or step are inlined into the entry point: each separately
+compiled layer over the force kernels made Numba optimize and emit their code once more (issue 52;
+`experiments/benchmarks/bench_cold_start.py` times a cold first simulation). The entry points
+(`run`, and `entry(settings)` for the other three) take the model's `arrays.System` flat, as they
+take `Frames`; every kernel below reads it as one System and a design as one `Stiffness`.
 """
 
 from __future__ import annotations
