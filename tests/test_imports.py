@@ -78,3 +78,13 @@ def test_every_command_is_declared_by_the_module_the_table_names():
             lambda name, folders_option=True, **kw: declared.append(name) or argparse.ArgumentParser()
         )
         assert sorted(declared) == sorted(n for n, (m, _) in COMMANDS.items() if m == module), module
+
+
+def test_a_shipped_model_loads_without_the_builder():
+    """`registry.load_model` of a built-in participant reads its shipped model (or the cache) without
+    importing the builder (scikit-learn, the morph): the builder only on a cache miss."""
+    loaded = _run(
+        "import sys\nfrom wrist_env.participants.registry import load_model\nload_model('P1')\n"
+        "print(' '.join(m for m in ('wrist_env.builder.pipeline', 'sklearn') if m in sys.modules))"
+    )
+    assert loaded == "", loaded

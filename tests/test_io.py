@@ -99,7 +99,7 @@ def test_the_registry_rebuilds_a_damaged_cached_model_and_says_which(built, mode
         rebuilt.append(name)
         return model
 
-    monkeypatch.setattr(registry, "build_model", fake_build)
+    monkeypatch.setattr("wrist_env.builder.pipeline.build_model", fake_build)
     model.save(entry)
     assert registry.load_model("P1") is not model and not rebuilt  # read back from the cache
     entry.with_suffix(".npz").write_bytes(b"")

@@ -112,7 +112,7 @@ def test_load_model_uses_the_cache(built, tmp_path, monkeypatch):
     monkeypatch.setenv("WRIST_ENV_CACHE", str(tmp_path))
     monkeypatch.setattr(builtin, "shipped_source_hash", lambda name: None)
     builds = []
-    monkeypatch.setattr(registry, "build_model", lambda name, *a, **k: builds.append(name) or model)
+    monkeypatch.setattr("wrist_env.builder.pipeline.build_model", lambda name, *a, **k: builds.append(name) or model)
     assert registry.load_model("P1") is model and builds == ["P1"]
     assert [p.name for p in tmp_path.iterdir() if p.suffix == ".npz"] == [f"P1-{model.source_hash}.npz"]
     again = registry.load_model("P1")

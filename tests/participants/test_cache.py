@@ -12,7 +12,9 @@ from wrist_env.participants import builtin, registry
 def must_build(monkeypatch):
     """P1 with no shipped model to read: load_model would build (the stand-in build fails the test)."""
     monkeypatch.setattr(builtin, "shipped_source_hash", lambda name: None)
-    monkeypatch.setattr(registry, "build_model", lambda *a, **k: pytest.fail("built before the cache was checked"))
+    monkeypatch.setattr(
+        "wrist_env.builder.pipeline.build_model", lambda *a, **k: pytest.fail("built before the cache was checked")
+    )
 
 
 def test_a_cache_that_is_a_file_is_named_before_the_build(must_build, monkeypatch, tmp_path):
@@ -36,7 +38,7 @@ def test_a_model_built_but_not_cached_is_still_returned(monkeypatch, tmp_path):
             raise PermissionError(13, "Permission denied", str(path))
 
     monkeypatch.setattr(builtin, "shipped_source_hash", lambda name: None)
-    monkeypatch.setattr(registry, "build_model", lambda *a, **k: Built())
+    monkeypatch.setattr("wrist_env.builder.pipeline.build_model", lambda *a, **k: Built())
     monkeypatch.setenv("WRIST_ENV_CACHE", str(tmp_path))
     with pytest.warns(UserWarning, match="could not be cached.*Permission denied"):
         assert isinstance(registry.load_model("P1"), Built)

@@ -111,7 +111,7 @@ def test_a_fresh_install_reads_the_shipped_builtin_model(tmp_path, monkeypatch):
     def no_build(*args, **kwargs):
         raise AssertionError("built instead of reading the shipped model")
 
-    monkeypatch.setattr(registry, "build_model", no_build)
+    monkeypatch.setattr("wrist_env.builder.pipeline.build_model", no_build)
     for name in builtin.BUILTIN:
         model = registry.load_model(name)
         assert model.name == name and model.source_hash == builtin.shipped_source_hash(name)

@@ -7,11 +7,8 @@ membrane → contact law → signed-distance grids and contact samples → mass.
 
 from __future__ import annotations
 
-import hashlib
-import json
 import os
 import time
-from dataclasses import asdict
 
 import numpy as np
 import trimesh
@@ -22,13 +19,13 @@ from wrist_env.anatomy.annotations import read_annotation_data, template_annotat
 from wrist_env.anatomy.template import closed, load_template
 from wrist_env.builder import cartilage, contact_law, fibres, mass, morph, sdf
 from wrist_env.builder.contact_samples import _contact_samples, _seat_samples
+from wrist_env.builder.digest import source_hash
 from wrist_env.builder.params import BuildParams
 from wrist_env.builder.surface import displaced_vertices, extrusion_directions, gap_to, grnn_smooth
 from wrist_env.design import ALL_LIGAMENTS, COLUMN_LIGAMENTS, LIGAMENT_NAMES, LIGAMENTS, RSC_INDEX
 from wrist_env.errors import BuildError
 from wrist_env.model import BONES, PAIRS, Model, offsets
 
-BUILDER_VERSION = 6  # 6: the TFCC (the ulna's head closed and gridded, the ulnocarpal pair); 5: the radial column a body of its own (trapezium + trapezoid), its STT and trapeziocapitate contacts and ligaments; 2: distal row and triquetrum as body parts, swept fossae; 3: both by default, TC and TH; 4: the distal row seated (anatomy.midcarpal)
 BUILD_STEPS = ("morph", "cartilage", "ligaments", "contact_law", "grids", "mass")  # timed in the report
 GRID_BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate")
 TFCC = "ulnocarpal"
@@ -44,19 +41,6 @@ built-in P1–P3 1.5–2.5 mm. The bounds leave room for variation and disease: 
 fits; a scapholunate gap over 3–4 mm is a dissociation, so that one may reach 8 mm. Outside them the
 bones do not sit as the template's do: right-hand meshes declared left measured 13–16 mm in three or
 four articulations (issue 11)."""
-
-
-def source_hash(name: str, bones: dict, params: BuildParams) -> str:
-    """Hash of everything a build depends on: bones, parameters, builder and annotation versions."""
-    h = hashlib.sha256()
-    h.update(json.dumps({"name": name, "params": asdict(params), "builder": BUILDER_VERSION}, sort_keys=True).encode())
-
-    h.update(json.dumps(read_annotation_data(), sort_keys=True).encode())
-    for bone in BONES:
-        h.update(np.ascontiguousarray(np.round(bones[bone].vertices, 6)).tobytes())
-        h.update(np.ascontiguousarray(bones[bone].faces).tobytes())
-        h.update(np.ascontiguousarray(bones[bone].part).tobytes())
-    return h.hexdigest()[:16]
 
 
 def _morph_one(args):

@@ -13,8 +13,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from wrist_env.anatomy.template import BoneSurface, carry_parts, load_template
+from wrist_env.builder.digest import source_hash
 from wrist_env.builder.params import BuildParams
-from wrist_env.builder.pipeline import build_model, source_hash
 from wrist_env.errors import BuildError, ParticipantError, StoreError
 from wrist_env.model import BONES, Model
 from wrist_env.participants import builtin
@@ -141,6 +141,8 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
             warnings.warn(f"building instead of reading a damaged shipped model: {e}", stacklevel=2)
     if cache:
         check_cache(path)  # before a build of minutes, not after
+    from wrist_env.builder.pipeline import build_model  # the builder (scikit-learn, libigl) only on a cache miss
+
     try:
         model = build_model(name, b, params, digest=digest)
     except BuildError as e:
