@@ -192,7 +192,7 @@ def simulate_frame(
     out = _outputs(0, 2, len(model.membrane_nodes))
     frames = _frames(two)
     nodes = np.array(nodes, dtype=np.float64)  # a copy: the kernel moves it
-    kernel.entry(p.settings)(*p.system, stiffness(p, design), frames, out, R.copy(), x.copy(), nodes, 1)
+    kernel.entry(p.settings)(*p.system, stiffness(p, design), frames, out, R, x, nodes, 1)  # pose_state's own arrays
     return _result(out, two, int(out.status[0]))
 
 
@@ -211,13 +211,8 @@ def simulate_batch(
     frames = _frames(driver)
     out = _outputs(len(per), len(driver.rotation), len(model.membrane_nodes))
     mine = [kernel.Outputs(*(o[i] for o in out)) for i in range(len(per))]
-    threads = min(numba.get_num_threads(), len(per))
-    if threads <= 1:
-        for design, filled in zip(per, mine):
-            _run(p, design, frames, filled)
-    else:
-        with ThreadPoolExecutor(threads) as pool:
-            list(pool.map(lambda i: _run(p, per[i], frames, mine[i]), range(len(per))))
+    with ThreadPoolExecutor(max(1, min(numba.get_num_threads(), len(per)))) as pool:
+        list(pool.map(lambda i: _run(p, per[i], frames, mine[i]), range(len(per))))
     return [_result(filled, driver, int(filled.status[0])) for filled in mine]
 
 
