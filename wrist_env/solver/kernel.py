@@ -164,12 +164,12 @@ def _predicted(state, work, system, stiffness, hist, capR, capx, load, move, smo
     copy_into(R[CAPITATE], capR)
     if st.driver == EXPERIMENTAL:
         copy_into(x[CAPITATE], capx)
-    net_forces(state, work, system, stiffness, load, np.bool_(True), np.bool_(False), smooth)
+    net_forces(state, work, system, stiffness, load, np.bool_(False), np.bool_(False), smooth)
     before = residual(work.F, work.T, st)
     if not predict(hist, R, x, v, w, nodes, nv, mem, st, move):
         _restore(R, x, nodes, keep_R, keep_x, keep_nodes)
         return False
-    net_forces(state, work, system, stiffness, load, np.bool_(True), np.bool_(False), smooth)
+    net_forces(state, work, system, stiffness, load, np.bool_(False), np.bool_(False), smooth)
     if residual(work.F, work.T, st) < before:
         return True
     _restore(R, x, nodes, keep_R, keep_x, keep_nodes)
@@ -453,7 +453,7 @@ def _record(f, state, work, system, stiffness, load, m, out, taken, settled, smo
     R, x, v, w, nodes, nv = state
     F, T, stats = work.F, work.T, work.stats
     com0 = bod.com0
-    energy = net_forces(state, work, system, stiffness, load, np.bool_(True), np.bool_(True), smooth)
+    energy = net_forces(state, work, system, stiffness, load, np.bool_(False), np.bool_(True), smooth)
     poses = out.poses
     for b in range(N_BONES):
         for i in range(3):
