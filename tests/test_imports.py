@@ -9,14 +9,18 @@ from pathlib import Path
 
 import pytest
 
+from wrist_env.cli import COMMANDS
+
 HEAVY = (
     "gymnasium",
     "wrist_env.builder.pipeline",
     "trimesh",
     "igl",
     "numba",
-    "scipy.optimize",
-    "scipy.spatial",
+    "scipy",
+    "pandas",
+    "pyarrow",
+    "sklearn",
     "matplotlib",
 )
 
@@ -78,6 +82,36 @@ def test_every_command_is_declared_by_the_module_the_table_names():
             lambda name, folders_option=True, **kw: declared.append(name) or argparse.ArgumentParser()
         )
         assert sorted(declared) == sorted(n for n, (m, _) in COMMANDS.items() if m == module), module
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_a_commands_help_and_usage_errors_load_nothing_it_runs(command):
+    """`wrist-bench <command> --help` exits 0 and `wrist-bench <command> --no-such-option` exits 2 having
+    imported none of `HEAVY` and no module of `wrist_env.cli.run`: a command's declaring module imports only
+    light ones, and `main` imports its run module once the arguments have parsed (issue 52)."""
+    code = (
+        "import sys\nfrom wrist_env.cli import main\nfor option in ('--help', '--no-such-option'):\n"
+        "    try:\n        main([%r, option])\n    except SystemExit as exit:\n        print('status:', exit.code)\n"
+        "print('loaded:', *(m for m in sys.modules if m.startswith('wrist_env.cli.run') or m in %r))"
+    ) % (command, HEAVY)
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    lines = done.stdout.strip().splitlines()
+    assert [line for line in lines if line.startswith("status:")] == ["status: 0", "status: 2"], done.stderr[-2000:]
+    assert lines[-1] == "loaded:", lines[-1]
+
+
+def test_every_command_runs_a_function_of_a_run_module():
+    """Each command's `run` default names ("module:function") a function of `wrist_env.cli.run` that
+    `main` resolves after parsing."""
+    from pkgutil import resolve_name
+
+    from wrist_env.cli import parser
+
+    sub = next(a for a in parser()._actions if a.dest == "command")
+    assert sorted(sub.choices) == sorted(COMMANDS)
+    for name, command in sub.choices.items():
+        run = resolve_name(f"wrist_env.cli.run.{command.get_default('run')}")
+        assert callable(run) and run.__module__.startswith("wrist_env.cli.run."), name
 
 
 def test_a_shipped_model_loads_without_the_builder():

@@ -152,18 +152,19 @@ def test_builtins_move_like_a_wrist(name, built):
 
 
 def test_load_directions_are_the_clis_choices_and_unit_vectors():
-    """`validate --load-direction` offers exactly `drivers.LOAD_DIRECTIONS`; each is a set of lines of
+    """`validate --load-direction` offers exactly `settings.LOAD_DIRECTIONS`; each is a set of lines of
     unit pulls whose shares sum to 1 and whose resultant pulls proximally, the axial one a single line
     along the radius' axis on the capitate, and another name is refused by name."""
     from wrist_env.cli import parser
     from wrist_env.participants.registry import load_model
     from wrist_env.solver import drivers
+    from wrist_env.solver.settings import DEFAULT_LOADS, LOAD_DIRECTIONS
 
     validate = parser()._subparsers._group_actions[0].choices["validate"]
     option = next(a for a in validate._actions if "--load-direction" in a.option_strings)
-    assert tuple(option.choices) == drivers.LOAD_DIRECTIONS and option.default == drivers.DEFAULT_LOADS
+    assert tuple(option.choices) == LOAD_DIRECTIONS and option.default == DEFAULT_LOADS
     p1 = load_model("P1")
-    for name in drivers.LOAD_DIRECTIONS:
+    for name in LOAD_DIRECTIONS:
         lines = drivers.loads(p1, name)
         assert np.allclose(np.linalg.norm(lines.direction, axis=1), 1.0) and np.isclose(lines.share.sum(), 1.0)
         total = lines.share @ lines.direction
@@ -177,7 +178,7 @@ def test_load_directions_are_the_clis_choices_and_unit_vectors():
 def test_the_preconditioned_solver_validates_like_the_default(built):
     """Issue 32's bar: under `SolverSettings.preconditioned()` P1's slopes and ratios are within 0.01 of
     the default solver's (measured < 0.001 on P1–P3; the load shares to 0.001 points)."""
-    from wrist_env.solver.arrays import solver_settings
+    from wrist_env.solver.settings import solver_settings
 
     model = built("P1")
     reports = [

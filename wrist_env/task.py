@@ -18,12 +18,12 @@ from wrist_env import design as design_vars
 from wrist_env.cost import COST_BONES, CostReport, CostWeights, kinematic_cost
 from wrist_env.design import ALL_LIGAMENT_NAMES, Design
 from wrist_env.model import BONES, PAIRS, Model
+from wrist_env.motions import MOTIONS
 from wrist_env.participants import builtin, registry
-from wrist_env.solver.arrays import SolverSettings
-from wrist_env.solver.drivers import DEFAULT_LOADS, LOAD_DIRECTIONS, Driver, idealized, trial_driver
+from wrist_env.solver.drivers import Driver, idealized, trial_driver
 from wrist_env.solver.forces import CONTACT_FIELDS
+from wrist_env.solver.settings import DEFAULT_LOADS, LOAD_DIRECTIONS, SolverSettings
 from wrist_env.solver.simulate import Result, prepare, simulate, simulate_batch
-from wrist_env.trial import MOTIONS
 
 
 @dataclass(frozen=True)
@@ -63,7 +63,7 @@ class Task:
     """Participant × motion: "calibrate" (unresisted trial), "validate" (held-out resisted
     trial) or "idealized" (flexion–extension sweep; reference = the hidden truth's
     sweep for built-in participants, none for user participants → reward 0).
-    load_direction: the loads' lines (`drivers.LOAD_DIRECTIONS`, default `drivers.DEFAULT_LOADS`): the
+    load_direction: the loads' lines (`settings.LOAD_DIRECTIONS`, default `settings.DEFAULT_LOADS`): the
     sweep's, and in a trial the radial column's (the capitate is prescribed) at the trial's `load_n`."""
 
     def __init__(

@@ -21,12 +21,8 @@ from numpy.typing import ArrayLike
 from wrist_env.errors import TrialError
 from wrist_env.frames import validate_poses
 from wrist_env.model import BONES, CARPALS
+from wrist_env.motions import TRIAL_MOTIONS
 
-TRIAL_MOTIONS = ("calibrate", "validate")
-"""The two trials of a participant that calibration uses: the unresisted one it fits and the resisted one it
-is judged on."""
-MOTIONS = TRIAL_MOTIONS + ("idealized",)
-"""Every motion a task drives: the two trials and the idealized flexion–extension sweep."""
 ROLES = TRIAL_MOTIONS + ("other",)
 REQUIRED_BONES = CARPALS
 MATRIX_COLUMNS = tuple(f"m{r}{c}" for r in range(3) for c in range(4))

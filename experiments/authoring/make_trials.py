@@ -8,7 +8,7 @@ transforms per bone per frame (RCS, mm):
 
 1. the capitate's rotations follow the task (Cardan Z-X-Y angles below);
    its translations, and the radial column, are free under the tendon lines
-   (`drivers.DEFAULT_LOADS`) at a total of 10 N unresisted, 40 N resisted
+   (`settings.DEFAULT_LOADS`) at a total of 10 N unresisted, 40 N resisted
    (grip clenches from 10 N to 60 N / 120 N), the load each frame records;
 2. the scaphoid and lunate come from a higher-fidelity run of the model —
    finer contact sampling (0.7 mm instead of 1.0 mm), half the time step,
@@ -37,8 +37,8 @@ from wrist_env.frames import cardan_rotation
 from wrist_env.model import BONES
 from wrist_env.participants import builtin
 from wrist_env.participants.registry import load_model
-from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.drivers import loaded
+from wrist_env.solver.settings import SolverSettings
 from wrist_env.solver.simulate import simulate
 from wrist_env.trial import Trial, write_trial_csv
 

@@ -33,10 +33,10 @@ from wrist_env import design
 from wrist_env.participants import registry
 from wrist_env.participants.registry import load_model
 from wrist_env.solver import arrays
-from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.drivers import idealized, static, trial_driver
 from wrist_env.solver.forces import pair_transform, rebuild_active, sample_lookup, sample_lookup_smooth
 from wrist_env.solver.rigid import pose_state
+from wrist_env.solver.settings import SolverSettings
 from wrist_env.solver.simulate import simulate, simulate_batch
 
 PREPRINT_SECONDS = 45.0  # one Abaqus simulation

@@ -27,13 +27,13 @@ from numba import njit
 from wrist_env import design
 from wrist_env.participants import registry
 from wrist_env.solver import kernel
-from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.drivers import trial_driver
 from wrist_env.solver.forces import contact_forces, fibre_forces
 from wrist_env.solver.integrator import move_blocks, move_diagonal
 from wrist_env.solver.membrane import membrane_forces, new_scratch, substep
 from wrist_env.solver.preconditioner import block_mass, metric
 from wrist_env.solver.rigid import pose_state
+from wrist_env.solver.settings import SolverSettings
 from wrist_env.solver.simulate import prepare, simulate, stiffness
 from wrist_env.solver.tangent import tangent
 

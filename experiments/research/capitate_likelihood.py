@@ -2,7 +2,7 @@
 
 On the built-in trials the hidden truth fits worse than the MAP (`experiments/research/model_error.py`: the
 calibration model is driven by the trial's noisy capitate poses). This script measures, for P1–P3,
-the log posterior of the truth minus that of the MAP (the best of `map.MAP_STARTS` Gauss–Newton
+the log posterior of the truth minus that of the MAP (the best of `settings.MAP_STARTS` Gauss–Newton
 runs, seed 0) under:
 
 - jeffreys: the Bayesian calibrator's likelihood (`likelihood.log_likelihood`: Gaussian, the noise

@@ -25,6 +25,7 @@ from wrist_env.solver import drivers, kernel
 from wrist_env.solver import simulate as sim
 from wrist_env.solver.outputs import articulation_forces
 from wrist_env.solver.rigid import pose_state
+from wrist_env.solver.settings import LOAD_DIRECTIONS
 from wrist_env.validation import NEUTRAL_LOAD_N, load_shares_pct
 
 STEP_RAD = 0.02  # the finite-difference turn (1.1 deg)
@@ -63,7 +64,7 @@ def summary(model, result) -> str:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("participants", nargs="+")
-    parser.add_argument("--load-direction", default="erhart2020", choices=drivers.LOAD_DIRECTIONS)
+    parser.add_argument("--load-direction", default="erhart2020", choices=LOAD_DIRECTIONS)
     args = parser.parse_args()
     d = design.population()
     for name in args.participants:

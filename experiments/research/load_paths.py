@@ -7,7 +7,7 @@ the force and share of each articulation (`model.ARTICULATIONS`: the midcarpal s
 Viegas 1993, the ulnar share against Palmer & Werner 1984) as `wrist-bench validate` checks them,
 and the space a TFCC would fill (`ulnocarpal_space`).
 Run: `python experiments/research/load_paths.py P1 [P2 ...] [--load-direction erhart2020]` (the load along the
-radius by default, or the tendon rig's resultant: `drivers.LOAD_DIRECTIONS`).
+radius by default, or the tendon rig's resultant: `settings.LOAD_DIRECTIONS`).
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ from wrist_env.solver import drivers
 from wrist_env.solver import simulate as sim
 from wrist_env.solver.contact import OUTSIDE_MM, sdf_lookup
 from wrist_env.solver.outputs import articulation_forces, pair_slice, pressure_map, sample_parts
+from wrist_env.solver.settings import DEFAULT_LOADS, LOAD_DIRECTIONS
 from wrist_env.validation import NEUTRAL_LOAD_N, load_shares_pct
 
 
@@ -89,7 +90,7 @@ def ulnocarpal_space(model) -> dict:
     return out | {"ulnar_variance_mm": float(corner[1] - head[:, 1].min())}
 
 
-def main(names, load_direction: str = drivers.DEFAULT_LOADS) -> None:
+def main(names, load_direction: str = DEFAULT_LOADS) -> None:
     for name in names:
         model = load_model(name)
         driver = drivers.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=load_direction)
@@ -123,6 +124,6 @@ def main(names, load_direction: str = drivers.DEFAULT_LOADS) -> None:
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("participants", nargs="*", default=["P1"])
-    parser.add_argument("--load-direction", choices=drivers.LOAD_DIRECTIONS, default=drivers.DEFAULT_LOADS)
+    parser.add_argument("--load-direction", choices=LOAD_DIRECTIONS, default=DEFAULT_LOADS)
     args = parser.parse_args()
     main(args.participants, args.load_direction)

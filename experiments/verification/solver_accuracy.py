@@ -46,9 +46,9 @@ from bench_solver import monte_carlo_designs  # noqa: E402  (experiments/benchma
 from wrist_env import design
 from wrist_env.participants import registry
 from wrist_env.participants.registry import load_model
-from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.drivers import idealized, trial_driver
 from wrist_env.solver.equilibrium import distance, nearest
+from wrist_env.solver.settings import SolverSettings
 from wrist_env.solver.simulate import prepare, simulate_batch, simulate_frame
 
 CACHE = Path(__file__).resolve().parents[2] / "runs" / "solver_accuracy"  # the repository root's runs/, git-ignored

@@ -20,7 +20,7 @@ from scipy import stats
 
 from wrist_env import design
 from wrist_env.bench.calibrate import action
-from wrist_env.solver.arrays import SolverSettings
+from wrist_env.solver.settings import SolverSettings
 from wrist_env.task import Task
 
 LOGS = Path(__file__).resolve().parents[2] / "leaderboards" / "iohanalyzer"

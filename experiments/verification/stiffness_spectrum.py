@@ -28,10 +28,11 @@ from wrist_env.participants.registry import load_model
 from wrist_env.solver import arrays
 from wrist_env.solver.drivers import idealized, trial_driver
 from wrist_env.solver.equilibrium import block_mass, tangent_stiffness
+from wrist_env.solver.settings import SolverSettings
 from wrist_env.solver.simulate import prepare, simulate, stiffness
 
 
-def node_courant(model, dsg, driver, settings: arrays.SolverSettings) -> float:
+def node_courant(model, dsg, driver, settings: SolverSettings) -> float:
     """dt·ω of the membrane's stiffest free-node mode at the design's node mass (`arrays.node_mass`)."""
     p = prepare(model, settings, driver.mode)
     st = stiffness(p, dsg)
@@ -39,7 +40,7 @@ def node_courant(model, dsg, driver, settings: arrays.SolverSettings) -> float:
     return settings.dt_s * float(np.sqrt(stiffest / st.node_mass))
 
 
-def report(name: str, settings: arrays.SolverSettings) -> None:
+def report(name: str, settings: SolverSettings) -> None:
     model = load_model(name)
     dsg = design.population()
     motions = {
@@ -54,7 +55,7 @@ def report(name: str, settings: arrays.SolverSettings) -> None:
         for f in frames:
             tangent = tangent_stiffness(model, dsg, driver, result, f, settings)
             omega = tangent.frequencies()
-            blocks = block_mass(model, dsg, driver, result, f, arrays.SolverSettings().preconditioned())
+            blocks = block_mass(model, dsg, driver, result, f, SolverSettings().preconditioned())
             w2 = eigh(tangent.stiffness, blocks.mass, eigvals_only=True)
             block = np.sqrt(w2[w2 > 0.0])
             nodes = np.linalg.eigvalsh(tangent.membrane)
@@ -75,7 +76,7 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("participants", nargs="*", default=["P1", "P2", "P3"])
     args = parser.parse_args(argv)
-    settings = arrays.SolverSettings()
+    settings = SolverSettings()
     print(f"time step {settings.dt_s:g} s; explicit stability limit dt·ω = 2")
     for name in args.participants:
         report(name, settings)

@@ -10,7 +10,7 @@ from wrist_env import design
 from wrist_env.envs.wrappers import FreezeVariables
 from wrist_env.model import TRAPEZIUM
 from wrist_env.participants import builtin
-from wrist_env.solver.drivers import DEFAULT_LOADS
+from wrist_env.solver.settings import DEFAULT_LOADS
 from wrist_env.task import task
 
 IDS = wrist_env.registered_ids()

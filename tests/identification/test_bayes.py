@@ -13,7 +13,7 @@ from wrist_env.errors import InputError
 from wrist_env.identification import bayes, mcmc, posterior, smc
 from wrist_env.identification import map as map_
 from wrist_env.identification import study as study_
-from wrist_env.identification.settings import SamplerSettings
+from wrist_env.identification.settings import MAP_STARTS, MCMC_STEPS, PRIOR_REFRESH, STEPS, SamplerSettings
 from wrist_env.participants.registry import load_model
 
 
@@ -112,7 +112,7 @@ def test_the_command_samples_p1_and_writes_coverage_and_figures(built, tmp_path,
     post = posterior.Posterior.load(tmp_path / "posterior_P1_seed0.npz")
     assert post.samples.shape == (4 * 48, design.N_MATERIAL) and post.predictive.shape[:3] == (2, 3, 2)
     assert json.loads((tmp_path / "posterior_P1_seed0.json").read_text())["fields"]["evaluations"] == post.evaluations
-    assert post.settings == {"walkers": 48, "steps": 8, "map_starts": 2, "prior_refresh": mcmc.PRIOR_REFRESH}
+    assert post.settings == {"walkers": 48, "steps": 8, "map_starts": 2, "prior_refresh": PRIOR_REFRESH}
     capsys.readouterr()
     assert main(args) == 0
     assert "loaded" in capsys.readouterr().out
@@ -317,8 +317,8 @@ def test_sampler_settings_refuse_values_out_of_range(field, value):
 
 def test_sampler_settings_are_frozen_and_record_what_shapes_a_run():
     emcee, tempered = SamplerSettings(walkers=48, steps=8, map_starts=2), SamplerSettings("smc", particles=64)
-    assert emcee.record() == {"walkers": 48, "steps": 8, "map_starts": 2, "prior_refresh": mcmc.PRIOR_REFRESH}
-    assert tempered.record() == {"particles": 64, "mcmc_steps": smc.MCMC_STEPS, "map_starts": map_.MAP_STARTS}
+    assert emcee.record() == {"walkers": 48, "steps": 8, "map_starts": 2, "prior_refresh": PRIOR_REFRESH}
+    assert tempered.record() == {"particles": 64, "mcmc_steps": MCMC_STEPS, "map_starts": MAP_STARTS}
     with pytest.raises(dataclasses.FrozenInstanceError):
         emcee.steps = 4
 
@@ -327,6 +327,6 @@ def test_the_commands_defaults_are_the_samplers_own(capsys):
     with pytest.raises(SystemExit):
         main(["posterior", "--help"])
     text = " ".join(capsys.readouterr().out.split())
-    for flag, value in [("--steps", mcmc.STEPS), ("--map-starts", map_.MAP_STARTS)]:
+    for flag, value in [("--steps", STEPS), ("--map-starts", MAP_STARTS)]:
         assert f"{flag.upper().lstrip('-').replace('-', '_')} " in text and f"default {value}" in text
-    assert f"(default {mcmc.PRIOR_REFRESH})" in text
+    assert f"(default {PRIOR_REFRESH})" in text

@@ -16,7 +16,7 @@ from wrist_env.errors import StoreError
 from wrist_env.montecarlo import StudyConfig, StudyError, read_runs, run_study
 from wrist_env.montecarlo.sampler import FRAME_COLUMNS, SCHEMA, TEAR_COLUMNS
 from wrist_env.runs import StoreBusyError
-from wrist_env.solver.drivers import DEFAULT_LOADS
+from wrist_env.solver.settings import DEFAULT_LOADS
 
 pytestmark = pytest.mark.slow  # builds models or runs simulations/studies (minutes)
 

@@ -11,7 +11,7 @@ from wrist_env import cli
 from wrist_env.errors import InputError, StoreError
 from wrist_env.montecarlo import StudyConfig, StudyError, read_runs, run_study, sampler
 from wrist_env.montecarlo.study import config_of, counts
-from wrist_env.solver.drivers import DEFAULT_LOADS
+from wrist_env.solver.settings import DEFAULT_LOADS
 
 CONFIG = StudyConfig(("P1",), n=10, seed=0)
 

@@ -8,7 +8,8 @@ from dataclasses import replace
 import pytest
 
 from wrist_env.solver import kernel
-from wrist_env.solver.arrays import EXPERIMENTAL, SolverSettings, settings_tuple
+from wrist_env.solver.arrays import EXPERIMENTAL, settings_tuple
+from wrist_env.solver.settings import SolverSettings
 
 
 @pytest.mark.parametrize(

@@ -12,9 +12,9 @@ from wrist_env.anatomy.tendons import resultant_direction
 from wrist_env.design import LIGAMENT_NAMES
 from wrist_env.model import CAPITATE
 from wrist_env.participants import registry
-from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.drivers import AXIAL, experimental, idealized, loaded
 from wrist_env.solver.equilibrium import nearest, tangent_stiffness
+from wrist_env.solver.settings import SolverSettings
 from wrist_env.solver.simulate import simulate
 
 SCAPHOID = 2

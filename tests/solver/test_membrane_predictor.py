@@ -8,10 +8,10 @@ from scipy.spatial.transform import Rotation
 
 from wrist_env import design
 from wrist_env.model import CAPITATE, FREE, N_BODIES
-from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.drivers import experimental, idealized
 from wrist_env.solver.membrane import _gaps, _substep_forces, membrane_forces, new_scratch, place_nodes, substep
 from wrist_env.solver.predictor import MAX_RATIO, capitate_move, history, predict, record
+from wrist_env.solver.settings import SolverSettings
 from wrist_env.solver.simulate import prepare, simulate, stiffness
 
 PRECONDITIONED = SolverSettings().preconditioned()

@@ -13,9 +13,9 @@ from test_verification import EPSILON_L
 
 from wrist_env import design
 from wrist_env.participants import registry
-from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.drivers import experimental, idealized
 from wrist_env.solver.equilibrium import block_mass, distance, tangent_stiffness
+from wrist_env.solver.settings import SolverSettings
 from wrist_env.solver.simulate import simulate
 
 PRECONDITIONED = SolverSettings().preconditioned()

@@ -7,8 +7,8 @@ from scipy.spatial.transform import Rotation
 from wrist_env import design
 from wrist_env.model import BONES, PAIRS
 from wrist_env.participants.builtin import truth
-from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.drivers import experimental, idealized
+from wrist_env.solver.settings import SolverSettings
 from wrist_env.solver.simulate import simulate, simulate_batch
 
 pytestmark = pytest.mark.slow  # builds models or runs simulations/studies (minutes)
@@ -102,7 +102,7 @@ def test_random_designs_across_the_bounds_never_raise(p1, solver):
     """Designs across the full bounds, tears included, with either solver or under the tendons' load
     direction: no exception, no NaN in a run reported ok, every failure flagged with NaN outputs and a
     message."""
-    from wrist_env.solver.arrays import SolverSettings
+    from wrist_env.solver.settings import SolverSettings
 
     rng = np.random.default_rng(11)
     designs = [design.from_action(a) for a in rng.uniform(-1, 1, (1000, 27))]

@@ -6,10 +6,10 @@ import numpy as np
 
 from wrist_env import design
 from wrist_env.participants import registry
-from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.contact import nodal_normals, sdf_lookup_scalar, sdf_lookup_smooth
 from wrist_env.solver.drivers import experimental
 from wrist_env.solver.equilibrium import nearest
+from wrist_env.solver.settings import SolverSettings
 from wrist_env.solver.simulate import simulate
 
 SPACING = 0.5

@@ -13,6 +13,7 @@ from wrist_env.solver import arrays
 from wrist_env.solver.drivers import experimental
 from wrist_env.solver.ligaments import EPSILON_L
 from wrist_env.solver.membrane import membrane_forces, place_nodes
+from wrist_env.solver.settings import SolverSettings
 from wrist_env.solver.simulate import prepare, simulate, stiffness
 
 pytestmark = pytest.mark.slow  # builds models or runs simulations/studies (minutes)
@@ -61,7 +62,7 @@ def test_membrane_eigenvalue_matches_the_force_kernels_jacobian(p1):
 def test_node_mass_is_raised_only_where_the_step_needs_it(p1):
     p = prepare(p1)
     population = stiffness(p, design.population())
-    assert population.node_mass == arrays.SolverSettings().node_mass_t  # the population's runs unchanged
+    assert population.node_mass == SolverSettings().node_mass_t  # the population's runs unchanged
     stiff = stiffness(p, stiff_rsc())
     k_along = np.max(stiff.m_K / stiff.m_l0)
     omega = np.sqrt((p.membrane_eigenvalue * k_along + p.settings.membrane_contact_stiffness) / stiff.node_mass)
@@ -73,7 +74,7 @@ def test_a_stiff_rsc_settles_every_frame(p1):
     """With the nodes at `node_mass_t` whatever the design, the RSC's +3 SD design chattered on P1's
     calibration trial (9,823 steps, 8.8 N left on a free bone); with their mass raised every frame settles."""
     driver = experimental(p1, registry.trial("P1", "calibrate").pose("capitate"))
-    s = arrays.SolverSettings()
+    s = SolverSettings()
     run = simulate(p1, stiff_rsc(), driver)
     assert run.ok, run.message
     assert run.steps[1:].max() < s.ramp_steps + s.max_hold_steps  # no frame ran out of hold steps
@@ -90,7 +91,7 @@ def test_every_stiffness_at_the_top_of_the_box_settles_with_the_block_mass(p1):
     everything = design.population().vector.copy()
     everything[:N_LIGAMENTS] = design.from_action(np.r_[np.ones(N_LIGAMENTS), np.zeros(16)]).vector[:N_LIGAMENTS]
     for dsg in (stiff_rsc(), design.Design.from_vector(everything)):
-        run = simulate(p1, dsg, driver, arrays.SolverSettings().preconditioned())
+        run = simulate(p1, dsg, driver, SolverSettings().preconditioned())
         assert run.ok and run.settled.all(), (run.message, run.settled)
         assert np.max(run.residual[:, 0]) < 0.5  # N
 
@@ -99,7 +100,7 @@ def test_settled_says_which_frames_ran_out_of_hold_steps(p1):
     driver = experimental(p1, registry.trial("P1", "calibrate").pose("capitate"))
     run = simulate(p1, design.population(), driver)
     assert run.settled.dtype == bool and run.settled.all()
-    short = replace(arrays.SolverSettings(), min_hold_steps=1, max_hold_steps=2)  # no frame can settle in 2 steps
+    short = replace(SolverSettings(), min_hold_steps=1, max_hold_steps=2)  # no frame can settle in 2 steps
     cut = simulate(p1, design.population(), driver, short)
     assert cut.ok and not cut.settled.any()
     assert np.all(cut.steps[1:] == short.ramp_steps + short.max_hold_steps)

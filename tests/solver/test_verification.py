@@ -29,8 +29,8 @@ from wrist_env.builder.contact_law import fit_contact_law
 from wrist_env.design import LIGAMENT_NAMES
 from wrist_env.model import BONES, CAPITATE, LUNATE, PAIRS, RADIUS, SCAPHOID
 from wrist_env.participants.builtin import truth
-from wrist_env.solver.arrays import SolverSettings
 from wrist_env.solver.drivers import experimental, idealized
+from wrist_env.solver.settings import SolverSettings
 from wrist_env.solver.simulate import simulate
 
 LUNOCAPITATE = PAIRS.index("lunocapitate")

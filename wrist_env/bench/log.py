@@ -44,8 +44,8 @@ from wrist_env.design import N_MATERIAL, NAMES
 from wrist_env.errors import StoreError, WristEnvError
 from wrist_env.frames import DOF_NAMES
 from wrist_env.limits import MAX_BUDGET, MAX_SEED, check_int
+from wrist_env.motions import TRIAL_MOTIONS
 from wrist_env.runs.store import RunStore, read_parquet, remove_file, write_parquet
-from wrist_env.trial import TRIAL_MOTIONS
 
 if TYPE_CHECKING:
     import pandas as pd

@@ -7,6 +7,7 @@ import os
 import sys
 from collections.abc import Sequence
 from importlib import import_module
+from pkgutil import resolve_name
 
 from wrist_env.errors import WristEnvError
 
@@ -49,9 +50,9 @@ COMMANDS = {
         "Bayesian calibration: the posterior of the 22 materials given the calibration trial (emcee or SMC)",
     ),
 }
-"""Every `wrist-bench` command: the module of `wrist_env.cli` that declares and runs it, and its one-line
-help. A command's module (and what it imports) is loaded only when that command is named, so
-`wrist-bench --help` loads none of them."""
+"""Every `wrist-bench` command: the module of `wrist_env.cli` that declares its arguments, and its one-line
+help. A command's module is loaded only when that command is named, so `wrist-bench --help` loads none of
+them; what runs it (`wrist_env.cli.run`, the solver and the rest) only once its arguments have parsed."""
 
 
 def parser(selected: str | None = None) -> argparse.ArgumentParser:
@@ -97,6 +98,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     name = _named(argv)
     args = parser(name or "").parse_args(argv)
     os.environ.setdefault("MPLBACKEND", "Agg")  # the commands save figures; none is shown
+    run = resolve_name(f"{__name__}.run.{args.run}")  # "module:function" of wrist_env.cli.run, imported now
 
     try:
         if getattr(args, "folder", None):
@@ -104,7 +106,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
             for folder in args.folder:
                 registry.add_folder(folder)
-        return args.run(args)
+        return run(args)
     except WristEnvError as exc:  # every project error (unknown calibrators too): one line, exit 2
         print(f"wrist-bench: error: {exc}", file=sys.stderr)
         return 2

@@ -1,11 +1,9 @@
-"""`wrist-bench` commands on what a trial can identify: sensitivity, identifiability, posterior."""
+"""`wrist-bench` commands on what a trial can identify: sensitivity, identifiability, posterior (their
+arguments; `wrist_env.cli.run.identification` runs them)."""
 
 from __future__ import annotations
 
-import time
 from collections.abc import Callable
-
-import numpy as np
 
 from wrist_env.cli.options import (
     out_option,
@@ -13,101 +11,10 @@ from wrist_env.cli.options import (
     progress_option,
     seed_option,
 )
-from wrist_env.errors import UsageError
-from wrist_env.identification import fisher, sensitivity
 from wrist_env.identification.settings import SAMPLERS, SamplerSettings
-from wrist_env.identification.study import study
-from wrist_env.participants import builtin, registry
-from wrist_env.trial import MOTIONS
+from wrist_env.motions import MOTIONS
 
 DEFAULTS = SamplerSettings()
-
-
-def _sensitivity(args) -> int:
-
-    registry.require(*args.participants)
-    for participant in args.participants:
-        start = time.perf_counter()
-        table = sensitivity.study(participant, args.method, args.n, tuple(args.motions), args.seed, args.out)
-        key = "mu_star" if args.method == "morris" else "ST"
-        for motion, rows in table[table["output"] == "cost"].groupby("motion", sort=False):
-            top = rows.nlargest(5, key)
-            ranked = ", ".join(f"{m} {v:.3g}" for m, v in zip(top["material"], top[key]))
-            print(f"{participant} {motion}: cost {key} {ranked} ({rows['runs'].iloc[0]} runs)")
-        print(
-            f"{participant}: {args.out}/sensitivity_{participant}_{args.method}.csv and .png "
-            f"in {time.perf_counter() - start:.0f} s",
-            flush=True,
-        )
-    return 0
-
-
-def _identifiability(args) -> int:
-
-    unknown = [p for p in args.participants if p not in builtin.BUILTIN]
-    if unknown:
-        raise UsageError(f"{unknown} have no hidden truth; built-ins: {list(builtin.BUILTIN)}")
-    materials, spectra = fisher.study(args.participants, args.out)
-    for (participant, trials), rows in materials.groupby(["participant", "trials"], sort=False):
-        s = spectra[(spectra["participant"] == participant) & (spectra["trials"] == trials)]
-        pinned = rows[rows["posterior_sd"] < 0.5]["material"].tolist()
-        print(
-            f"{participant} {trials}: {int((s['sd'] < 1).sum())} of 22 directions pinned tighter than the prior; "
-            f"materials to < 0.5 SD: {', '.join(pinned) or 'none'}"
-        )
-    print(f"written to {args.out}")
-    return 0
-
-
-def _posterior(args) -> int:
-
-    registry.require(*args.participants)
-    if args.seeds < 1:
-        raise UsageError(f"needs --seeds >= 1, but got {args.seeds}")
-    settings = SamplerSettings(
-        args.sampler, args.walkers, args.steps, args.particles, args.mcmc_steps, args.map_starts, args.prior_refresh
-    )
-
-    def report(post, loaded):
-        how = (
-            "loaded from"
-            if loaded
-            else f"sampled in {post.wall_seconds / 60:.1f} min ({post.evaluations} simulations),"
-        )
-        mixing = (
-            f"ESS min {np.nanmin(post.ess):.0f}, split R-hat max {np.nanmax(post.rhat):.2f}"
-            if post.sampler == "emcee"
-            else f"{post.stages} stages, {post.ess[0]:.0f} distinct particles, log evidence {post.log_evidence:.1f}"
-        )
-        print(
-            f"{post.participant} seed {post.seed}: {how} {args.out}; acceptance {post.acceptance:.2f}, "
-            f"{mixing}, noise {post.noise[0]:.2f} mm / {post.noise[1]:.2f} deg",
-            flush=True,
-        )
-
-    table = study(
-        args.participants,
-        args.seeds,
-        args.out,
-        settings,
-        progress=not args.no_progress,
-        on_run=report,
-        report=args.report,
-        trials="model" if args.model_trials else "built-in",
-    )
-    if "coverage_90" in table:
-        for participant, rows in table.groupby("participant", sort=False):
-            print(
-                f"{participant}: 50 % intervals cover {rows.coverage_50.mean():.0%}, 90 % cover "
-                f"{rows.coverage_90.mean():.0%} of the 22 true materials; recovery of the posterior mean "
-                f"{rows.recovery_mean.median():.2f} SD (population {rows.recovery_population.iloc[0]:.2f})"
-            )
-        print(
-            f"all: 50 % intervals cover {table.coverage_50.mean():.0%}, 90 % cover {table.coverage_90.mean():.0%} "
-            f"({len(table)} runs)"
-        )
-    print(f"written to {args.out}" + (f" (table and figures: {args.report})" if args.report else ""))
-    return 0
 
 
 def add_commands(command: Callable[..., object]) -> None:
@@ -131,7 +38,7 @@ def add_commands(command: Callable[..., object]) -> None:
     )
     seed_option(s, "sampling")
     out_option(s, "runs/sensitivity")
-    s.set_defaults(run=_sensitivity)
+    s.set_defaults(run="identification:sensitivity")
 
     s = command(
         "identifiability",
@@ -142,7 +49,7 @@ def add_commands(command: Callable[..., object]) -> None:
     )
     participants_argument(s, "built-in participants (they have a hidden truth)")
     out_option(s, "runs/identifiability")
-    s.set_defaults(run=_identifiability)
+    s.set_defaults(run="identification:identifiability")
 
     s = command(
         "posterior",
@@ -201,4 +108,4 @@ def add_commands(command: Callable[..., object]) -> None:
         "(no model error: tells the calibrator's honesty from the model's fidelity; files get a _model suffix)",
     )
     progress_option(s)
-    s.set_defaults(run=_posterior)
+    s.set_defaults(run="identification:posterior")

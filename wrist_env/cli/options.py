@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from wrist_env.solver.drivers import DEFAULT_LOADS, LOAD_DIRECTIONS
+from wrist_env.solver.settings import DEFAULT_LOADS, LOAD_DIRECTIONS
 
 
 def out_option(s: argparse.ArgumentParser, default: str | None = None, what: str = "output folder") -> None:

@@ -1,20 +1,12 @@
-"""`wrist-bench` studies: calibrate, benchmark, leaderboard, iohanalyzer, montecarlo, montecarlo-report."""
+"""`wrist-bench` studies: calibrate, benchmark, leaderboard, iohanalyzer, montecarlo, montecarlo-report (their
+arguments; `wrist_env.cli.run.studies` runs them)."""
 
 from __future__ import annotations
 
 import argparse
-import importlib.util
-import json
-import sys
-import time
 from collections.abc import Callable
-from pathlib import Path
 
 import optimizers
-from wrist_env.bench.calibrate import PRIOR_SUFFIX, calibrate
-from wrist_env.bench.iohanalyzer import export
-from wrist_env.bench.leaderboard import reference, write_leaderboard
-from wrist_env.bench.runner import benchmark, make_cells
 from wrist_env.cli.options import (
     json_option,
     load_direction_option,
@@ -25,165 +17,8 @@ from wrist_env.cli.options import (
     scheduler_option,
     seed_option,
 )
-from wrist_env.design import INJURABLE, LIGAMENT_NAMES, SPAN_SD
-from wrist_env.errors import UsageError
-from wrist_env.montecarlo.report import write_report
-from wrist_env.montecarlo.sampler import EXCLUDE_ABOVE_MPA, TEAR_PROBABILITY
-from wrist_env.montecarlo.study import StudyConfig, run_study
-from wrist_env.participants import builtin, registry
-from wrist_env.trial import TRIAL_MOTIONS
-
-
-def _calibrate(args) -> int:
-
-    registry.require(args.participant)
-    start = time.perf_counter()
-    name = args.optimizer + (PRIOR_SUFFIX if args.prior and not args.optimizer.endswith(PRIOR_SUFFIX) else "")
-    run = calibrate(args.participant, name, args.budget, args.seed, log=args.log, storage=args.storage)
-    wall = time.perf_counter() - start
-    ref = reference(args.participant)
-    out = run.to_dict(history=True)
-    out["wall_seconds"] = round(wall, 3)
-    out["population"] = {m: ref.population[m]["cost"] for m in TRIAL_MOTIONS}
-    out["truth"] = None if ref.truth is None else {m: ref.truth[m]["cost"] for m in TRIAL_MOTIONS}
-    if args.out:
-        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.out).write_text(json.dumps(out, indent=1, allow_nan=False))
-    if args.json:
-        print(json.dumps(out, indent=1, allow_nan=False))
-        return 0
-    truth = out["truth"]
-    print(
-        f"{args.participant}: {name}, seed {args.seed}: {run.result.nfev} evaluations"
-        f"{f' ({run.replayed} replayed from the log)' if run.replayed else ''} in {wall:.1f} s; {run.result.message}"
-    )
-    for motion, name in (("calibrate", "calibration trial"), ("validate", "held-out resisted trial")):
-        score = getattr(run, motion)
-        print(
-            f"{name + ' cost:':<30} population {out['population'][motion]:.3f} -> calibrated {score['cost']:.3f}"
-            + ("" if truth is None else f"  (hidden truth {truth[motion]:.3f})")
-            + (" FAILED" if score["failed"] else "")
-        )
-    if run.recovery_z is not None:
-        print(
-            f"{'parameter recovery:':<30} {run.recovery_z:.3f} SD from the truth (population design "
-            f"{run.recovery_z_population:.3f})"
-        )
-    d = run.design
-    print("calibrated design (injury scalars intact):")
-    print(f"  {'ligament':<8} {'stiffness N/mm':>15} {'reference strain':>17}")
-    for i, lig in enumerate(LIGAMENT_NAMES):
-        print(f"  {lig:<8} {d.stiffness[i]:15.2f} {d.reference_strain[i]:17.4f}")
-    if args.out:
-        print(f"written to {args.out} (usable as --design of simulate and evaluate)")
-    return 0
-
-
-def _benchmark(args) -> int:
-
-    participants = args.participants or list(builtin.BUILTIN)
-    names = args.optimizers or list(optimizers.available())
-    if args.prior:
-        names = list(dict.fromkeys(names + [n + PRIOR_SUFFIX for n in names if not n.endswith(PRIOR_SUFFIX)]))
-    cells = make_cells(participants, names, args.seeds, args.budget)
-    where = f"the dask scheduler {args.scheduler}" if args.scheduler else "local processes"
-    print(
-        f"{len(cells)} cells: participants {', '.join(participants)} x calibrators {', '.join(names)} x "
-        f"{args.seeds} seeds, budget {args.budget}; on {where}; run log {args.out}",
-        flush=True,
-    )
-    report = benchmark(
-        participants,
-        names,
-        args.seeds,
-        args.budget,
-        args.out,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        progress=not args.no_progress,
-        storage=args.storage,
-        threads=args.threads,
-        folders=tuple(args.folder or ()),
-    )
-    print(
-        f"ran {len(report.ran)} cells, skipped {len(report.skipped)} already finished, "
-        f"{len(report.failed)} failed; {report.evaluations} evaluations logged"
-    )
-    for key, error in report.failed:
-        print(f"  failed {key.name}: {error}", file=sys.stderr)
-    if args.scheduler is None:
-        print(f"local: {report.workers} worker process(es) x {report.threads} Numba thread(s)")
-    print(f"wall time {report.wall_seconds:.1f} s")
-    leaderboard = Path(args.leaderboard) if args.leaderboard else Path(args.out) / "leaderboards"
-    if report.ran or report.skipped:
-        path = write_leaderboard(args.out, leaderboard)
-        print(f"leaderboard: {path}")
-    return 1 if report.failed else 0
-
-
-def _leaderboard(args) -> int:
-
-    if not Path(args.runs).is_dir():
-        raise UsageError(f"no run log at {args.runs}")
-    path = write_leaderboard(args.runs, args.out, title=args.title)
-    print(path)
-    return 0
-
-
-def _iohanalyzer(args) -> int:
-
-    if importlib.util.find_spec("ioh") is None:
-        raise SystemExit('wrist-bench iohanalyzer needs ioh, which is not installed: pip install -e ".[ioh]"')
-    if not Path(args.runs).is_dir():
-        raise UsageError(f"no run log at {args.runs}")
-    for folder in export(args.runs, args.out):
-        print(folder)
-    return 0
-
-
-def _montecarlo(args) -> int:
-
-    registry.require(*args.participants)
-    config = StudyConfig(
-        tuple(args.participants), args.n, args.seed, args.tear_probability, load_direction=args.load_direction
-    )
-    where = (
-        f"the dask scheduler {args.scheduler}"
-        if args.scheduler
-        else f"{args.workers} local worker processes"
-        if args.workers > 1
-        else "this process (Numba threads on every core)"
-    )
-    print(
-        f"Monte Carlo: {', '.join(config.participants)}, {config.n:,} successful runs each, seed {config.seed}, "
-        f"load {config.load_direction}, "
-        f"batch {args.batch}, on {where}; run log {args.out}",
-        flush=True,
-    )
-    summary = run_study(
-        config,
-        args.out,
-        batch=args.batch,
-        scheduler=args.scheduler,
-        workers=args.workers,
-        folders=tuple(args.folder or ()),
-        progress=not args.no_progress,
-    )
-    print(summary.line())
-    return 0
-
-
-def _montecarlo_report(args) -> int:
-
-    if not Path(args.runs).is_dir():
-        raise UsageError(f"no Monte Carlo run log at {args.runs}")
-    summary = write_report(args.runs, args.out, max_runs=args.max_runs)
-    t5 = summary["table5"]
-    print(
-        f"Table 5: {t5['runs']:,} runs, {t5['rows']:,} rows, fit {t5['fit_seconds']} s; "
-        f"report {summary['report_seconds']} s; written to {args.out}"
-    )
-    return 0
+from wrist_env.design import INJURABLE, SPAN_SD
+from wrist_env.montecarlo.config import EXCLUDE_ABOVE_MPA, TEAR_PROBABILITY
 
 
 def _run_log_arguments(s: argparse.ArgumentParser, *, out: str, runs: str = "runs/benchmark") -> None:
@@ -220,7 +55,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     )
     out_option(s, what="also write the JSON result to this file (usable as --design elsewhere)")
     json_option(s, "the result, design and held-out cost")
-    s.set_defaults(run=_calibrate)
+    s.set_defaults(run="studies:calibrate")
 
     s = command(
         "benchmark",
@@ -249,7 +84,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     )
     s.add_argument("--leaderboard", help="leaderboard folder (default: <out>/leaderboards)")
     progress_option(s)
-    s.set_defaults(run=_benchmark)
+    s.set_defaults(run="studies:benchmark")
 
     s = command(
         "leaderboard",
@@ -259,7 +94,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     )
     _run_log_arguments(s, out="runs/leaderboard")
     s.add_argument("--title", help="title of the README.md")
-    s.set_defaults(run=_leaderboard)
+    s.set_defaults(run="studies:leaderboard")
 
     s = command(
         "iohanalyzer",
@@ -268,7 +103,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "Zip the output folder and upload it to IOHanalyzer. Needs the [ioh] extra.",
     )
     _run_log_arguments(s, out="runs/iohanalyzer")
-    s.set_defaults(run=_iohanalyzer)
+    s.set_defaults(run="studies:iohanalyzer")
 
     s = command(
         "montecarlo",
@@ -302,7 +137,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "Numba threads on every core)",
     )
     progress_option(s)
-    s.set_defaults(run=_montecarlo)
+    s.set_defaults(run="studies:montecarlo")
 
     s = command(
         "montecarlo-report",
@@ -314,4 +149,4 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     )
     _run_log_arguments(s, out="runs/montecarlo-report", runs="runs/montecarlo")
     s.add_argument("--max-runs", type=int, help="fit on a seeded random subset of this many runs (default: all)")
-    s.set_defaults(run=_montecarlo_report)
+    s.set_defaults(run="studies:montecarlo_report")

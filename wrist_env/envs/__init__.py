@@ -11,7 +11,7 @@ import gymnasium as gym
 
 from wrist_env.envs import ids
 from wrist_env.envs.ids import MOTION_PREFIX, NAMESPACE, env_id
-from wrist_env.trial import MOTIONS
+from wrist_env.motions import MOTIONS
 
 if TYPE_CHECKING:
     from pathlib import Path

@@ -6,14 +6,14 @@ from __future__ import annotations
 from collections.abc import Iterable
 from types import ModuleType
 
-from wrist_env.trial import MOTIONS
+from wrist_env.motions import MOTIONS
 
 NAMESPACE = "wrist_env"
 MOTION_PREFIX = {m: m.capitalize() for m in MOTIONS}
 
 
 def env_id(participant: str, motion: str) -> str:
-    """The Gymnasium id of a participant's motion (`trial.MOTIONS`)."""
+    """The Gymnasium id of a participant's motion (`motions.MOTIONS`)."""
     return f"{NAMESPACE}/{MOTION_PREFIX[motion]}-{participant}-v0"
 
 

@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike
 
 from wrist_env import design
 from wrist_env.limits import MAX_BATCH, check_int
-from wrist_env.solver.drivers import DEFAULT_LOADS
+from wrist_env.solver.settings import DEFAULT_LOADS
 from wrist_env.task import task
 
 OBSERVATION = np.zeros(design.N_DESIGN, dtype=np.float32)
@@ -32,7 +32,7 @@ class WristEnv(gym.Env):
 
     participant: a registered participant name; motion: "calibrate",
     "validate" or "idealized"; load_direction: the idealized sweep's load
-    (`drivers.LOAD_DIRECTIONS`, default `drivers.DEFAULT_LOADS`). info: cost, per-DOF 75th-percentile errors and
+    (`settings.LOAD_DIRECTIONS`, default `settings.DEFAULT_LOADS`). info: cost, per-DOF 75th-percentile errors and
     RMSE (mm, deg), per-frame contact (MPa, mm², N), bundle forces (N),
     energies (N·mm), poses, and `failed` — deterministic, NaN-free.
     """

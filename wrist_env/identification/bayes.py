@@ -47,9 +47,9 @@ from wrist_env.identification.posterior import Posterior
 from wrist_env.identification.settings import SamplerSettings
 from wrist_env.identification.smc import DefensiveStart, sample_smc
 from wrist_env.model import BONES
+from wrist_env.motions import TRIAL_MOTIONS
 from wrist_env.participants import builtin
 from wrist_env.task import Task, cost_poses, task
-from wrist_env.trial import TRIAL_MOTIONS
 
 PREDICTIVE_DRAWS = 32
 

@@ -20,11 +20,11 @@ import numpy as np
 from wrist_env import design
 from wrist_env.figures.identifiability import plot
 from wrist_env.identification.likelihood import residuals
+from wrist_env.motions import TRIAL_MOTIONS
 from wrist_env.participants import builtin
-from wrist_env.solver.arrays import SolverSettings
+from wrist_env.solver.settings import SolverSettings
 from wrist_env.solver.simulate import simulate_batch
 from wrist_env.task import Task, cost_poses
-from wrist_env.trial import TRIAL_MOTIONS
 
 STEP_Z = 0.25  # central-difference step, SD units
 SETTINGS = SolverSettings(tolerance=1e-4, force_floor_n=1e-3, max_hold_steps=6400)

@@ -8,11 +8,9 @@ from scipy.optimize import least_squares
 
 from wrist_env import design
 from wrist_env.identification import likelihood
+from wrist_env.identification.settings import MAP_STARTS
 from wrist_env.task import Task
 
-MAP_STARTS = 24
-"""Gauss–Newton starts of the MAP search: on P1's model trials (seed 0) 10 of 24 random starts reached
-the basin of the best fit (objective 35) and 14 stopped at 91–146; 8 starts all missed it there."""
 FD_STEP_Z = 0.1
 """Forward-difference step of the MAP search's Jacobian (SD units)."""
 FAILED_RESIDUAL = 30.0

@@ -11,13 +11,8 @@ import numpy as np
 
 from wrist_env import design
 from wrist_env.identification import likelihood
+from wrist_env.identification.settings import PRIOR_REFRESH
 from wrist_env.task import Task
-
-WALKERS = 48
-STEPS = 1200
-"""Ensemble steps: at 300 the chains were overconfident even on the model's own trials (README); ~12 min a run."""
-PRIOR_REFRESH = 0.2
-"""Share of emcee's moves that are `prior_refresh`; the rest DE (80 %) and DE snooker (20 %)."""
 
 
 def log_likelihood(calibration: Task, counter: list | None = None) -> Callable[[np.ndarray], np.ndarray]:

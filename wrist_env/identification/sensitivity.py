@@ -26,8 +26,8 @@ from wrist_env import design
 from wrist_env.cost import COST_BONES, DOF_NAMES
 from wrist_env.design import full_action
 from wrist_env.figures.sensitivity import plot
+from wrist_env.motions import MOTIONS
 from wrist_env.task import task
-from wrist_env.trial import MOTIONS
 
 METHODS = ("morris", "sobol")
 MATERIALS = design.NAMES[: design.N_MATERIAL]

@@ -1,4 +1,5 @@
-"""The Bayesian calibrator's sampler settings: one frozen record that refuses values out of range."""
+"""The Bayesian calibrator's sampler settings: their defaults (which `map`, `mcmc` and `smc` take from here)
+and one frozen record that refuses values out of range."""
 
 from __future__ import annotations
 
@@ -7,11 +8,22 @@ from dataclasses import dataclass
 
 from wrist_env.design import N_MATERIAL
 from wrist_env.errors import InputError
-from wrist_env.identification.map import MAP_STARTS
-from wrist_env.identification.mcmc import PRIOR_REFRESH, STEPS, WALKERS
-from wrist_env.identification.smc import MCMC_STEPS, PARTICLES
 
 SAMPLERS = ("emcee", "smc")
+"""The Bayesian calibrator's samplers: emcee's ensemble MCMC (`mcmc`) or SMCPy's tempered SMC (`smc`)."""
+WALKERS = 48
+"""emcee's ensemble walkers."""
+STEPS = 1200
+"""Ensemble steps: at 300 the chains were overconfident even on the model's own trials (README); ~12 min a run."""
+PRIOR_REFRESH = 0.2
+"""Share of emcee's moves that are `prior_refresh`; the rest DE (80 %) and DE snooker (20 %)."""
+PARTICLES = 256
+"""SMC's particles."""
+MCMC_STEPS = 5
+"""Random-walk Metropolis steps per particle and SMC stage."""
+MAP_STARTS = 24
+"""Gauss–Newton starts of the MAP search: on P1's model trials (seed 0) 10 of 24 random starts reached
+the basin of the best fit (objective 35) and 14 stopped at 91–146; 8 starts all missed it there."""
 
 # (field, least value, why): the ensemble and the particle cloud need two members per material to span
 # the 22 dimensions (emcee refuses fewer); half the steps are burn-in and split R-hat halves the rest

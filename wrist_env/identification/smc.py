@@ -8,9 +8,6 @@ from scipy.stats import multivariate_t
 
 from wrist_env.identification import likelihood
 
-PARTICLES = 256
-MCMC_STEPS = 5
-"""Random-walk Metropolis steps per particle and SMC stage."""
 START_DF = 5
 START_SCALE = 1.5
 """SMC's start around the MAP: Student-t degrees of freedom and the Laplace covariance's scale (SD)."""

@@ -8,10 +8,14 @@ from dataclasses import dataclass
 
 from wrist_env.errors import WristEnvError
 from wrist_env.limits import MAX_RUNS, MAX_SEED, check_int, check_unique
-from wrist_env.montecarlo import sampler
-from wrist_env.solver.drivers import DEFAULT_LOADS, LOAD_DIRECTIONS
+from wrist_env.solver.settings import DEFAULT_LOADS, LOAD_DIRECTIONS
 
 VERSION = 1
+TEAR_PROBABILITY = 0.3
+"""Chance that each injurable ligament is torn in a Monte Carlo run (preprint 2.3.2)."""
+EXCLUDE_ABOVE_MPA = 16.5
+"""A run is excluded when its radioscaphoid mean pressure exceeds this (MPa) at any frame of the sweep
+(preprint 2.3.2; how we read it: `sampler`)."""
 
 
 class StudyError(WristEnvError):
@@ -25,12 +29,12 @@ class StudyConfig:
     participants: tuple[str, ...]
     n: int
     seed: int = 0
-    tear_probability: float = sampler.TEAR_PROBABILITY
-    exclude_above_mpa: float = sampler.EXCLUDE_ABOVE_MPA
+    tear_probability: float = TEAR_PROBABILITY
+    exclude_above_mpa: float = EXCLUDE_ABOVE_MPA
     max_attempts: int | None = None
     """Give up (StudyError) after this many runs of one participant; default 5 n + 100."""
     load_direction: str = DEFAULT_LOADS
-    """The sweeps' load direction (`drivers.LOAD_DIRECTIONS`): along the radius, or a tendon rig's."""
+    """The sweeps' load direction (`LOAD_DIRECTIONS`): along the radius, or a tendon rig's."""
 
     def __post_init__(self):
         object.__setattr__(self, "participants", tuple(self.participants))

@@ -40,16 +40,15 @@ from numpy.typing import ArrayLike
 from wrist_env import design
 from wrist_env.design import INJURABLE, LIGAMENT_NAMES, N_DESIGN, N_MATERIAL, NAMES, SPAN_SD
 from wrist_env.errors import DesignError
+from wrist_env.montecarlo.config import EXCLUDE_ABOVE_MPA, TEAR_PROBABILITY
 from wrist_env.participants import registry
-from wrist_env.solver.drivers import DEFAULT_LOADS
+from wrist_env.solver.settings import DEFAULT_LOADS
 from wrist_env.task import task
 
 if TYPE_CHECKING:
     from pathlib import Path
 
 
-TEAR_PROBABILITY = 0.3
-"""Chance that each injurable ligament is torn in a Monte Carlo run (preprint 2.3.2)."""
 TORN_ACTION, INTACT_ACTION = -0.5, 1.0
 """Normalized injury scalars the Monte Carlo study gives a torn and an intact ligament."""
 
@@ -102,7 +101,6 @@ def monte_carlo_actions(
     return monte_carlo_from_unit(latin_hypercube(n, seed), tear_probability=tear_probability)
 
 
-EXCLUDE_ABOVE_MPA = 16.5
 RS_PAIR = "radioscaphoid"
 TEAR_COLUMNS = tuple(f"{n}.torn" for n in INJURABLE)
 FORCE_COLUMNS = tuple(f"{n}.force_n" for n in LIGAMENT_NAMES)
@@ -168,7 +166,7 @@ def run_chunk(
 
     Runs wherever it is called: in this process, a local worker process or a dask worker
     (`folders`: user participant folders to register there first). load_direction: the sweep's
-    load (`drivers.LOAD_DIRECTIONS`).
+    load (`settings.LOAD_DIRECTIONS`).
     """
     if folders:
         for folder in folders:

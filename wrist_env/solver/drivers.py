@@ -3,7 +3,7 @@
 `experimental(model, transforms)` prescribes all 6 DOF of the capitate from a trial's 4×4 transforms
 (`trial_driver` for a `Trial`); `loaded(model, rotations, load_n)` prescribes its rotations and leaves its
 translations free under a compressive load (N) on lines of action (`Loads`: along the radius' axis,
-`AXIAL`, or the tendons where they enter the hand, `LOAD_DIRECTIONS`); `idealized(model)` is the loaded
+`AXIAL`, or the tendons where they enter the hand: `settings.LOAD_DIRECTIONS`); `idealized(model)` is the loaded
 driver ramping from maximum flexion to maximum extension (deg) about the RCS z axis; `static` holds it
 at neutral. Poses in the RCS, mm.
 """
@@ -20,15 +20,13 @@ from scipy.spatial.transform import Rotation
 from wrist_env.anatomy.tendons import model_lines
 from wrist_env.model import CAPITATE, Model
 from wrist_env.solver import arrays, kernel
+from wrist_env.solver.settings import DEFAULT_LOADS, LOAD_DIRECTIONS
 
 if TYPE_CHECKING:
     from wrist_env.trial import Trial
 
 IDEALIZED_LOAD_N = 10.0  # compressive load that keeps the joint in contact (N)
 AXIAL = (0.0, 1.0, 0.0)  # the load along the radius' long axis, proximal (RCS +y)
-DEFAULT_LOADS = "erhart2020"
-"""Every driver's loads unless told otherwise (`LOAD_DIRECTIONS`): the tendons where they enter the hand
-(issue 33: under the axial load the radial column carries nothing)."""
 
 
 @dataclass(frozen=True)
@@ -149,12 +147,6 @@ def loaded(
     load = np.broadcast_to(np.asarray(load_n, dtype=np.float64), (n,)).copy()
     angle = np.full(n, np.nan) if angle_deg is None else np.asarray(angle_deg, dtype=np.float64)
     return Driver(arrays.LOADED, rotation, com, angle, load, loads(model, direction))
-
-
-LOAD_DIRECTIONS = ("axial", "erhart2020", "erhart2020_groups")
-
-"""Named loads: "axial", one compressive line on the capitate along the radius' long axis (`AXIAL`), or
-a tendon rig (`anatomy.tendons.RIGS`): each tendon on the body it loads, where it enters the hand."""
 
 
 def loads(model: Model, direction: str | ArrayLike) -> Loads:

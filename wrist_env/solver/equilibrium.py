@@ -21,6 +21,7 @@ from wrist_env.design import Design
 from wrist_env.model import CAPITATE, FREE, Model
 from wrist_env.solver import arrays, kernel, preconditioner
 from wrist_env.solver.rigid import LEVER_MM, pose_state, pose_translation, rotate_in_place
+from wrist_env.solver.settings import SolverSettings
 from wrist_env.solver.simulate import prepare, stiffness
 from wrist_env.solver.tangent import tangent
 
@@ -140,7 +141,7 @@ def _frame_args(p, design_stiffness, free_nodes, driver, result, f: int) -> tupl
     return R0, x0, nodes0, free_nodes, p.system, design_stiffness, driver.kernel_load(f)
 
 
-def nearest(model: Model, design: Design, driver, result, settings: arrays.SolverSettings | None = None) -> Equilibrium:
+def nearest(model: Model, design: Design, driver, result, settings: SolverSettings | None = None) -> Equilibrium:
     """The equilibrium nearest each frame of `result` (a successful `simulate(model, design, driver)`)."""
     if not result.ok:
         raise ValueError(f"the run failed ({result.message}); there is no state to start from")
@@ -203,7 +204,7 @@ class Tangent:
 
 
 def tangent_stiffness(
-    model: Model, design: Design, driver, result, frame: int, settings: arrays.SolverSettings | None = None
+    model: Model, design: Design, driver, result, frame: int, settings: SolverSettings | None = None
 ) -> Tangent:
     """`Tangent` stiffness of the free bones at `frame` of `result` (a successful `simulate(model, design, driver)`):
     central differences of the force kernels (`JACOBIAN_STEP`), no time step or damping."""
@@ -251,7 +252,7 @@ class BlockMass:
 
 
 def block_mass(
-    model: Model, design: Design, driver, result, frame: int, settings: arrays.SolverSettings | None = None
+    model: Model, design: Design, driver, result, frame: int, settings: SolverSettings | None = None
 ) -> BlockMass:
     """The `BlockMass` the explicit solver would build at `frame` of `result` (a successful `simulate`)
     under `settings` (their block_* fields; the block mass need not be on)."""

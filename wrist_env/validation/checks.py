@@ -13,8 +13,9 @@ from wrist_env.model import BONES, MIDCARPAL, PAIRS, Model
 from wrist_env.participants.registry import load_model
 from wrist_env.solver import drivers
 from wrist_env.solver import simulate as sim
-from wrist_env.solver.drivers import DEFAULT_LOADS, IDEALIZED_LOAD_N
+from wrist_env.solver.drivers import IDEALIZED_LOAD_N
 from wrist_env.solver.outputs import cardan_deg
+from wrist_env.solver.settings import DEFAULT_LOADS
 from wrist_env.validation.bands import (
     EXTENSION_30_DEG,
     NEUTRAL_LOAD_N,
@@ -49,8 +50,8 @@ def validate(
 
     params: build parameters (`BuildParams`; the anatomy variant), default the default build.
     load_n: the compressive load (N) of the sweeps; the neutral pose takes `NEUTRAL_LOAD_N`.
-    load_direction: the loads' direction in the sweeps and at neutral (`drivers.LOAD_DIRECTIONS`).
-    settings: the solver's (`arrays.SolverSettings`), default its defaults.
+    load_direction: the loads' direction in the sweeps and at neutral (`settings.LOAD_DIRECTIONS`).
+    settings: the solver's (`settings.SolverSettings`), default its defaults.
     """
 
     start = time.perf_counter()

@@ -14,7 +14,7 @@ from wrist_env.bench.leaderboard.reference import Reference, rmse_array
 from wrist_env.bench.leaderboard.tables import calibrator_label, quantile, runs_of, spread
 from wrist_env.cost import COST_BONES
 from wrist_env.frames import DOF_NAMES, DOF_UNITS
-from wrist_env.trial import TRIAL_MOTIONS
+from wrist_env.motions import TRIAL_MOTIONS
 
 PREPRINT_SHARE_IMPROVED = {"calibrate": 66.7, "validate": 61.1}
 """Share of DOF (%) with lower RMSE after calibration in the preprint's Tables 3 and 4."""

@@ -9,9 +9,9 @@ import numpy as np
 from wrist_env import design
 from wrist_env.cost import COST_BONES
 from wrist_env.frames import DOF_NAMES
+from wrist_env.motions import TRIAL_MOTIONS
 from wrist_env.participants import builtin
 from wrist_env.task import task
-from wrist_env.trial import TRIAL_MOTIONS
 
 
 @dataclass

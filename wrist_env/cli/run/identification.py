@@ -1,0 +1,102 @@
+"""How `wrist-bench` runs the commands on what a trial can identify: sensitivity, identifiability, posterior
+(declared in `wrist_env.cli.identification_commands`)."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from wrist_env.errors import UsageError
+from wrist_env.identification import fisher
+from wrist_env.identification import sensitivity as global_sensitivity
+from wrist_env.identification.settings import SamplerSettings
+from wrist_env.identification.study import study
+from wrist_env.participants import builtin, registry
+
+
+def sensitivity(args) -> int:
+
+    registry.require(*args.participants)
+    for participant in args.participants:
+        start = time.perf_counter()
+        table = global_sensitivity.study(participant, args.method, args.n, tuple(args.motions), args.seed, args.out)
+        key = "mu_star" if args.method == "morris" else "ST"
+        for motion, rows in table[table["output"] == "cost"].groupby("motion", sort=False):
+            top = rows.nlargest(5, key)
+            ranked = ", ".join(f"{m} {v:.3g}" for m, v in zip(top["material"], top[key]))
+            print(f"{participant} {motion}: cost {key} {ranked} ({rows['runs'].iloc[0]} runs)")
+        print(
+            f"{participant}: {args.out}/sensitivity_{participant}_{args.method}.csv and .png "
+            f"in {time.perf_counter() - start:.0f} s",
+            flush=True,
+        )
+    return 0
+
+
+def identifiability(args) -> int:
+
+    unknown = [p for p in args.participants if p not in builtin.BUILTIN]
+    if unknown:
+        raise UsageError(f"{unknown} have no hidden truth; built-ins: {list(builtin.BUILTIN)}")
+    materials, spectra = fisher.study(args.participants, args.out)
+    for (participant, trials), rows in materials.groupby(["participant", "trials"], sort=False):
+        s = spectra[(spectra["participant"] == participant) & (spectra["trials"] == trials)]
+        pinned = rows[rows["posterior_sd"] < 0.5]["material"].tolist()
+        print(
+            f"{participant} {trials}: {int((s['sd'] < 1).sum())} of 22 directions pinned tighter than the prior; "
+            f"materials to < 0.5 SD: {', '.join(pinned) or 'none'}"
+        )
+    print(f"written to {args.out}")
+    return 0
+
+
+def posterior(args) -> int:
+
+    registry.require(*args.participants)
+    if args.seeds < 1:
+        raise UsageError(f"needs --seeds >= 1, but got {args.seeds}")
+    settings = SamplerSettings(
+        args.sampler, args.walkers, args.steps, args.particles, args.mcmc_steps, args.map_starts, args.prior_refresh
+    )
+
+    def report(post, loaded):
+        how = (
+            "loaded from"
+            if loaded
+            else f"sampled in {post.wall_seconds / 60:.1f} min ({post.evaluations} simulations),"
+        )
+        mixing = (
+            f"ESS min {np.nanmin(post.ess):.0f}, split R-hat max {np.nanmax(post.rhat):.2f}"
+            if post.sampler == "emcee"
+            else f"{post.stages} stages, {post.ess[0]:.0f} distinct particles, log evidence {post.log_evidence:.1f}"
+        )
+        print(
+            f"{post.participant} seed {post.seed}: {how} {args.out}; acceptance {post.acceptance:.2f}, "
+            f"{mixing}, noise {post.noise[0]:.2f} mm / {post.noise[1]:.2f} deg",
+            flush=True,
+        )
+
+    table = study(
+        args.participants,
+        args.seeds,
+        args.out,
+        settings,
+        progress=not args.no_progress,
+        on_run=report,
+        report=args.report,
+        trials="model" if args.model_trials else "built-in",
+    )
+    if "coverage_90" in table:
+        for participant, rows in table.groupby("participant", sort=False):
+            print(
+                f"{participant}: 50 % intervals cover {rows.coverage_50.mean():.0%}, 90 % cover "
+                f"{rows.coverage_90.mean():.0%} of the 22 true materials; recovery of the posterior mean "
+                f"{rows.recovery_mean.median():.2f} SD (population {rows.recovery_population.iloc[0]:.2f})"
+            )
+        print(
+            f"all: 50 % intervals cover {table.coverage_50.mean():.0%}, 90 % cover {table.coverage_90.mean():.0%} "
+            f"({len(table)} runs)"
+        )
+    print(f"written to {args.out}" + (f" (table and figures: {args.report})" if args.report else ""))
+    return 0

@@ -1,0 +1,176 @@
+"""How `wrist-bench` runs the studies: calibrate, benchmark, leaderboard, iohanalyzer, montecarlo,
+montecarlo-report (declared in `wrist_env.cli.study_commands`)."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import sys
+import time
+from pathlib import Path
+
+import optimizers
+from wrist_env import bench
+from wrist_env.bench.calibrate import PRIOR_SUFFIX
+from wrist_env.bench.iohanalyzer import export
+from wrist_env.bench.leaderboard import reference, write_leaderboard
+from wrist_env.bench.runner import make_cells
+from wrist_env.design import LIGAMENT_NAMES
+from wrist_env.errors import UsageError
+from wrist_env.montecarlo.config import StudyConfig
+from wrist_env.montecarlo.report import write_report
+from wrist_env.montecarlo.study import run_study
+from wrist_env.motions import TRIAL_MOTIONS
+from wrist_env.participants import builtin, registry
+
+
+def calibrate(args) -> int:
+
+    registry.require(args.participant)
+    start = time.perf_counter()
+    name = args.optimizer + (PRIOR_SUFFIX if args.prior and not args.optimizer.endswith(PRIOR_SUFFIX) else "")
+    run = bench.calibrate(args.participant, name, args.budget, args.seed, log=args.log, storage=args.storage)
+    wall = time.perf_counter() - start
+    ref = reference(args.participant)
+    out = run.to_dict(history=True)
+    out["wall_seconds"] = round(wall, 3)
+    out["population"] = {m: ref.population[m]["cost"] for m in TRIAL_MOTIONS}
+    out["truth"] = None if ref.truth is None else {m: ref.truth[m]["cost"] for m in TRIAL_MOTIONS}
+    if args.out:
+        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.out).write_text(json.dumps(out, indent=1, allow_nan=False))
+    if args.json:
+        print(json.dumps(out, indent=1, allow_nan=False))
+        return 0
+    truth = out["truth"]
+    print(
+        f"{args.participant}: {name}, seed {args.seed}: {run.result.nfev} evaluations"
+        f"{f' ({run.replayed} replayed from the log)' if run.replayed else ''} in {wall:.1f} s; {run.result.message}"
+    )
+    for motion, name in (("calibrate", "calibration trial"), ("validate", "held-out resisted trial")):
+        score = getattr(run, motion)
+        print(
+            f"{name + ' cost:':<30} population {out['population'][motion]:.3f} -> calibrated {score['cost']:.3f}"
+            + ("" if truth is None else f"  (hidden truth {truth[motion]:.3f})")
+            + (" FAILED" if score["failed"] else "")
+        )
+    if run.recovery_z is not None:
+        print(
+            f"{'parameter recovery:':<30} {run.recovery_z:.3f} SD from the truth (population design "
+            f"{run.recovery_z_population:.3f})"
+        )
+    d = run.design
+    print("calibrated design (injury scalars intact):")
+    print(f"  {'ligament':<8} {'stiffness N/mm':>15} {'reference strain':>17}")
+    for i, lig in enumerate(LIGAMENT_NAMES):
+        print(f"  {lig:<8} {d.stiffness[i]:15.2f} {d.reference_strain[i]:17.4f}")
+    if args.out:
+        print(f"written to {args.out} (usable as --design of simulate and evaluate)")
+    return 0
+
+
+def benchmark(args) -> int:
+
+    participants = args.participants or list(builtin.BUILTIN)
+    names = args.optimizers or list(optimizers.available())
+    if args.prior:
+        names = list(dict.fromkeys(names + [n + PRIOR_SUFFIX for n in names if not n.endswith(PRIOR_SUFFIX)]))
+    cells = make_cells(participants, names, args.seeds, args.budget)
+    where = f"the dask scheduler {args.scheduler}" if args.scheduler else "local processes"
+    print(
+        f"{len(cells)} cells: participants {', '.join(participants)} x calibrators {', '.join(names)} x "
+        f"{args.seeds} seeds, budget {args.budget}; on {where}; run log {args.out}",
+        flush=True,
+    )
+    report = bench.benchmark(
+        participants,
+        names,
+        args.seeds,
+        args.budget,
+        args.out,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        progress=not args.no_progress,
+        storage=args.storage,
+        threads=args.threads,
+        folders=tuple(args.folder or ()),
+    )
+    print(
+        f"ran {len(report.ran)} cells, skipped {len(report.skipped)} already finished, "
+        f"{len(report.failed)} failed; {report.evaluations} evaluations logged"
+    )
+    for key, error in report.failed:
+        print(f"  failed {key.name}: {error}", file=sys.stderr)
+    if args.scheduler is None:
+        print(f"local: {report.workers} worker process(es) x {report.threads} Numba thread(s)")
+    print(f"wall time {report.wall_seconds:.1f} s")
+    leaderboard = Path(args.leaderboard) if args.leaderboard else Path(args.out) / "leaderboards"
+    if report.ran or report.skipped:
+        path = write_leaderboard(args.out, leaderboard)
+        print(f"leaderboard: {path}")
+    return 1 if report.failed else 0
+
+
+def leaderboard(args) -> int:
+
+    if not Path(args.runs).is_dir():
+        raise UsageError(f"no run log at {args.runs}")
+    path = write_leaderboard(args.runs, args.out, title=args.title)
+    print(path)
+    return 0
+
+
+def iohanalyzer(args) -> int:
+
+    if importlib.util.find_spec("ioh") is None:
+        raise SystemExit('wrist-bench iohanalyzer needs ioh, which is not installed: pip install -e ".[ioh]"')
+    if not Path(args.runs).is_dir():
+        raise UsageError(f"no run log at {args.runs}")
+    for folder in export(args.runs, args.out):
+        print(folder)
+    return 0
+
+
+def montecarlo(args) -> int:
+
+    registry.require(*args.participants)
+    config = StudyConfig(
+        tuple(args.participants), args.n, args.seed, args.tear_probability, load_direction=args.load_direction
+    )
+    where = (
+        f"the dask scheduler {args.scheduler}"
+        if args.scheduler
+        else f"{args.workers} local worker processes"
+        if args.workers > 1
+        else "this process (Numba threads on every core)"
+    )
+    print(
+        f"Monte Carlo: {', '.join(config.participants)}, {config.n:,} successful runs each, seed {config.seed}, "
+        f"load {config.load_direction}, "
+        f"batch {args.batch}, on {where}; run log {args.out}",
+        flush=True,
+    )
+    summary = run_study(
+        config,
+        args.out,
+        batch=args.batch,
+        scheduler=args.scheduler,
+        workers=args.workers,
+        folders=tuple(args.folder or ()),
+        progress=not args.no_progress,
+    )
+    print(summary.line())
+    return 0
+
+
+def montecarlo_report(args) -> int:
+
+    if not Path(args.runs).is_dir():
+        raise UsageError(f"no Monte Carlo run log at {args.runs}")
+    summary = write_report(args.runs, args.out, max_runs=args.max_runs)
+    t5 = summary["table5"]
+    print(
+        f"Table 5: {t5['runs']:,} runs, {t5['rows']:,} rows, fit {t5['fit_seconds']} s; "
+        f"report {summary['report_seconds']} s; written to {args.out}"
+    )
+    return 0
