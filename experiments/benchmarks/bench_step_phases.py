@@ -38,7 +38,7 @@ from wrist_env.solver.simulate import prepare, simulate, stiffness
 from wrist_env.solver.tangent import tangent
 
 FRAME = 8
-SOLVERS = {"default": SolverSettings(), "preconditioned": SolverSettings().preconditioned()}
+SOLVERS = {"diagonal mass": SolverSettings().diagonal(), "block mass (default)": SolverSettings()}
 
 
 @njit(cache=True, error_model="numpy")

@@ -9,7 +9,7 @@ simulation, frames that ran out of hold steps, and the largest centre-of-mass
 distance (mm) and rotation (°) of a moving bone from the reference — median,
 95th percentile, maximum, and the share of designs within 0.1 mm and 0.5°.
 Because a soft design can reach different equilibria by different paths, the
-reference is run twice more along other paths (a quarter of the default's time
+reference is run twice more along other paths (a quarter of the diagonal mass's time
 step, and ramps twice as slow): a design whose three converged runs agree
 within 0.1 mm and 0.5° is path-independent, and the share within is printed
 for those designs too (for the others no run has a converged answer to match).
@@ -19,10 +19,10 @@ are also polished by the quasi-static Newton reference
 answer to the equilibrium nearest it, and the net force left there.
 
 With --frame-local, instead: each frame of each path-independent design run alone from the
-reference's previous frame, by the settings under test and by the defaults (`frame_local`).
+reference's previous frame, by the settings under test and by the diagonal mass (`frame_local`).
 
-Run: `python experiments/verification/solver_accuracy.py [P1 P2 P3] [--designs 100] [--newton 3] [--preconditioned] [--frame-local] [--set dt_s=9e-5 ...]`
-(--set changes the settings under test; the reference stays the default's, with the same
+Run: `python experiments/verification/solver_accuracy.py [P1 P2 P3] [--designs 100] [--newton 3] [--diagonal] [--frame-local] [--set dt_s=9e-5 ...]`
+(--set changes the settings under test; the reference stays the diagonal mass's (`BASELINE`), with the same
 `smooth_normals`, which changes the answer, not only the path to it).
 References are cached in runs/solver_accuracy/ under a hash of their settings.
 The three reference runs take ~1 min per participant for 100 designs on 2 cores (measured at ee125c8).
@@ -53,6 +53,9 @@ from wrist_env.solver.simulate import prepare, simulate_batch, simulate_frame
 
 CACHE = Path(__file__).resolve().parents[2] / "runs" / "solver_accuracy"  # the repository root's runs/, git-ignored
 TOLERANCE = (0.1, 0.5)  # mm, degrees: issue 13's "answer unchanged"
+BASELINE = SolverSettings().diagonal()
+"""The yardstick's base: the diagonal mass (the default until issue 52). The reference runs are built on it,
+and the settings under test are compared with it on the same designs."""
 
 
 def reference_settings(base: SolverSettings) -> SolverSettings:
@@ -131,13 +134,13 @@ def mcnemar(a: list[bool], b: list[bool]) -> str:
     only_a = sum(x and not y for x, y in zip(a, b))
     only_b = sum(y and not x for x, y in zip(a, b))
     p = binomtest(only_a, only_a + only_b).pvalue if only_a + only_b else 1.0
-    return f"within for the defaults only {only_a}, for the settings under test only {only_b} (McNemar p = {p:.2g})"
+    return f"within for the diagonal mass only {only_a}, for the settings under test only {only_b} (McNemar p = {p:.2g})"
 
 
 def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int, paired: bool = False) -> None:
     model = load_model(name)
     designs = [design.population()] + monte_carlo_designs(n_designs)
-    ref = reference(name, model, designs, replace(SolverSettings(), smooth_normals=settings.smooth_normals))
+    ref = reference(name, model, designs, replace(BASELINE, smooth_normals=settings.smooth_normals))
     for motion, driver in drivers(name, model).items():
         runs = simulate_batch(model, designs, driver, settings)
         both = [i for i, r in enumerate(runs) if r.ok and ref[motion + "_ok"][i]]
@@ -166,9 +169,9 @@ def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int, p
             f"  path-independent designs (reference, quarter step and slow ramps agree): {independent.sum()} of "
             f"{len(independent)}; of them within 0.1 mm and 0.5°: {100 * np.mean(matched):.0f} %"
         )
-        if paired:  # the defaults on the same designs
+        if paired:  # the diagonal mass on the same designs
             defaults = simulate_batch(
-                model, designs, driver, replace(SolverSettings(), smooth_normals=settings.smooth_normals)
+                model, designs, driver, replace(BASELINE, smooth_normals=settings.smooth_normals)
             )
             hits = [
                 defaults[i].ok and within(defaults[i].poses, ref[motion][i], model.com)
@@ -176,7 +179,7 @@ def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int, p
             ]
             d_steps = np.mean([r.steps.sum() for r in defaults])
             print(
-                f"  the defaults: {d_steps:.0f} mean steps ({d_steps / steps.mean():.2f}× the settings under test); "
+                f"  the diagonal mass: {d_steps:.0f} mean steps ({d_steps / steps.mean():.2f}× the settings under test); "
                 f"path-independent within {100 * np.mean(hits):.0f} %; {mcnemar(hits, matched)}"
             )
         for i in tqdm(range(min(n_newton, len(runs))), desc=f"{name} {motion} Newton", leave=False):
@@ -193,14 +196,14 @@ def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int, p
 
 def frame_local(name: str, n_designs: int, settings: SolverSettings) -> None:
     """Each frame of each path-independent design run alone from the reference's previous frame
-    (`simulate.simulate_frame`), by the settings under test and by the defaults: the share of frames
+    (`simulate.simulate_frame`), by the settings under test and by the diagonal mass: the share of frames
     that land within `TOLERANCE` (and within 0.02 mm and 0.1°) of the reference's, the McNemar test on
     the frames, and the mean steps per frame. A solver's error at a frame, apart from the path that led
     there."""
     model = load_model(name)
     designs = [design.population()] + monte_carlo_designs(n_designs)
-    ref = reference(name, model, designs, replace(SolverSettings(), smooth_normals=settings.smooth_normals))
-    defaults = replace(SolverSettings(), smooth_normals=settings.smooth_normals)
+    ref = reference(name, model, designs, replace(BASELINE, smooth_normals=settings.smooth_normals))
+    defaults = replace(BASELINE, smooth_normals=settings.smooth_normals)
     for motion, driver in drivers(name, model).items():
         chosen = np.flatnonzero(path_independent(ref, motion, model.com))
         prepared = {k: prepare(model, s, driver.mode) for k, s in (("test", settings), ("defaults", defaults))}
@@ -226,7 +229,7 @@ def frame_local(name: str, n_designs: int, settings: SolverSettings) -> None:
                     steps[k].append(int(r.steps[1]))
         print(
             f"{name} {motion} frame-local ({len(hits['test'])} frames of {len(chosen)} path-independent designs): "
-            f"within 0.1 mm and 0.5° — settings under test {100 * np.mean(hits['test']):.1f} %, defaults "
+            f"within 0.1 mm and 0.5° — settings under test {100 * np.mean(hits['test']):.1f} %, diagonal mass "
             f"{100 * np.mean(hits['defaults']):.1f} %; within 0.02 mm and 0.1° — {100 * np.mean(close['test']):.1f} % / "
             f"{100 * np.mean(close['defaults']):.1f} %; steps per frame {np.mean(steps['test']):.0f} / "
             f"{np.mean(steps['defaults']):.0f}\n  {mcnemar(hits['defaults'], hits['test'])}"
@@ -240,24 +243,24 @@ def main(argv=None) -> None:
     parser.add_argument("--newton", type=int, default=3, help="designs polished by the Newton reference")
     parser.add_argument("--set", nargs="*", default=[], metavar="FIELD=VALUE", help="settings under test")
     parser.add_argument(
-        "--preconditioned", action="store_true", help="test SolverSettings().preconditioned() (the block mass)"
+        "--diagonal", action="store_true", help="test SolverSettings().diagonal() instead of the defaults (the block mass)"
     )
     parser.add_argument(
         "--frame-local",
         action="store_true",
-        help="only the frame-local comparison (`frame_local`), against the defaults",
+        help="only the frame-local comparison (`frame_local`), against the diagonal mass",
     )
     args = parser.parse_args(argv)
     changes = {k: ast.literal_eval(v) for k, v in (item.split("=", 1) for item in args.set)}
-    base = SolverSettings().preconditioned() if args.preconditioned else SolverSettings()
+    base = BASELINE if args.diagonal else SolverSettings()
     settings = replace(base, **changes)
-    under = ("the block mass" if args.preconditioned else "the defaults") + (f" with {changes}" if changes else "")
-    print(f"settings under test: {under}; reference: {reference_settings(SolverSettings())}")
+    under = ("the diagonal mass" if args.diagonal else "the defaults (the block mass)") + (f" with {changes}" if changes else "")
+    print(f"settings under test: {under}; reference: {reference_settings(BASELINE)}")
     for name in args.participants:
         if args.frame_local:
             frame_local(name, args.designs, settings)
             continue
-        report(name, args.designs, settings, args.newton, paired=args.preconditioned or bool(changes))
+        report(name, args.designs, settings, args.newton, paired=not args.diagonal or bool(changes))
 
 
 if __name__ == "__main__":

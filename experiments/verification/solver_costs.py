@@ -2,8 +2,8 @@
 
 Reads every design the committed benchmark logged (`leaderboards/iohanalyzer/*/data_*/*.dat`: each
 calibrator's improving designs, 22 normalized materials in [-1, 1], injuries intact) and scores each
-on the participant's calibration trial with today's default solver and with the block mass
-(`SolverSettings().preconditioned()`), batched. Prints per participant: designs, Spearman's ρ and
+on the participant's calibration trial with the diagonal mass (`SolverSettings().diagonal()`, the default until issue 52)
+and with the block mass (the defaults), batched. Prints per participant: designs, Spearman's ρ and
 Kendall's τ of the two costs, the median and largest |Δ cost|, the share of designs whose cost moves
 by more than 1 %, and the simulations that failed under one solver only.
 
@@ -46,13 +46,13 @@ def costs(participant: str, settings: SolverSettings, xs: np.ndarray) -> np.ndar
 
 def main(participants: list[str]) -> None:
     print(
-        "| participant | designs | Spearman ρ | Kendall τ | median / largest abs Δ cost | moved > 1 % | failed: default only / block only |"
+        "| participant | designs | Spearman ρ | Kendall τ | median / largest abs Δ cost | moved > 1 % | failed: diagonal only / block only |"
     )
     print("|---|---|---|---|---|---|---|")
     for p in participants:
         xs = logged_designs(p)
-        a = costs(p, SolverSettings(), xs)
-        b = costs(p, SolverSettings().preconditioned(), xs)
+        a = costs(p, SolverSettings().diagonal(), xs)
+        b = costs(p, SolverSettings(), xs)
         ok = np.isfinite(a) & np.isfinite(b)
         rho = stats.spearmanr(a[ok], b[ok]).statistic
         tau = stats.kendalltau(a[ok], b[ok]).statistic

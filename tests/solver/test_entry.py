@@ -15,13 +15,13 @@ from wrist_env.solver.settings import SolverSettings
 @pytest.mark.parametrize(
     "settings, expected",
     [
-        (SolverSettings(), kernel.run),
-        (SolverSettings().preconditioned(), kernel.run_preconditioned),
-        (replace(SolverSettings(), block_mass=True), kernel.run_preconditioned),
-        (replace(SolverSettings(), membrane_substeps=3), kernel.run_preconditioned),
-        (replace(SolverSettings(), predict=True), kernel.run_preconditioned),
-        (replace(SolverSettings(), smooth_normals=False), kernel.run_trilinear),
-        (replace(SolverSettings().preconditioned(), smooth_normals=False), kernel.run_trilinear_preconditioned),
+        (SolverSettings().diagonal(), kernel.run),
+        (SolverSettings(), kernel.run_preconditioned),
+        (replace(SolverSettings().diagonal(), block_mass=True), kernel.run_preconditioned),
+        (replace(SolverSettings().diagonal(), membrane_substeps=3), kernel.run_preconditioned),
+        (replace(SolverSettings().diagonal(), predict=True), kernel.run_preconditioned),
+        (replace(SolverSettings().diagonal(), smooth_normals=False), kernel.run_trilinear),
+        (replace(SolverSettings(), smooth_normals=False), kernel.run_trilinear_preconditioned),
     ],
 )
 def test_each_setting_picks_the_entry_point_that_can_run_it(settings, expected):
@@ -30,13 +30,14 @@ def test_each_setting_picks_the_entry_point_that_can_run_it(settings, expected):
 
 def test_a_default_simulation_compiles_one_entry_point_and_workers_compile_none(tmp_path):
     """In a fresh process, starting local workers warms the default solver's entry point in the parent
-    (`kernel.run`, and no other entry point), and a worker's first simulation loads it from Numba's cache
+    (`kernel.run_preconditioned`, and no other entry point), and a worker's first simulation loads it from Numba's cache
     instead of compiling it."""
     (tmp_path / "probe.py").write_text(
         "def first_simulation():\n"
         "    from wrist_env.solver import kernel, simulate\n"
         "    simulate.warm()\n"
-        "    return sum(kernel.run.stats.cache_hits.values()), sum(kernel.run.stats.cache_misses.values())\n"
+        "    entry = kernel.run_preconditioned\n"
+        "    return sum(entry.stats.cache_hits.values()), sum(entry.stats.cache_misses.values())\n"
     )
     (tmp_path / "main.py").write_text(
         "from probe import first_simulation\n"
@@ -51,5 +52,5 @@ def test_a_default_simulation_compiles_one_entry_point_and_workers_compile_none(
     done = subprocess.run([sys.executable, "main.py"], cwd=tmp_path, capture_output=True, text=True)
     assert done.returncode == 0, done.stderr[-3000:]
     compiled, loaded = done.stdout.splitlines()[:2]
-    assert compiled == "run"
+    assert compiled == "run_preconditioned"
     assert loaded == "1 0"  # the worker: one cache hit, no compilation

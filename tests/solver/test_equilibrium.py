@@ -43,7 +43,7 @@ def two_bundles_mid_oscillation():
     l0 = np.array([abs(p) / materials[g][1] for g, p in fib])
     K = np.array([materials[g][0] * l for (g, _), l in zip(fib, l0)])
     settings = replace(
-        undamped(SolverSettings()),
+        undamped(SolverSettings().diagonal()),
         dt_s=1e-6,
         settle_steps=0,
         move_steps=0,

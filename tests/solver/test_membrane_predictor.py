@@ -14,7 +14,7 @@ from wrist_env.solver.predictor import MAX_RATIO, capitate_move, history, predic
 from wrist_env.solver.settings import SolverSettings
 from wrist_env.solver.simulate import prepare, simulate, stiffness
 
-PRECONDITIONED = SolverSettings().preconditioned()
+PRECONDITIONED = SolverSettings()
 
 
 def _shaken_neutral(model, shake_mm, seed):
@@ -137,16 +137,16 @@ def test_the_predictor_needs_two_equilibria_and_a_moving_capitate():
     assert np.isclose(capitate_move(np.array([0.0, 0.1, 0.0]), np.array([3.0, 4.0, 0.0])), 1.0 + 5.0)
 
 
-def test_the_predicted_sweep_settles_every_frame_on_the_default_answer(p1):
-    """P1's population sweep under the preconditioned solver (predictor, subcycled membrane): every
-    frame settles within 0.02 mm and 0.15° of the default solver's answer, and frames 2 on (the ones
+def test_the_predicted_sweep_settles_every_frame_on_the_diagonal_mass_answer(p1):
+    """P1's population sweep under the default solver (block mass, predictor, subcycled membrane): every
+    frame settles within 0.02 mm and 0.15° of the diagonal mass's answer, and frames 2 on (the ones
     predicted) take fewer steps than without the predictor."""
     from dataclasses import replace
 
     from wrist_env.solver.equilibrium import distance
 
     driver = idealized(p1)
-    default = simulate(p1, design.population(), driver)
+    default = simulate(p1, design.population(), driver, SolverSettings().diagonal())
     predicted = simulate(p1, design.population(), driver, PRECONDITIONED)
     plain = simulate(p1, design.population(), driver, replace(PRECONDITIONED, predict=False))
     assert predicted.ok and predicted.settled.all(), predicted.message
@@ -167,7 +167,7 @@ def test_a_frame_run_alone_from_the_previous_answer_lands_on_the_same_answer(p1)
 
     driver = experimental(p1, registry.trial("P1", "calibrate").pose("capitate"))
     run = simulate(p1, design.population(), driver)
-    for settings in (None, PRECONDITIONED):
+    for settings in (SolverSettings().diagonal(), PRECONDITIONED):
         alone = simulate_frame(p1, design.population(), driver, 6, run.poses[5], run.membrane_nodes[5], settings)
         assert alone.ok and alone.settled[1] and np.isnan(alone.poses[0]).all()
         d = distance(alone.poses[1:], run.poses[6:7], p1.com)[0]

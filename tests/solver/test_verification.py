@@ -189,7 +189,7 @@ def test_fibres_oscillate_as_solve_ivp_predicts(case, mass_scale):
     period_guess = 2 * np.pi / omega + 2 * coast
     dt = period_guess / 1500
     settings = sampled_every(
-        replace(undamped(SolverSettings()), dt_s=dt, mass_scale=mass_scale, inertia_scale=1.0, max_disp_mm=1e3), 4
+        replace(undamped(SolverSettings().diagonal()), dt_s=dt, mass_scale=mass_scale, inertia_scale=1.0, max_disp_mm=1e3), 4
     )
     n_frames = int(3.2 * period_guess / (4 * dt))
     result = simulate(model, dsg, experimental(model, np.tile(np.eye(4), (n_frames, 1, 1))), settings)
@@ -385,14 +385,17 @@ def test_moved_model_is_the_same_geometry(p1, move):
 
 @pytest.mark.parametrize("move", list(MOVES))
 def test_rigidly_moved_model_gives_the_same_relative_kinematics(p1, move):
-    """P1 (ground-truth design, default settings, experimental driver) moved rigidly by G
+    """P1 (ground-truth design, the diagonal mass, experimental driver) moved rigidly by G
     (a turn about a coordinate axis, so the axis-aligned float32 grids are permuted exactly,
     plus a translation) with the capitate driven by G T G⁻¹: the scaphoid, lunate and
     capitate poses relative to the radius, mapped back (G⁻¹ P G), match the unmoved run's
     within 1e-5 mm (centre of mass) and 1e-4°; contact outputs and bundle forces within
     1e-5 of their largest values. Only float64 round-off differs between the runs (with the free
     radial column and the TFCC's soft layer it reaches 3e-6 mm and 3e-5°; five bodies kept it under
-    1e-6 mm and 1e-5°)."""
+    1e-6 mm and 1e-5°). The block mass (the default solver) takes its path from round-off too: its
+    rebuilds and FIRE's restarts fall on other steps (340 steps against 335), so its answers agree only
+    within the equilibrium tolerance (measured 5e-4 mm, 6e-3°); this test is of the physics' frame
+    independence, so it runs the diagonal mass."""
     (axis, turns), t = MOVES[move]
     Q = syn.rotation_90(axis, turns)
     G = homogeneous(Q, t)
@@ -400,8 +403,9 @@ def test_rigidly_moved_model_gives_the_same_relative_kinematics(p1, move):
     moved = syn.transformed(p1, Q, t)
     T = capitate_motion(p1)
     dsg = truth("P1")
-    a = simulate(p1, dsg, experimental(p1, T))
-    b = simulate(moved, dsg, experimental(moved, G @ T @ G_inv))
+    diagonal = SolverSettings().diagonal()
+    a = simulate(p1, dsg, experimental(p1, T), diagonal)
+    b = simulate(moved, dsg, experimental(moved, G @ T @ G_inv), diagonal)
     assert a.ok and b.ok, (a.message, b.message)
     back = G_inv @ b.poses @ G
     scaphoid_turn = np.degrees(np.linalg.norm(Rotation.from_matrix(a.poses[:, SCAPHOID, :3, :3]).as_rotvec(), axis=1))

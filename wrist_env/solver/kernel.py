@@ -249,7 +249,7 @@ def _stage(f, R0, x0, frame_R, frame_x, frame_load, st):
 def run(bod, grids, law, fib, mem, st, stiffness, frames, out, R, x, nodes, first):
     """Simulate one design (`Stiffness`) of the model whose `arrays.System` is (bod, grids, law, fib,
     mem, st) through the capitate's `Frames` from the state (R, x, nodes), its stages from `first`
-    (`_run`): smooth contact normals, the scaled physical mass (`SolverSettings()`).
+    (`_run`): smooth contact normals, the scaled physical mass (`SolverSettings().diagonal()`).
 
     One compiled entry point serves single runs and batches alike (`simulate.simulate_batch` runs
     designs on threads: `nogil`); it takes the System flat, as it takes `Frames`. `entry(settings)`
@@ -260,14 +260,14 @@ def run(bod, grids, law, fib, mem, st, stiffness, frames, out, R, x, nodes, firs
 @njit(cache=True, error_model="numpy", nogil=True)
 def run_preconditioned(bod, grids, law, fib, mem, st, stiffness, frames, out, R, x, nodes, first):
     """`run` with the block mass, the membrane's substeps and the predictor compiled in (each on where
-    its setting says: `SolverSettings.preconditioned()`)."""
+    its setting says: the defaults, `SolverSettings()`)."""
     _run(System(bod, grids, law, fib, mem, st), stiffness, frames, out, R, x, nodes, first, True, True)
 
 
 @njit(cache=True, error_model="numpy", nogil=True)
 def run_trilinear(bod, grids, law, fib, mem, st, stiffness, frames, out, R, x, nodes, first):
     """`run` with the trilinear interpolant's own gradient as the contact normal
-    (`SolverSettings(smooth_normals=False)`)."""
+    (`SolverSettings(smooth_normals=False).diagonal()`)."""
     _run(System(bod, grids, law, fib, mem, st), stiffness, frames, out, R, x, nodes, first, False, False)
 
 

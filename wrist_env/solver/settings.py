@@ -38,27 +38,41 @@ class SolverSettings:
     (`predictor`), ramping the capitate over predict_ramp_steps instead of
     ramp_steps, where that lowers the residual (the trials' measured poses
     are too noisy to extrapolate: their holds then lock up, measured in the
-    README). `preconditioned()` turns these on with the stages they need.
+    README).
+    The defaults (issue 32; the default since issue 52) are the block mass, the
+    membrane's nodes subcycled 7 steps a step and the secant predictor, with the
+    stages they need: ramps of 10 steps, a 60-step move to the first pose (30
+    lands P1's and P3's 40° flexion on another equilibrium), at most 150
+    settling steps, FIRE's α₀ 0.2, no fibre damping (a viscous term in seconds
+    that the block mass's light directions cannot carry: dt·c/m =
+    fibre_damping_s / dt_s · block_courant² > 2 at block_courant 1), the mass
+    rebuilt every 20 steps and at each stage but not after FIRE's restarts (a
+    rebuild costs ~3 steps; rebuilding at the restarts too cost 1.15–1.7× the
+    time for about the same steps). Each frame lands as close to a converged
+    answer as the diagonal mass's (`diagonal()`) in 2.5–3× fewer steps
+    (`experiments/verification/solver_accuracy.py --frame-local`; docs/solver.md).
     mass_scale, inertia_scale: mass scaling of the free bones (inertia_scale
     multiplies rotational inertia on top of mass_scale). node_mass_t: the mass
     of the RSC membrane's free nodes, raised per design where its connectors
     are too stiff for dt_s (`node_mass`). active_band_mm: a
     contact sample is looked up every step while it is within this distance
     of contact (a pair's set is refilled once its samples may have moved half
-    of it: `forces.contact_forces`).
+    of it: `forces.contact_forces`); the rule is exact for bands below
+    2/√3 × the grids' margin (`BuildParams.grid_margin_mm`, 3 mm: 3.5 mm), since
+    a sample outside its grid reads `contact.OUTSIDE_MM` until a refill.
     """
 
     dt_s: float = 6e-5
-    settle_steps: int = 800
-    move_steps: int = 200
-    ramp_steps: int = 60
+    settle_steps: int = 150
+    move_steps: int = 60
+    ramp_steps: int = 10
     min_hold_steps: int = 10
     max_hold_steps: int = 1600
     tolerance: float = 0.001
     force_floor_n: float = 0.01
     damping_per_s: float = 100.0
     rot_damping_per_s: float = 100.0
-    fibre_damping_s: float = 2e-4
+    fibre_damping_s: float = 0.0
     mass_scale: float = 10.0
     inertia_scale: float = 2.0
     active_band_mm: float = 0.15
@@ -66,41 +80,38 @@ class SolverSettings:
     membrane_contact_stiffness: float = 50.0
     max_disp_mm: float = 15.0
     max_rot_deg: float = 75.0
-    fire_alpha0: float = 0.1
+    fire_alpha0: float = 0.2
     smooth_normals: bool = True
-    block_mass: bool = False
+    block_mass: bool = True
     block_courant: float = 0.8
     block_floor: float = 0.1
-    block_refresh_steps: int = 10
+    block_refresh_steps: int = 20
     block_max_move_mm: float = 0.3
-    membrane_substeps: int = 0
+    membrane_substeps: int = 7
     membrane_substep_damping_per_s: float = 2000.0
-    block_refresh_restart: bool = True
-    predict: bool = False
+    block_refresh_restart: bool = False
+    predict: bool = True
     predict_ramp_steps: int = 0
 
-    def preconditioned(self) -> "SolverSettings":
-        """These settings with the block mass (`preconditioner`), the membrane's nodes subcycled 7
-        steps a step (`membrane`) and the secant predictor (`predictor`), and the stages they need:
-        ramps of 10 steps, a 60-step move to the first pose (30 lands P1's and P3's 40° flexion on
-        another equilibrium), at most 150 settling steps, FIRE's α₀ 0.2, no fibre damping (a viscous
-        term in seconds that the block mass's light directions cannot carry: dt·c/m = fibre_damping_s
-        / dt_s · block_courant² > 2 at block_courant 1), the mass rebuilt every 20 steps and at each
-        stage but not after FIRE's restarts (a rebuild costs ~3 steps; rebuilding at the restarts too
-        cost 1.15–1.7× the time for about the same steps). Measured in `experiments/benchmarks/bench_solver.py`
-        and the README's solver section."""
+    def diagonal(self) -> "SolverSettings":
+        """These settings with each free bone's scaled physical mass and inertia instead of the block mass
+        (the default until issue 52, and the base of the accuracy yardstick's reference runs,
+        `experiments/verification/solver_accuracy.py`): no membrane substeps and no predictor, and the
+        stages they took: 60-step ramps, a 200-step move to the first pose, at most 800 settling steps,
+        FIRE's α₀ 0.1, fibre damping 2e-4 s, and (were the block mass turned on) a rebuild every 10 steps
+        and after FIRE's restarts."""
         return replace(
             self,
-            block_mass=True,
-            fibre_damping_s=0.0,
-            fire_alpha0=0.2,
-            settle_steps=150,
-            move_steps=60,
-            ramp_steps=10,
-            block_refresh_steps=20,
-            block_refresh_restart=False,
-            membrane_substeps=7,
-            predict=True,
+            block_mass=False,
+            fibre_damping_s=2e-4,
+            fire_alpha0=0.1,
+            settle_steps=800,
+            move_steps=200,
+            ramp_steps=60,
+            block_refresh_steps=10,
+            block_refresh_restart=True,
+            membrane_substeps=0,
+            predict=False,
         )
 
     def halved(self) -> "SolverSettings":
@@ -116,15 +127,16 @@ class SolverSettings:
         )
 
 
-SOLVERS = ("default", "preconditioned")
-"""The named solver settings: today's defaults, and `SolverSettings.preconditioned` (opt-in, issue 32)."""
+SOLVERS = ("default", "diagonal")
+"""The named solver settings: the defaults (the block mass, issue 32, the default since issue 52) and
+`SolverSettings.diagonal` (each bone's scaled physical mass: the default before)."""
 
 
 def solver_settings(name: str) -> SolverSettings:
     """The settings of a solver in `SOLVERS`."""
     if name not in SOLVERS:
         raise ValueError(f"solver must be one of {SOLVERS}, but got {name!r}")
-    return SolverSettings().preconditioned() if name == "preconditioned" else SolverSettings()
+    return SolverSettings().diagonal() if name == "diagonal" else SolverSettings()
 
 
 LOAD_DIRECTIONS = ("axial", "erhart2020", "erhart2020_groups")

@@ -17,6 +17,7 @@ from wrist_env.model import N_BODIES, PAIRS, Model
 from wrist_env.solver import arrays, kernel
 from wrist_env.solver.drivers import Driver, static
 from wrist_env.solver.rigid import pose_state
+from wrist_env.solver.settings import SolverSettings
 
 if TYPE_CHECKING:
     pass
@@ -106,9 +107,9 @@ class Prepared:
             )
 
 
-def prepare(model: Model, settings: arrays.SolverSettings | None = None, mode: int = arrays.EXPERIMENTAL) -> Prepared:
+def prepare(model: Model, settings: SolverSettings | None = None, mode: int = arrays.EXPERIMENTAL) -> Prepared:
     """The kernel arrays of `model` under `settings` (default `SolverSettings()`) for drivers of `mode`."""
-    s = settings or arrays.SolverSettings()
+    s = settings or SolverSettings()
     grd = arrays.grids(model, s.smooth_normals)
     mem = arrays.membrane(model, grd)
     return Prepared(
@@ -141,7 +142,7 @@ def simulate(
     model: Model,
     design: Design,
     driver: Driver,
-    settings: arrays.SolverSettings | None = None,
+    settings: SolverSettings | None = None,
     *,
     prepared: Prepared | None = None,
 ) -> Result:
@@ -170,7 +171,7 @@ def simulate_frame(
     frame: int,
     poses: np.ndarray,
     nodes: np.ndarray,
-    settings: arrays.SolverSettings | None = None,
+    settings: SolverSettings | None = None,
     *,
     prepared: Prepared | None = None,
 ) -> Result:
@@ -200,7 +201,7 @@ def simulate_batch(
     model: Model,
     designs: Iterable[Design],
     driver: Driver,
-    settings: arrays.SolverSettings | None = None,
+    settings: SolverSettings | None = None,
     *,
     prepared: Prepared | None = None,
 ) -> list[Result]:
@@ -242,7 +243,7 @@ def _result(out: kernel.Outputs, driver: Driver, status: int) -> Result:
     )
 
 
-def warm(settings: arrays.SolverSettings | None = None) -> None:
+def warm(settings: SolverSettings | None = None) -> None:
     """Compile (or load from Numba's cache) the kernel entry point for `settings` (default
     `SolverSettings()`) by simulating built-in P1 held at neutral for one frame: called before local
     worker processes start, so that they load the compiled kernel instead of each compiling it."""
