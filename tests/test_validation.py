@@ -182,9 +182,7 @@ def test_the_default_solver_validates_like_the_diagonal_mass(built):
     from wrist_env.solver.settings import solver_settings
 
     model = built("P1")
-    reports = [
-        validation.validate("P1", model=model, settings=solver_settings(s)) for s in ("diagonal", "default")
-    ]
+    reports = [validation.validate("P1", model=model, settings=solver_settings(s)) for s in ("diagonal", "default")]
     for check in ("scaphoid_slope", "lunate_slope", "scaphoid_above_lunate", "rs_rl_force_ratio"):
         a, b = (r.row(check).value for r in reports)
         assert abs(a - b) < 0.01, (check, a, b)

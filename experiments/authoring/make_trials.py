@@ -45,7 +45,9 @@ from wrist_env.trial import Trial, write_trial_csv
 DATA = Path(__file__).resolve().parents[2] / "wrist_env" / "participants" / "data"
 N_FRAMES = 15
 HIGH_FIDELITY_BUILD = BuildParams(contact_spacing_mm=0.7)
-HIGH_FIDELITY_SOLVER = replace(SolverSettings().diagonal().halved(), tolerance=1e-4, force_floor_n=1e-3, max_hold_steps=6400)
+HIGH_FIDELITY_SOLVER = replace(
+    SolverSettings().diagonal().halved(), tolerance=1e-4, force_floor_n=1e-3, max_hold_steps=6400
+)
 NOISE_MM, NOISE_DEG = builtin.TRACKING_NOISE_MM, builtin.TRACKING_NOISE_DEG
 LOAD_N = {"unresisted": 10.0, "resisted": 40.0}
 GRIP_PEAK_N = {"unresisted": 60.0, "resisted": 120.0}

@@ -134,7 +134,9 @@ def mcnemar(a: list[bool], b: list[bool]) -> str:
     only_a = sum(x and not y for x, y in zip(a, b))
     only_b = sum(y and not x for x, y in zip(a, b))
     p = binomtest(only_a, only_a + only_b).pvalue if only_a + only_b else 1.0
-    return f"within for the diagonal mass only {only_a}, for the settings under test only {only_b} (McNemar p = {p:.2g})"
+    return (
+        f"within for the diagonal mass only {only_a}, for the settings under test only {only_b} (McNemar p = {p:.2g})"
+    )
 
 
 def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int, paired: bool = False) -> None:
@@ -170,9 +172,7 @@ def report(name: str, n_designs: int, settings: SolverSettings, n_newton: int, p
             f"{len(independent)}; of them within 0.1 mm and 0.5°: {100 * np.mean(matched):.0f} %"
         )
         if paired:  # the diagonal mass on the same designs
-            defaults = simulate_batch(
-                model, designs, driver, replace(BASELINE, smooth_normals=settings.smooth_normals)
-            )
+            defaults = simulate_batch(model, designs, driver, replace(BASELINE, smooth_normals=settings.smooth_normals))
             hits = [
                 defaults[i].ok and within(defaults[i].poses, ref[motion][i], model.com)
                 for i in np.flatnonzero(independent)
@@ -243,7 +243,9 @@ def main(argv=None) -> None:
     parser.add_argument("--newton", type=int, default=3, help="designs polished by the Newton reference")
     parser.add_argument("--set", nargs="*", default=[], metavar="FIELD=VALUE", help="settings under test")
     parser.add_argument(
-        "--diagonal", action="store_true", help="test SolverSettings().diagonal() instead of the defaults (the block mass)"
+        "--diagonal",
+        action="store_true",
+        help="test SolverSettings().diagonal() instead of the defaults (the block mass)",
     )
     parser.add_argument(
         "--frame-local",
@@ -254,7 +256,9 @@ def main(argv=None) -> None:
     changes = {k: ast.literal_eval(v) for k, v in (item.split("=", 1) for item in args.set)}
     base = BASELINE if args.diagonal else SolverSettings()
     settings = replace(base, **changes)
-    under = ("the diagonal mass" if args.diagonal else "the defaults (the block mass)") + (f" with {changes}" if changes else "")
+    under = ("the diagonal mass" if args.diagonal else "the defaults (the block mass)") + (
+        f" with {changes}" if changes else ""
+    )
     print(f"settings under test: {under}; reference: {reference_settings(BASELINE)}")
     for name in args.participants:
         if args.frame_local:

@@ -189,7 +189,10 @@ def test_fibres_oscillate_as_solve_ivp_predicts(case, mass_scale):
     period_guess = 2 * np.pi / omega + 2 * coast
     dt = period_guess / 1500
     settings = sampled_every(
-        replace(undamped(SolverSettings().diagonal()), dt_s=dt, mass_scale=mass_scale, inertia_scale=1.0, max_disp_mm=1e3), 4
+        replace(
+            undamped(SolverSettings().diagonal()), dt_s=dt, mass_scale=mass_scale, inertia_scale=1.0, max_disp_mm=1e3
+        ),
+        4,
     )
     n_frames = int(3.2 * period_guess / (4 * dt))
     result = simulate(model, dsg, experimental(model, np.tile(np.eye(4), (n_frames, 1, 1))), settings)
