@@ -92,14 +92,20 @@ def main() -> None:
         lines.append(row)
     print("\n".join(lines))
     if args.out:
-        made = " ".join(["python", "experiments/benchmarks/bench_cold_start.py", *sys.argv[1:]])
-        about = [f"this: {_commit(HERE)}"] + ([f"against: {_commit(trees['against'])}"] if args.against else [])
-        head = (
-            f"Measured by `{made}` on {time.strftime('%Y-%m-%d')}, {os.cpu_count()} cores, Python "
-            f"{sys.version.split()[0]}; {'; '.join(about)}.\n\n"
-        )
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text(head + "\n".join(lines) + "\n")
+        write_table(args.out, "bench_cold_start.py", trees, lines)
+
+
+def write_table(out: Path, script: str, trees: dict[str, Path], lines: list[str]) -> None:
+    """Write a comparison table (Markdown `lines`) to `out`, headed by the command that made it, the date,
+    the machine and each checkout's commit."""
+    made = " ".join(["python", f"experiments/benchmarks/{script}", *sys.argv[1:]])
+    about = [f"{name}: {_commit(tree)}" for name, tree in trees.items()]
+    head = (
+        f"Measured by `{made}` on {time.strftime('%Y-%m-%d')}, {os.cpu_count()} cores, Python "
+        f"{sys.version.split()[0]}; {'; '.join(about)}.\n\n"
+    )
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(head + "\n".join(lines) + "\n")
 
 
 def _commit(tree: Path) -> str:

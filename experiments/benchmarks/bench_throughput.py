@@ -21,16 +21,14 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
-import os
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_cold_start import HERE, _commit, _run  # noqa: E402  (experiments/benchmarks/bench_cold_start.py)
+from bench_cold_start import HERE, _run, write_table  # noqa: E402  (experiments/benchmarks/bench_cold_start.py)
 
 PROBE = """
 import json, sys, time
@@ -103,14 +101,7 @@ def main() -> None:
             lines.append(row)
     print("\n".join(lines))
     if args.out:
-        made = " ".join(["python", "experiments/benchmarks/bench_throughput.py", *sys.argv[1:]])
-        about = [f"this: {_commit(HERE)}"] + ([f"against: {_commit(trees['against'])}"] if args.against else [])
-        head = (
-            f"Measured by `{made}` on {time.strftime('%Y-%m-%d')}, {os.cpu_count()} cores, Python "
-            f"{sys.version.split()[0]}; {'; '.join(about)}.\n\n"
-        )
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text(head + "\n".join(lines) + "\n")
+        write_table(args.out, "bench_throughput.py", trees, lines)
 
 
 if __name__ == "__main__":
