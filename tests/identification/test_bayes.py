@@ -100,7 +100,7 @@ def test_the_command_samples_p1_and_writes_coverage_and_figures(built, tmp_path,
     """`wrist-bench posterior P1` with a short chain: a saved posterior per seed, coverage in [0, 1],
     the intervals and predictive figures; rerun, it loads instead of sampling."""
     built("P1")
-    args = ["posterior", "P1", "--seeds", "1", "--walkers", "48", "--steps", "8", "--map-starts", "2"]
+    args = ["posterior", "P1", "--seeds", "1", "--walkers", "48", "--steps", "8", "--map-starts", "1"]
     args += ["--out", str(tmp_path)]
     assert main(args) == 0
     import pandas as pd
@@ -112,7 +112,7 @@ def test_the_command_samples_p1_and_writes_coverage_and_figures(built, tmp_path,
     post = posterior.Posterior.load(tmp_path / "posterior_P1_seed0.npz")
     assert post.samples.shape == (4 * 48, design.N_MATERIAL) and post.predictive.shape[:3] == (2, 3, 2)
     assert json.loads((tmp_path / "posterior_P1_seed0.json").read_text())["fields"]["evaluations"] == post.evaluations
-    assert post.settings == {"walkers": 48, "steps": 8, "map_starts": 2, "prior_refresh": PRIOR_REFRESH}
+    assert post.settings == {"walkers": 48, "steps": 8, "map_starts": 1, "prior_refresh": PRIOR_REFRESH}
     capsys.readouterr()
     assert main(args) == 0
     assert "loaded" in capsys.readouterr().out
@@ -160,7 +160,7 @@ def test_the_command_runs_smc_and_keeps_its_own_files(built, tmp_path, capsys):
     samples that all satisfy the prior box, each with its own log posterior, stages and evidence in
     its JSON, an `_smc` table."""
     built("P1")
-    args = ["posterior", "P1", "--sampler", "smc", "--particles", "44", "--mcmc-steps", "1", "--map-starts", "2"]
+    args = ["posterior", "P1", "--sampler", "smc", "--particles", "44", "--mcmc-steps", "1", "--map-starts", "1"]
     args += ["--out", str(tmp_path)]
     assert main(args) == 0
     post = posterior.Posterior.load(tmp_path / "posterior_P1_seed0_smc.npz")
