@@ -20,6 +20,7 @@ from wrist_env.anatomy.template import closed, load_template
 from wrist_env.builder import cartilage, contact_law, fibres, mass, morph, sdf
 from wrist_env.builder.contact_samples import _contact_samples, _seat_samples
 from wrist_env.builder.digest import source_hash
+from wrist_env.builder.handedness import check_side
 from wrist_env.builder.params import BuildParams
 from wrist_env.builder.surface import displaced_vertices, extrusion_directions, gap_to, grnn_smooth
 from wrist_env.design import ALL_LIGAMENTS, COLUMN_LIGAMENTS, LIGAMENT_NAMES, LIGAMENTS, RSC_INDEX
@@ -194,6 +195,7 @@ def build_model(
         bar.set_postfix_str(BUILD_STEPS[following] if following < len(BUILD_STEPS) else "done")
 
     bones = {**bones, "ulna": closed(bones["ulna"])}  # an open ulna's head, closed for its grid (the TFCC)
+    check_side(name, load_template(*params.anatomy).bones, bones, params.seed)  # before the minute of morphing
     morphs, morph_report = _morph_all(bones, params, workers)
     lap("morph")
     coverage, sites, relocated = _transfer(morphs, bones, params)
