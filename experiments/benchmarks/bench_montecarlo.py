@@ -12,16 +12,25 @@ after a warm-up chunk that loads the model and Numba's cache, and prints:
   beside the preprint's 13 days.
 
 Run: `python experiments/benchmarks/bench_montecarlo.py [--n 500] [--batch 64] [--workers 0]
-[--participants P1] [--scheduler ADDRESS]`. Compare `--workers 0` (one process, a batch's designs on
-one thread per core) with `--workers 2` (two processes, one thread each). On a shared machine expect
-±15 %.
+[--participants P1] [--scheduler ADDRESS] [--against PATH --rounds 2 --out FILE]`. Compare `--workers 0`
+(one process, a batch's designs on one thread per core) with `--workers 2` (two processes, one thread
+each). With `--against PATH` (another checkout, e.g. a worktree of main) the same study runs in a fresh
+process of each checkout in turn (A B A B …), each over its own warm Numba cache, and a table gives the
+medians and their ratio this / against (`--out`: also as Markdown, with both commits). On a shared
+machine expect ±15 %.
 """
 
 from __future__ import annotations
 
 import argparse
+import hashlib
+import json
+import sys
 import tempfile
 import time
+from pathlib import Path
+
+import numpy as np
 
 PREPRINT_SECONDS = 13 * 24 * 3600.0
 FULL = 2 * 12_500
@@ -35,8 +44,17 @@ def main(argv=None) -> int:
     p.add_argument("--batch", type=int, default=64)
     p.add_argument("--workers", type=int, default=0)
     p.add_argument("--scheduler")
-    p.add_argument("--out", help="keep the log here (default: a temporary folder)")
+    p.add_argument(
+        "--out", help="keep the log here (default: a temporary folder); with --against: the table (Markdown)"
+    )
+    p.add_argument("--against", type=Path, help="another checkout to compare with, in turn")
+    p.add_argument(
+        "--rounds", type=int, default=2, help="with --against: studies of each checkout, in turn (default 2)"
+    )
+    p.add_argument("--json", action="store_true", help="print the figures as one JSON line (what --against reads)")
     args = p.parse_args(argv)
+    if args.against:
+        return _compare(args, argv if argv is not None else sys.argv[1:])
 
     import numba
 
@@ -61,6 +79,14 @@ def main(argv=None) -> int:
         if args.workers
         else f"one process, {numba.get_num_threads()} Numba threads"
     )
+    if args.json:
+        figures = {
+            "simulations/s": rate,
+            "excluded and failed, %": 100 * bad,
+            "projected 2 x 12,500 successful runs, min": projected / 60,
+        }
+        print(json.dumps(figures))
+        return 0
     print(
         f"Monte Carlo {', '.join(args.participants)}, n = {args.n} each, seed {args.seed}, batch {args.batch}, {mode}"
     )
@@ -74,6 +100,42 @@ def main(argv=None) -> int:
         f"projected 2 x 12,500 successful runs: {projected / 60:.1f} min "
         f"(preprint: 13 days, {PREPRINT_SECONDS / projected:,.0f}x faster)"
     )
+    return 0
+
+
+def _compare(args, argv: list[str]) -> int:
+    """The study in a fresh process of each checkout in turn (this script, the checkout's package), the
+    medians and their ratio."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from bench_cold_start import HERE, _run, write_table  # experiments/benchmarks/bench_cold_start.py
+
+    own = []  # the study's own arguments: without --against, --rounds and --out
+    skip = {"--against", "--rounds", "--out"}
+    it = iter(argv)
+    for a in it:
+        if a.split("=")[0] in skip:
+            if "=" not in a:
+                next(it, None)
+            continue
+        own.append(a)
+    trees = {"this": HERE, "against": args.against.resolve()}
+    runs = {name: [] for name in trees}
+    for r in range(args.rounds):
+        for name, tree in trees.items():
+            cache = (
+                Path(tempfile.gettempdir()) / f"wrist-env-montecarlo-{hashlib.sha1(str(tree).encode()).hexdigest()[:8]}"
+            )
+            _, out = _run(tree, cache, [str(Path(__file__).resolve()), *own, "--json"])
+            runs[name].append(json.loads(out.strip().splitlines()[-1]))
+            print(f"round {r + 1}/{args.rounds}, {name}: done", file=sys.stderr, flush=True)
+    head = f"Monte Carlo {', '.join(args.participants)}, n = {args.n} each, batch {args.batch}, workers {args.workers}"
+    lines = [f"| {head}: figure (median of {args.rounds}) | this | against | this / against |", "|---|---|---|---|"]
+    for k in runs["this"][0]:
+        this, that = (float(np.median([m[k] for m in runs[name]])) for name in trees)
+        lines.append(f"| {k} | {this:,.2f} | {that:,.2f} | {this / that:.2f} |")
+    print("\n".join(lines))
+    if args.out:
+        write_table(Path(args.out), "bench_montecarlo.py", trees, lines)
     return 0
 
 

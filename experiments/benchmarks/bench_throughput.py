@@ -6,7 +6,8 @@ running that checkout's default solver (`simulate(..., settings=None)`, whatever
 the same designs: 64 Monte Carlo designs (Table 2 normals truncated at ±3 SD, each injurable ligament
 torn with probability 0.3, seed 0, as `bench_solver.py`) batched on every core (`simulate_batch`), and
 the population design alone on one core (median of 5), for the idealized sweep (17 frames) and the
-participant's 15-frame calibration trial. The kernels load from each checkout's warm Numba cache (a
+participant's 15-frame calibration trial, and what the trial rate makes of the default benchmark (3
+participants × 11 calibrators × 5 seeds × 300 evaluations, simulation time only). The kernels load from each checkout's warm Numba cache (a
 warm-up simulation first). Prints each figure's median over the rounds and, with `--against`, the
 ratio this / that; issue 52 asks the batched rates to reach 3× main's.
 
@@ -39,6 +40,7 @@ from wrist_env.solver.drivers import idealized, trial_driver
 from wrist_env.solver.simulate import simulate, simulate_batch
 
 name = sys.argv[1]
+BENCHMARK = 3 * 11 * 5 * 300  # participants x calibrators x seeds x budget: `wrist-bench benchmark`'s defaults
 model = registry.load_model(name)
 rng = np.random.default_rng(0)
 materials = design.sample_materials(64, 0)
@@ -58,6 +60,8 @@ for motion, driver in (("sweep", idealized(model)), ("trial", trial_driver(model
     results = simulate_batch(model, designs, driver)
     out[f"{motion}: 64 designs batched, simulations/s"] = len(designs) / (time.perf_counter() - start)
     out[f"{motion}: 64 designs batched, mean steps"] = float(np.mean([r.steps.sum() for r in results if r.ok]))
+rate = out["trial: 64 designs batched, simulations/s"]
+out["the default benchmark's 49,500 trial evaluations at that rate, min"] = BENCHMARK / rate / 60
 print(json.dumps(out))
 """
 
