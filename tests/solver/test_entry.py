@@ -1,6 +1,7 @@
 """The kernel's compiled entry points (`kernel.entry`): each solver compiles only its own, and local worker
 processes start after their parent compiled it (`simulate.warm`)."""
 
+import os
 import subprocess
 import sys
 from dataclasses import replace
@@ -54,3 +55,36 @@ def test_a_default_simulation_compiles_one_entry_point_and_workers_compile_none(
     compiled, loaded = done.stdout.splitlines()[:2]
     assert compiled == "run_preconditioned"
     assert loaded == "1 0"  # the worker: one cache hit, no compilation
+
+
+@pytest.mark.slow
+def test_the_parts_a_second_process_compiles_are_the_ones_the_entry_point_calls(tmp_path):
+    """`precompile.part_signatures` types the block mass's kernels as `kernel.run_preconditioned` calls
+    them: compiled first (as the second process does), the entry point's own compile reuses each of them
+    and adds no second signature (a mismatch would compile it again, and the second process would save
+    nothing). An empty Numba cache, one process (~1 min)."""
+    probe = (
+        "from wrist_env.solver import precompile, simulate\n"
+        "from wrist_env.solver.settings import SolverSettings\n"
+        "precompile.start = lambda settings: None\n"
+        "precompile.compile_parts(SolverSettings())\n"
+        "simulate.warm()\n"
+        "for dispatcher, _ in precompile.part_signatures(SolverSettings()):\n"
+        "    print(dispatcher.py_func.__name__, len(dispatcher.signatures))\n"
+    )
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, env=env)
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert done.stdout.split() == ["tangent", "1", "substep", "1", "block_mass", "1"]
+
+
+def test_a_second_process_compiles_only_from_an_empty_cache():
+    """`precompile.start` starts nothing for the diagonal mass's entry point (it has no block mass) nor for
+    one this process has compiled or loaded already."""
+    from wrist_env.solver import precompile
+    from wrist_env.solver.simulate import warm
+
+    assert precompile.start(settings_tuple(SolverSettings().diagonal(), EXPERIMENTAL)) is None
+    warm()
+    assert kernel.run_preconditioned.signatures
+    assert precompile.start(settings_tuple(SolverSettings(), EXPERIMENTAL)) is None

@@ -14,7 +14,7 @@ import numpy as np
 
 from wrist_env.design import ALL_LIGAMENT_NAMES, Design, population
 from wrist_env.model import N_BODIES, PAIRS, Model
-from wrist_env.solver import arrays, kernel
+from wrist_env.solver import arrays, kernel, precompile
 from wrist_env.solver.drivers import Driver, static
 from wrist_env.solver.rigid import pose_state
 from wrist_env.solver.settings import SolverSettings
@@ -151,17 +151,16 @@ def simulate(
     prepared: `prepare(model, settings, driver.mode)`, to skip rebuilding the kernel arrays."""
     p = _prepared(model, settings, driver, prepared)
     out = _outputs(0, len(driver.rotation), len(model.membrane_nodes))
-    _run(p, stiffness(p, design), _frames(driver), out)
+    with precompile.compiling(p.settings) as entry:
+        _run(entry, p, stiffness(p, design), _frames(driver), out)
     return _result(out, driver, int(out.status[0]))
 
 
-def _run(p: Prepared, design: kernel.Stiffness, frames: kernel.Frames, out: kernel.Outputs) -> None:
-    """`kernel.run` of one design from rest (rotations identity, bones and membrane nodes at their
-    neutral places), filling `out`."""
+def _run(entry, p: Prepared, design: kernel.Stiffness, frames: kernel.Frames, out: kernel.Outputs) -> None:
+    """The kernel's `entry` point (`kernel.entry`) for one design from rest (rotations identity, bones and
+    membrane nodes at their neutral places), filling `out`."""
     R = np.repeat(np.eye(3)[None], N_BODIES, axis=0)
-    kernel.entry(p.settings)(
-        *p.system, design, frames, out, R, p.bodies.com0.copy(), p.membrane.rest.copy(), kernel.SETTLE
-    )
+    entry(*p.system, design, frames, out, R, p.bodies.com0.copy(), p.membrane.rest.copy(), kernel.SETTLE)
 
 
 def simulate_frame(
@@ -193,7 +192,8 @@ def simulate_frame(
     out = _outputs(0, 2, len(model.membrane_nodes))
     frames = _frames(two)
     nodes = np.array(nodes, dtype=np.float64)  # a copy: the kernel moves it
-    kernel.entry(p.settings)(*p.system, stiffness(p, design), frames, out, R, x, nodes, 1)  # pose_state's own arrays
+    with precompile.compiling(p.settings) as entry:
+        entry(*p.system, stiffness(p, design), frames, out, R, x, nodes, 1)  # pose_state's own arrays
     return _result(out, two, int(out.status[0]))
 
 
@@ -212,8 +212,9 @@ def simulate_batch(
     frames = _frames(driver)
     out = _outputs(len(per), len(driver.rotation), len(model.membrane_nodes))
     mine = [kernel.Outputs(*(o[i] for o in out)) for i in range(len(per))]
-    with ThreadPoolExecutor(max(1, min(numba.get_num_threads(), len(per)))) as pool:
-        list(pool.map(lambda i: _run(p, per[i], frames, mine[i]), range(len(per))))
+    threads = max(1, min(numba.get_num_threads(), len(per)))
+    with precompile.compiling(p.settings) as entry, ThreadPoolExecutor(threads) as pool:
+        list(pool.map(lambda i: _run(entry, p, per[i], frames, mine[i]), range(len(per))))
     return [_result(filled, driver, int(filled.status[0])) for filled in mine]
 
 
@@ -246,7 +247,8 @@ def _result(out: kernel.Outputs, driver: Driver, status: int) -> Result:
 def warm(settings: SolverSettings | None = None) -> None:
     """Compile (or load from Numba's cache) the kernel entry point for `settings` (default
     `SolverSettings()`) by simulating built-in P1 held at neutral for one frame: called before local
-    worker processes start, so that they load the compiled kernel instead of each compiling it."""
+    worker processes start, so that they load the compiled kernel instead of each compiling it (from an
+    empty cache, the block mass's kernels compile in a second process meanwhile: `precompile`)."""
     from wrist_env.participants.registry import load_model  # the registry builds on the solver
 
     model = load_model("P1")

@@ -1,0 +1,112 @@
+"""The block mass's kernels compiled in a second process while `simulate.warm` compiles the entry point.
+
+A cold compile of the default entry point (`kernel.run_preconditioned`) takes about a minute on one core,
+a third of it the block mass's own kernels: the tangent (`tangent.tangent`), the membrane's substeps
+(`membrane.substep`) and the mass (`preconditioner.block_mass`), which the entry point reaches only after
+the force kernels. When the entry point's cache is empty, `start` runs this module in a second process: it
+compiles those three for the entry point's argument types (Numba writes each to its cache), and the entry
+point, compiling in the first process meanwhile, loads each from the cache when it reaches it instead of
+compiling it, if it is there by then (a part still compiling is compiled twice: the answer is the same).
+`simulate` calls the entry point through `compiling`, so a process's first simulation does this by itself;
+on P1's trial from an empty cache, a warm-up took 38–39 s instead of 57 s on 2 cores (the tangent and the
+substeps loaded, the mass compiled in both).
+
+Run: `python -m wrist_env.solver.precompile {smooth,trilinear}` (what `start` runs).
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from contextlib import contextmanager
+
+import numpy as np
+from numba import typeof, types
+
+from wrist_env.design import population
+from wrist_env.model import N_BODIES
+from wrist_env.solver import arrays, kernel, membrane, preconditioner, tangent
+from wrist_env.solver.settings import SolverSettings
+
+NORMALS = ("smooth", "trilinear")
+"""The two kinds of contact normal, each its own compiled kernels (`SolverSettings.smooth_normals`)."""
+
+
+def part_signatures(settings: SolverSettings) -> list[tuple[object, tuple]]:
+    """(kernel, argument types) of each part as the preconditioned entry point calls it, in the order in
+    which the entry point reaches them after the force kernels, typed on built-in P1's arrays (the types
+    do not depend on the model's sizes)."""
+    from wrist_env.participants.registry import load_model  # the registry builds on the solver
+    from wrist_env.solver.simulate import prepare, stiffness
+
+    p = prepare(load_model("P1"), settings, arrays.EXPERIMENTAL)
+    R, x = np.zeros((N_BODIES, 3, 3)), np.zeros((N_BODIES, 3))
+    nodes = np.zeros((len(p.model.membrane_nodes), 3))
+    design = stiffness(p, population())
+    work = kernel.new_work(p.grids, nodes)
+    m = preconditioner.metric()
+    smooth = types.literal(bool(settings.smooth_normals))  # a compile-time constant in the entry point
+
+    def typed(*args):
+        return tuple(a if isinstance(a, types.Type) else typeof(a) for a in args)
+
+    return [
+        (tangent.tangent, typed(R, x, nodes, p.system, design, work.active, work.n_active, m, smooth)),
+        (
+            membrane.substep,
+            typed(
+                R, x, p.bodies.com0, p.membrane, nodes, nodes, design.m_l0, design.m_K, 0.0, p.settings,
+                membrane.new_scratch(nodes), smooth,
+            ),
+        ),
+        (preconditioner.block_mass, typed(R, p.bodies, p.settings, m)),
+    ]  # fmt: skip
+
+
+def compile_parts(settings: SolverSettings) -> None:
+    """Compile (or load from Numba's cache) each part for the entry point's argument types."""
+    for dispatcher, signature in part_signatures(settings):
+        dispatcher.compile(signature)
+
+
+def cold(entry) -> bool:
+    """Whether the compiled entry point `entry` has nothing in Numba's cache (so it will compile). False
+    where Numba's cache cannot be read this way (its private index API changed)."""
+    try:
+        return not entry._cache._cache_file._load_index()
+    except (AttributeError, OSError, ValueError):
+        return False
+
+
+def start(settings) -> subprocess.Popen | None:
+    """A process compiling the parts for the kernel `Settings` `settings` (`arrays.settings_tuple`), if its
+    entry point is a preconditioned one, not compiled or loaded in this process yet, with nothing in the
+    cache, on a machine with more than one core; else None."""
+    entry = kernel.entry(settings)
+    preconditioned = entry in (kernel.run_preconditioned, kernel.run_trilinear_preconditioned)
+    if not preconditioned or entry.signatures or (os.cpu_count() or 1) < 2 or not cold(entry):
+        return None
+    normals = NORMALS[0] if settings.smooth_normals else NORMALS[1]
+    command = [sys.executable, "-m", "wrist_env.solver.precompile", normals]
+    return subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+@contextmanager
+def compiling(settings):
+    """Around the first calls of the entry point for the kernel `Settings` `settings`: yields the entry
+    point, with the parts compiling in a second process meanwhile where `start` says so; that process
+    ends when the block ends (by then its work is done, or done here too)."""
+    helper = start(settings)
+    try:
+        yield kernel.entry(settings)
+    finally:
+        if helper is not None:
+            helper.terminate()
+            helper.wait()
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 2 or sys.argv[1] not in NORMALS:
+        raise SystemExit(f"usage: python -m wrist_env.solver.precompile {{{','.join(NORMALS)}}}")
+    compile_parts(SolverSettings(smooth_normals=sys.argv[1] == NORMALS[0]))
