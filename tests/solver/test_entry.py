@@ -5,6 +5,7 @@ import os
 import subprocess
 import sys
 from dataclasses import replace
+from pathlib import Path
 
 import pytest
 
@@ -88,3 +89,20 @@ def test_a_second_process_compiles_only_from_an_empty_cache():
     warm()
     assert kernel.run_preconditioned.signatures
     assert precompile.start(settings_tuple(SolverSettings(), EXPERIMENTAL)) is None
+
+
+def test_the_second_process_imports_this_package_not_one_in_the_working_folder(tmp_path, monkeypatch):
+    """From a folder holding another wrist_env (a checkout beside an installed copy), `python -m` would import
+    that one and fill its cache, not the one this process reads: the second process runs from the folder
+    holding the package imported here."""
+    import wrist_env
+    from wrist_env.solver import precompile
+
+    (tmp_path / "wrist_env").mkdir()
+    monkeypatch.chdir(tmp_path)
+    command, home = precompile.helper_command(True)
+    probe = "import wrist_env.solver.precompile as p; print(p.__file__)"
+    done = subprocess.run([command[0], "-c", probe], cwd=home, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert Path(done.stdout.strip()).resolve().parents[2] == Path(wrist_env.__file__).resolve().parents[1]
+    assert command[1:] == ["-m", "wrist_env.solver.precompile", "smooth"]

@@ -20,6 +20,7 @@ import os
 import subprocess
 import sys
 from contextlib import contextmanager
+from pathlib import Path
 
 import numpy as np
 from numba import typeof, types
@@ -87,10 +88,16 @@ def start(settings) -> subprocess.Popen | None:
     preconditioned = entry in (kernel.run_preconditioned, kernel.run_trilinear_preconditioned)
     if not preconditioned or entry.signatures or (os.cpu_count() or 1) < 2 or not cold(entry):
         return None
-    normals = NORMALS[0] if settings.smooth_normals else NORMALS[1]
-    command = [sys.executable, "-m", "wrist_env.solver.precompile", normals]
-    return subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    command, home = helper_command(bool(settings.smooth_normals))
+    return subprocess.Popen(command, cwd=home, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
+
+def helper_command(smooth: bool) -> tuple[list[str], Path]:
+    """The second process's command and working folder: the folder holding this very package, so that
+    `-m` imports it and not another copy found first from the working folder (a checkout beside an
+    installed copy): its cache is the one this process reads."""
+    normals = NORMALS[0] if smooth else NORMALS[1]
+    return [sys.executable, "-m", "wrist_env.solver.precompile", normals], Path(__file__).resolve().parents[2]
 
 @contextmanager
 def compiling(settings):
