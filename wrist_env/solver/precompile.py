@@ -99,6 +99,7 @@ def helper_command(smooth: bool) -> tuple[list[str], Path]:
     normals = NORMALS[0] if smooth else NORMALS[1]
     return [sys.executable, "-m", "wrist_env.solver.precompile", normals], Path(__file__).resolve().parents[2]
 
+
 @contextmanager
 def compiling(settings):
     """Around the first calls of the entry point for the kernel `Settings` `settings`: yields the entry
