@@ -54,7 +54,7 @@ def main(argv=None) -> int:
     p.add_argument("--json", action="store_true", help="print the figures as one JSON line (what --against reads)")
     args = p.parse_args(argv)
     if args.against:
-        return _compare(args, argv if argv is not None else sys.argv[1:])
+        return _compare(args)
 
     import numba
 
@@ -103,21 +103,15 @@ def main(argv=None) -> int:
     return 0
 
 
-def _compare(args, argv: list[str]) -> int:
+def _compare(args) -> int:
     """The study in a fresh process of each checkout in turn (this script, the checkout's package), the
     medians and their ratio."""
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     from bench_cold_start import HERE, _run, write_table  # experiments/benchmarks/bench_cold_start.py
 
-    own = []  # the study's own arguments: without --against, --rounds and --out
-    skip = {"--against", "--rounds", "--out"}
-    it = iter(argv)
-    for a in it:
-        if a.split("=")[0] in skip:
-            if "=" not in a:
-                next(it, None)
-            continue
-        own.append(a)
+    own = ["--participants", *args.participants, "--n", str(args.n), "--seed", str(args.seed)]
+    own += ["--batch", str(args.batch), "--workers", str(args.workers)]
+    own += ["--scheduler", args.scheduler] if args.scheduler else []
     trees = {"this": HERE, "against": args.against.resolve()}
     runs = {name: [] for name in trees}
     for r in range(args.rounds):

@@ -84,11 +84,14 @@ def start(settings) -> subprocess.Popen | None:
     """A process compiling the parts for the kernel `Settings` `settings` (`arrays.settings_tuple`), if its
     entry point is a preconditioned one, not compiled or loaded in this process yet, with nothing in the
     cache, on a machine with more than one core; else None."""
-    entry = kernel.entry(settings)
+    return _start(kernel.entry(settings), bool(settings.smooth_normals))
+
+
+def _start(entry, smooth: bool) -> subprocess.Popen | None:
     preconditioned = entry in (kernel.run_preconditioned, kernel.run_trilinear_preconditioned)
     if not preconditioned or entry.signatures or (os.cpu_count() or 1) < 2 or not cold(entry):
         return None
-    command, home = helper_command(bool(settings.smooth_normals))
+    command, home = helper_command(smooth)
     return subprocess.Popen(command, cwd=home, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
 
@@ -105,9 +108,10 @@ def compiling(settings):
     """Around the first calls of the entry point for the kernel `Settings` `settings`: yields the entry
     point, with the parts compiling in a second process meanwhile where `start` says so; that process
     ends when the block ends (by then its work is done, or done here too)."""
-    helper = start(settings)
+    entry = kernel.entry(settings)
+    helper = _start(entry, bool(settings.smooth_normals))
     try:
-        yield kernel.entry(settings)
+        yield entry
     finally:
         if helper is not None:
             helper.terminate()
