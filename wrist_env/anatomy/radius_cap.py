@@ -26,6 +26,7 @@ from collections.abc import Iterable, Sequence
 
 import numpy as np
 import trimesh
+from numba import njit
 from numpy.typing import ArrayLike
 from scipy.spatial import cKDTree
 
@@ -74,16 +75,34 @@ def offset_heightfield(
     height = np.full(len(grid), -np.inf)
     reach = int(np.ceil(g / spacing_mm + 0.5))
     cell = np.rint((row_points[:, [0, 2]] - lo) / spacing_mm).astype(np.int64)
-    for di in range(-reach, reach + 1):  # every grid node within g of a point: the ball's top there
-        for dk in range(-reach, reach + 1):
-            i, k = cell[:, 0] + di, cell[:, 1] + dk
-            inside = (i >= 0) & (i < len(xs)) & (k >= 0) & (k < len(zs))
-            i, k, p = i[inside], k[inside], row_points[inside]
-            d2 = (xs[i] - p[:, 0]) ** 2 + (zs[k] - p[:, 2]) ** 2
-            near = d2 < g * g * (1 - 1e-9)
-            np.maximum.at(height, i[near] * len(zs) + k[near], p[near, 1] + np.sqrt(g * g - d2[near]))
+    _ball_tops(xs, zs, np.ascontiguousarray(row_points, dtype=np.float64), cell, float(g), reach, height)
     height[~on_footprint | ~np.isfinite(height)] = np.nan
     return xs, zs, fill_creases(height.reshape(X.shape), sigma_cells=1.5)
+
+
+@njit(cache=True)
+def _ball_tops(xs, zs, points, cell, g, reach, height):
+    """Raise `height` (len(xs) × len(zs), flat, C order) at every grid node within `g` (mm) of a point's
+    (x, z), found among the `reach` cells around the point's own cell (`cell`: (n, 2) node indices), to
+    the top of the point's ball there: y + sqrt(g² − d²). Every node is checked against every point in
+    reach (a few hundred thousand swept samples × a few hundred nodes each: compiled, not array passes)."""
+    nx, nz = len(xs), len(zs)
+    inside = g * g * (1 - 1e-9)
+    for n in range(points.shape[0]):
+        for di in range(-reach, reach + 1):
+            i = cell[n, 0] + di
+            if i < 0 or i >= nx:
+                continue
+            dx2 = (xs[i] - points[n, 0]) ** 2
+            for dk in range(-reach, reach + 1):
+                k = cell[n, 1] + dk
+                if k < 0 or k >= nz:
+                    continue
+                d2 = dx2 + (zs[k] - points[n, 2]) ** 2
+                if d2 < inside:
+                    top = points[n, 1] + np.sqrt(g * g - d2)
+                    if top > height[i * nz + k]:
+                        height[i * nz + k] = top
 
 
 def sphere_centre(points: np.ndarray) -> np.ndarray:
