@@ -1,5 +1,6 @@
 """The Monte Carlo study's log without the solver (a stand-in `run_chunk`): settings, copies, gaps, checksums."""
 
+import json
 import re
 import shutil
 
@@ -11,6 +12,9 @@ from wrist_env import cli
 from wrist_env.errors import InputError, StoreError
 from wrist_env.montecarlo import StudyConfig, StudyError, read_runs, run_study, sampler
 from wrist_env.montecarlo.study import config_of, counts
+from wrist_env.participants.registry import load_model
+from wrist_env.runs import provenance
+from wrist_env.runs.store import add_checksums
 from wrist_env.solver.settings import DEFAULT_LOADS
 
 CONFIG = StudyConfig(("P1",), n=10, seed=0)
@@ -71,7 +75,11 @@ def test_parts_that_do_not_record_their_settings_need_study_json(study):
     for part in (out / "runs").glob("*.parquet"):  # parts as written before they recorded settings
         pq.write_table(pq.read_table(part).replace_schema_metadata(None), part)
         part.with_name(part.name + ".sha256").unlink()
-    assert run_study(CONFIG, out, batch=4).simulated == 0  # study.json says what they are
+    with pytest.raises(StoreError, match="P1-0000000-0000004.parquet: it has no checksum"):
+        read_runs(out)
+    assert len(add_checksums(out)) == 3  # the explicit command for a log made before checksums
+    with pytest.raises(StudyError, match="P1-0000000-0000004.parquet: its runs were made on another model or trials"):
+        run_study(CONFIG, out, batch=4)  # study.json says the settings, but nothing says the model
     (out / "study.json").unlink()
     with pytest.raises(StudyError, match="3 parts .* do not record their settings .* no study.json"):
         run_study(StudyConfig(("P1",), n=10, seed=1), out)
@@ -80,7 +88,8 @@ def test_parts_that_do_not_record_their_settings_need_study_json(study):
 def test_a_copied_part_is_named_then_moved_aside(study):
     out, log = study
     part = sorted((out / "runs").glob("*.parquet"))[1]
-    shutil.copy(part, out / "runs" / "P1-copy.parquet")
+    shutil.copy(part, out / "runs" / "P1-copy.parquet")  # with its valid checksum
+    shutil.copy(part.with_name(part.name + ".sha256"), out / "runs" / "P1-copy.parquet.sha256")
     with pytest.raises(StudyError, match=r"P1-copy.parquet: run P1 #4 is logged twice \(also in " + part.name):
         read_runs(out)
     with pytest.warns(UserWarning, match="P1-copy.parquet: its runs are not the ones its name says"):
@@ -141,3 +150,57 @@ def test_a_resume_under_another_load_direction_is_refused(study, tmp_path_factor
         run_study(CONFIG, other, batch=4)
     with pytest.raises(StudyError, match="sideways"):
         StudyConfig(("P1",), n=10, load_direction="sideways")
+
+
+def test_the_report_refuses_a_part_copied_from_another_study_with_its_checksum(study, tmp_path, capsys):
+    """Issue 53: a part of a seed-1 study (its valid .sha256 beside it) in a seed-0 study's runs/."""
+    out, _ = study
+    other = tmp_path / "other"
+    assert run_study(StudyConfig(("P1",), n=14, seed=1), other, batch=4).done
+    part = other / "runs" / "P1-0000012-0000014.parquet"
+    for p in (part, part.with_name(part.name + ".sha256")):
+        shutil.copy(p, out / "runs" / p.name)
+    status, err = _cli(capsys, "montecarlo-report", "--runs", str(out), "--out", str(tmp_path / "report"))
+    assert status == 2 and err.count("\n") == 1
+    assert "P1-0000012-0000014.parquet: its runs were made with other settings" in err and "seed 1 (asked 0)" in err
+    assert not (tmp_path / "report").exists()
+
+
+def test_the_report_refuses_a_study_json_that_the_parts_contradict(study, tmp_path, capsys):
+    out, _ = study
+    manifest = json.loads((out / "study.json").read_text())
+    (out / "study.json").write_text(json.dumps({**manifest, "seed": 7}))
+    status, err = _cli(capsys, "montecarlo-report", "--runs", str(out), "--out", str(tmp_path / "report"))
+    assert status == 2 and "P1-0000000-0000004.parquet: its runs were made with other settings" in err
+    assert "seed 0 (asked 7)" in err
+
+
+def test_a_model_changed_between_a_kill_and_a_resume_is_refused(study, monkeypatch):
+    """Every part records its participant's model and trials; a resume on another model refuses, naming it."""
+    out, log = study
+    part = out / "runs" / "P1-0000000-0000004.parquet"
+    recorded = provenance.read_provenance(part)
+    assert recorded == provenance.of_participant("P1") and recorded["model"] == load_model("P1").source_hash
+    changed = {**recorded, "trials": {**recorded["trials"], "unresisted": "0" * 64}}
+    monkeypatch.setattr(provenance, "of_participant", lambda name: changed)
+    with pytest.raises(
+        StudyError, match=re.escape(str(part)) + r": .*another model or trials of P1 \(trials unresisted changed\)"
+    ):
+        run_study(CONFIG, out, batch=4)
+    assert read_runs(out).equals(log)
+
+
+def test_the_report_refuses_parts_of_one_participant_made_on_two_models(study, tmp_path, capsys):
+    out, _ = study
+    part = sorted((out / "runs").glob("*.parquet"))[-1]
+    table = pq.read_table(part)
+    made_from = provenance.read_provenance(part)
+    pq.write_table(provenance.with_provenance(table, {**made_from, "model": "f" * 16}), part)
+    part.with_name(part.name + ".sha256").unlink()
+    add_checksums(out)
+    status, err = _cli(capsys, "montecarlo-report", "--runs", str(out), "--out", str(tmp_path / "report"))
+    assert (
+        status == 2
+        and f"{part.name}: made on another model or trials of P1 than" in err
+        and "model ffffffffffff…" in err
+    )

@@ -1,5 +1,6 @@
 """The run store: write-once atomic parts, damaged files named, quarantine, locks, temporary files."""
 
+import json
 import os
 import re
 import time
@@ -9,6 +10,7 @@ import pytest
 
 from wrist_env.errors import StoreError
 from wrist_env.runs import PartExistsError, RunStore, StoreBusyError
+from wrist_env.runs.store import add_checksums
 
 TABLE = pa.table({"x": [1, 2]})
 
@@ -94,11 +96,42 @@ def test_a_part_changed_after_it_was_written_fails_its_checksum(tmp_path):
     assert store.read_parts()["x"].to_pylist() == [1, 2]
 
 
-def test_a_part_without_a_checksum_is_read_unchecked(tmp_path):
+def test_a_part_without_its_checksum_is_damage_until_checksummed_on_request(tmp_path):
+    """Deleting a checksum must not switch checking off; `add_checksums` (for a log made before them)
+    names what it checksums, once."""
     store = RunStore(tmp_path, parts="p")
     store.write_part("a", TABLE)
-    (tmp_path / "p" / "a.parquet.sha256").unlink()  # a log written before checksums
+    path = tmp_path / "p" / "a.parquet"
+    (tmp_path / "p" / "a.parquet.sha256").unlink()
+    with pytest.raises(StoreError, match=re.escape(str(path)) + ": it has no checksum.*wrist-bench checksum"):
+        store.read_parts()
+    assert [n for n, _ in store.damaged_parts()] == ["a"]
+    assert add_checksums(tmp_path) == [path]
     assert store.read_parts()["x"].to_pylist() == [1, 2]
+    assert add_checksums(tmp_path) == []  # named once
+
+
+def test_a_record_without_its_checksum_is_damage_until_checksummed_on_request(tmp_path):
+    store = RunStore(tmp_path, records="cells")
+    store.write_record("cell", {"nfev": 3, "best_cost": 1.5})
+    path = store.record_path("cell")
+    path.write_text(json.dumps({"nfev": 3, "best_cost": 0.001}))  # edited, its checksum removed
+    with pytest.raises(StoreError, match=re.escape(str(path)) + ": it has no checksum"):
+        store.read_record("cell")
+    assert add_checksums(tmp_path) == [path]
+    assert store.read_record("cell") == {"nfev": 3, "best_cost": 0.001}
+
+
+def test_add_checksums_refuses_a_damaged_part_and_a_missing_folder(tmp_path):
+    store = RunStore(tmp_path, parts="p")
+    store.write_part("a", TABLE)
+    path = tmp_path / "p" / "a.parquet"
+    (tmp_path / "p" / "a.parquet.sha256").unlink()
+    path.write_bytes(path.read_bytes()[:40])
+    with pytest.raises(StoreError, match=re.escape(str(path)) + ": damaged Parquet"):
+        add_checksums(tmp_path)
+    with pytest.raises(StoreError, match="no such folder"):
+        add_checksums(tmp_path / "nowhere")
 
 
 def test_a_record_changed_after_it_was_written_fails_its_checksum(tmp_path):

@@ -1,6 +1,8 @@
 """A Monte Carlo study's log on disk: its run store (`<out>/runs/*.parquet`, rows `sampler.SCHEMA`,
-each part recording the settings it was made with) and its manifest (`<out>/study.json`); reading
-the logged runs back, refusing other settings, and moving damaged or stray parts aside."""
+each part recording the settings it was made with and its participant's model and trials:
+`wrist_env.runs.provenance`) and its manifest (`<out>/study.json`); reading the logged runs back,
+refusing other settings or models (`check_settings` before a resume, `check_log` before a report), and
+moving damaged or stray parts aside."""
 
 from __future__ import annotations
 
@@ -10,12 +12,12 @@ from pathlib import Path
 import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
-import pyarrow.parquet as pq
 
 from wrist_env.errors import StoreError
 from wrist_env.io import read_json, write_json
 from wrist_env.montecarlo import sampler
 from wrist_env.montecarlo.config import StudyConfig, StudyError
+from wrist_env.runs import provenance
 from wrist_env.runs.store import RunStore
 
 MANIFEST = "study.json"
@@ -36,20 +38,22 @@ SETTINGS = b"wrist_env.study"
 """The Parquet metadata key under which every part records the settings it was made with (`StudyConfig.key`)."""
 
 
-def with_settings(table: pa.Table, config: StudyConfig) -> pa.Table:
-    """A chunk's rows with the study's settings in their metadata (so a part says what made it)."""
-    return table.replace_schema_metadata({SETTINGS: json.dumps(config.key(), sort_keys=True)})
+def with_settings(table: pa.Table, config: StudyConfig, made_from: dict) -> pa.Table:
+    """A chunk's rows with the study's settings and its participant's provenance (`provenance.of_participant`)
+    in their metadata (so a part says what made it)."""
+    table = table.replace_schema_metadata({SETTINGS: json.dumps(config.key(), sort_keys=True)})
+    return provenance.with_provenance(table, made_from)
 
 
 def part_settings(store: RunStore, name: str) -> dict | None:
     """The settings a part was made with (None: written before parts recorded them); StoreError if
     the part cannot be read."""
-    path = store.part_path(name)
-    try:
-        raw = (pq.read_schema(path).metadata or {}).get(SETTINGS)
-        return None if raw is None else json.loads(raw)
-    except (OSError, pa.ArrowException, ValueError) as e:
-        raise StoreError(f"{path}: damaged Parquet part ({type(e).__name__}); {RERUN}") from None
+    return provenance.read_metadata(store.part_path(name), SETTINGS, RERUN)
+
+
+def part_participant(name: str) -> str:
+    """The participant a part's name (`part_name`) says it holds."""
+    return name.rsplit("-", 2)[0]
 
 
 def _differences(old: dict, key: dict) -> str:
@@ -57,8 +61,9 @@ def _differences(old: dict, key: dict) -> str:
     return ", ".join(f"{k} {old[k]!r} (asked {key[k]!r})" for k in sorted(key) if old[k] != key[k])
 
 
-def check_settings(out: str | Path, config: StudyConfig) -> None:
-    """StudyError if a logged part was made under other settings than `config`'s, or if neither its
+def check_settings(out: str | Path, config: StudyConfig, made_from: dict[str, dict] | None = None) -> None:
+    """StudyError if a logged part was made under other settings than `config`'s, or on another model or
+    trials than `made_from` ({participant: `provenance.of_participant`}, where given), or if neither its
     parts nor `study.json` say what they were made with (damaged parts are left to `repair`)."""
     out, key = Path(out), config.key()
     store, unrecorded = runs_log(out), []
@@ -79,6 +84,45 @@ def check_settings(out: str | Path, config: StudyConfig) -> None:
             f"{out}: {len(unrecorded)} parts (first {unrecorded[0]}.parquet) do not record their settings and there "
             f"is no {MANIFEST} to say them; restore it, or use another --out"
         )
+    for name in store.part_names():
+        today = (made_from or {}).get(part_participant(name))
+        try:
+            recorded = provenance.read_provenance(store.part_path(name), RERUN)
+        except StoreError:
+            continue
+        changed = "" if today is None else provenance.differences(recorded, today)
+        if changed:
+            raise StudyError(
+                f"{store.part_path(name)}: its runs were made on another model or trials of "
+                f"{part_participant(name)} ({changed}); use another --out to run the study on today's"
+            )
+
+
+def check_log(out: str | Path, config: StudyConfig) -> None:
+    """Before a report: StudyError naming the part unless every part was made with `config`'s settings
+    (`study.json`'s), holds the runs its name says, once, and agrees with the other parts of its
+    participant on the model and trials (a part copied from another study, a `study.json` edited, a
+    model changed between a kill and a resume)."""
+    check_settings(out, config)
+    store = runs_log(out)
+    stray = _stray_parts(store)
+    if stray:
+        name, why = stray[0]
+        raise StudyError(f"{store.part_path(name)}: {why.split(';')[0]}; {RERUN} (it moves such parts aside)")
+    first: dict[str, tuple[str, dict | None]] = {}
+    for name in store.part_names():
+        made_from = provenance.read_provenance(store.part_path(name), RERUN)
+        p = part_participant(name)
+        seen, recorded = first.setdefault(p, (name, made_from))
+        if recorded != made_from:
+            if recorded is None or made_from is None:
+                changed = "one of the two does not record its model (made by an older wrist-env)"
+            else:
+                changed = provenance.differences(made_from, recorded, against=f"{seen}.parquet")
+            raise StudyError(
+                f"{store.part_path(name)}: made on another model or trials of {p} than {seen}.parquet ({changed}); "
+                "a study's runs must share one model: move the odd parts away, or rerun the study in another --out"
+            )
 
 
 def repair(out: str | Path) -> int:

@@ -21,7 +21,7 @@ from wrist_env.figures import montecarlo as figures
 from wrist_env.io import write_json
 from wrist_env.montecarlo import stats
 from wrist_env.montecarlo.config import StudyError
-from wrist_env.montecarlo.log import read_runs
+from wrist_env.montecarlo.log import check_log, read_runs
 from wrist_env.montecarlo.study import config_of, counts
 
 PREPRINT = {
@@ -138,10 +138,11 @@ def write_report(
     """Fit, draw and write the report of the study logged in `runs`; returns the summary dict."""
     start = time.perf_counter()
     runs, out = Path(runs), Path(out)
+    config = config_of(runs)
+    check_log(runs, config)  # every part made with study.json's settings, on one model, where its name says
     table = read_runs(runs)
     if table is None:
         raise StudyError(f"{runs} holds no logged runs")
-    config = config_of(runs)
     study_counts = {p: asdict(c) for p, c in counts(runs, complete=True).items()}
     frames = stats.frame_table(table)
     if frames.empty:

@@ -53,6 +53,7 @@ from wrist_env.montecarlo.log import (
     with_settings,
 )
 from wrist_env.participants import registry
+from wrist_env.runs import provenance
 from wrist_env.runs.executor import executor
 
 if TYPE_CHECKING:
@@ -205,14 +206,14 @@ def _run_locked(
     config: StudyConfig, out: Path, batch: int, scheduler, workers, folders: tuple, progress: bool
 ) -> StudySummary:
     start_time = time.perf_counter()
-    check_settings(out, config)
+    for f in folders:
+        registry.ensure_folder(f)
+    made_from = {p: provenance.of_participant(p) for p in config.participants}  # what every part records
+    check_settings(out, config, made_from)
     _manifest(out, config)
     repair(out)
     log = runs_log(out)
     outcomes = _logged_outcomes(out, config.participants)
-    if folders:
-        for f in folders:
-            registry.ensure_folder(f)
 
     summary = StudySummary(config, {}, out=out)
     bar = None
@@ -259,7 +260,7 @@ def _run_locked(
                     cols = table.select(["participant", "sample_id", "ok", "excluded"]).to_pydict()
                     p = cols["participant"][0]
                     ids = tuple(int(s) for s in cols["sample_id"])
-                    log.write_part(part_name(p, ids), with_settings(table, config))
+                    log.write_part(part_name(p, ids), with_settings(table, config, made_from[p]))
                     good = 0
                     for s, ok, ex_ in zip(ids, cols["ok"], cols["excluded"]):
                         outcomes[p][s] = (bool(ok), bool(ex_))

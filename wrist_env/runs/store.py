@@ -12,10 +12,12 @@ Every file is written by `wrist_env.io.atomic_write` (temporary name, fsync,
 `os.replace`, folder fsync): a reader, or a writer killed midway, never sees
 half a file. A part name that exists is never overwritten. Every part and
 record carries a SHA-256 (a part's in `<file>.sha256`, a record's under
-`record_sha256`), checked on every read; files written before checksums have
-none and are read unchecked. A damaged part or record (truncated, empty,
-garbage, or not the bytes it was written with) is a `StoreError` naming the
-file and what to do; the studies move such files to `damaged/` on resume and redo their work.
+`record_sha256`), checked on every read. A damaged part or record (truncated, empty,
+garbage, not the bytes it was written with, or without its checksum: a deleted
+checksum must not switch checking off) is a `StoreError` naming the file and
+what to do; the studies move such files to `damaged/` on resume and redo their
+work. A log written before checksums existed is checksummed once, on request,
+by `add_checksums` (`wrist-bench checksum <folder>`), which names each file.
 Nothing here knows what a row means: `wrist_env.bench.log` (the benchmark's
 evaluations) and `wrist_env.montecarlo.log` (the Monte Carlo runs) do.
 """
@@ -42,6 +44,9 @@ RECORD_CHECKSUM = "record_sha256"
 DAMAGED = "damaged"
 LOCKS = "locks"
 STORE_LOCK = "store"
+RECORD_FOLDERS = ("cells",)
+"""The folders whose JSON files are checksummed records (a benchmark's cell summaries); `add_checksums`
+leaves other JSON (a study's manifest, a report's summary) alone."""
 
 
 class PartExistsError(StoreError, FileExistsError):
@@ -79,14 +84,18 @@ def _advice(advice: str) -> str:
     return f"; {advice}" if advice else ""
 
 
+MISSING = "it has no checksum (deleted, or written before wrist-env kept them: if you trust it, `wrist-bench checksum <folder>` adds them)"
+"""Why a part or record without its checksum is refused."""
+
+
 def verify_checksum(path: str | Path, advice: str = "") -> None:
-    """`StoreError` naming `path` if its bytes are not the ones its `.sha256` was written with
-    (a file without one, written before checksums, passes)."""
+    """`StoreError` naming `path` if its bytes are not the ones its `.sha256` was written with, or it has
+    no `.sha256`."""
     path, side = Path(path), checksum_path(path)
     try:
         expected = side.read_text().strip()
     except FileNotFoundError:
-        return
+        raise StoreError(f"{path}: {MISSING}{_advice(advice)}") from None
     except (OSError, UnicodeDecodeError) as e:
         raise StoreError(f"{side}: unreadable checksum ({type(e).__name__}){_advice(advice)}") from None
     try:
@@ -112,6 +121,35 @@ def read_parquet(
         raise StoreError(
             f"{path}: damaged Parquet file ({type(e).__name__}: {str(e).splitlines()[0][:200]}){_advice(advice)}"
         ) from None
+
+
+def add_checksums(root: str | Path) -> list[Path]:
+    """Checksum the parts and records under `root` that have none (a log written before wrist-env kept
+    checksums): each Parquet file without its `.sha256` that reads whole gets one, each JSON record (a
+    dict) without `record_sha256` gets it. Returns the files checksummed, for the caller to name: only
+    for logs you trust, as a deleted checksum looks the same. `StoreError` naming a file that cannot be
+    read whole (it stays unchecked, and a study moves it aside)."""
+    root, done = Path(root), []
+    if not root.is_dir():
+        raise StoreError(f"{root}: no such folder (a benchmark's --out, or a Monte Carlo study's)")
+    for path in sorted(root.rglob("*.parquet")):
+        if path.name.startswith(".") or DAMAGED in path.relative_to(root).parts or checksum_path(path).exists():
+            continue
+        try:
+            pq.read_table(path)
+        except (OSError, pa.ArrowException, ValueError) as e:
+            raise StoreError(f"{path}: damaged Parquet file ({type(e).__name__}); not checksummed") from None
+        digest = sha256_file(path) + "\n"
+        atomic_write(checksum_path(path), lambda c, d=digest: Path(c).write_text(d))
+        done.append(path)
+    for path in sorted(root.rglob("*.json")):
+        if path.name.startswith(".") or DAMAGED in path.relative_to(root).parts:
+            continue
+        data = read_json(path, "record")
+        if isinstance(data, dict) and path.parent.name in RECORD_FOLDERS and RECORD_CHECKSUM not in data:
+            write_json(path, {**data, RECORD_CHECKSUM: json_sha256(data)})
+            done.append(path)
+    return done
 
 
 class RunStore:
@@ -198,7 +236,9 @@ class RunStore:
         if not path.is_file():
             return None
         data = read_json(path, "record", advice)
-        if isinstance(data, dict) and RECORD_CHECKSUM in data:
+        if not isinstance(data, dict) or RECORD_CHECKSUM not in data:
+            raise StoreError(f"{path}: {MISSING}{_advice(advice)}")
+        if isinstance(data, dict):
             expected = data.pop(RECORD_CHECKSUM)
             if json_sha256(data) != expected:
                 raise StoreError(
