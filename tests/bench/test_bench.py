@@ -210,6 +210,25 @@ def _copy_runs(finished, tmp_path) -> Path:
     return tmp_path / "runs"
 
 
+def test_a_participant_changed_since_its_cells_ran_runs_them_again(p1, finished, tmp_path, monkeypatch):
+    """Issue 53: edit a participant's calibrate trial and rerun the same benchmark: its finished cells were
+    made on the old trial, so they are moved aside and run again (not "skipped"), and the leaderboard
+    refuses the old log against the new trial."""
+    from wrist_env.runs import provenance
+
+    runs = _copy_runs(finished, tmp_path)
+    today = provenance.of_participant(p1)
+    assert RunLog(runs).summary(RunKey(p1, "random", 0, 12))["provenance"] == today
+    edited = {**today, "trials": {**today["trials"], "unresisted": "0" * 64}}
+    monkeypatch.setattr(provenance, "of_participant", lambda name: edited)
+    with pytest.raises(StoreError, match=r"seed0.budget12.json: this cell was calibrated on another model or trials"):
+        write_leaderboard(runs, tmp_path / "lb")
+    with pytest.warns(UserWarning, match=r"made on another model or trials of P1 \(trials unresisted changed\)"):
+        report = benchmark([p1], ["random"], 2, 12, runs, workers=1, progress=False)
+    assert sorted(k.seed for k in report.ran) == [0, 1] and not report.skipped
+    assert all(RunLog(runs).summary(k)["provenance"] == edited for k in report.ran)
+
+
 def test_a_finished_cell_without_its_evaluations_is_an_error_then_rerun(p1, finished, tmp_path):
     from wrist_env.bench.log import IncompleteCellError
 
@@ -288,7 +307,7 @@ def test_a_truncated_cell_summary_is_named_then_rerun_by_replay(p1, finished, tm
     path.write_text(path.read_text()[:40])
     with pytest.raises(StoreError, match=re.escape(str(path)) + ".*cannot be read as JSON"):
         write_leaderboard(runs, tmp_path / "lb")
-    with pytest.warns(UserWarning, match="damaged cell summary"):
+    with pytest.warns(UserWarning, match="cannot be read as JSON"):
         report = benchmark([p1], ["random"], 2, 12, runs, workers=1, progress=False)
     assert [k.seed for k in report.ran] == [0] and RunLog(runs).summary(report.ran[0])["replayed"] == 12
 

@@ -67,6 +67,7 @@ def test_the_run_log_keeps_each_evaluations_unsettled_frames(tmp_path):
     from wrist_env.bench.calibrate import unsettled_frames
     from wrist_env.bench.leaderboard.tables import unsettled_shares
     from wrist_env.bench.log import SCHEMA, RunKey, RunLog
+    from wrist_env.runs.store import add_checksums
 
     log, key = RunLog(tmp_path), RunKey("P1", "random", 0, 4)
     info = {"settled": np.array([True, False, False])}
@@ -85,5 +86,6 @@ def test_the_run_log_keeps_each_evaluations_unsettled_frames(tmp_path):
     other = RunLog(tmp_path / "old")
     other.evals_dir.mkdir(parents=True)
     pq.write_table(table, other.evals_dir / f"cell-{key.name}-n000004.parquet")
+    add_checksums(other.root)  # a log from before checksums, checksummed on request
     assert other.read()["unsettled"].isna().all()
     assert np.isnan(unsettled_shares(other.read())[("P1", "random", 0, 4)])

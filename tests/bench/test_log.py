@@ -70,7 +70,7 @@ def test_a_summary_without_validate_is_named_then_moved_aside(tmp_path):
     log.write_summary(KEY, summary)
     with pytest.raises(StoreError, match=r"\.json: not a whole cell summary \(no validate\).*rerun the benchmark"):
         log.summaries()
-    with pytest.warns(UserWarning, match="damaged cell summary"):
+    with pytest.warns(UserWarning, match="not a whole cell summary"):
         assert log.repair() == 1
     assert log.summary(KEY) is None  # the cell runs again, by replay of its 8 logged evaluations
 
@@ -84,7 +84,7 @@ def test_an_edited_summary_is_named_then_moved_aside(tmp_path):
     path.write_text(json.dumps(data))
     with pytest.raises(StoreError, match=re.escape(str(path)) + ".*SHA-256.*rerun the benchmark"):
         log.summaries()
-    with pytest.warns(UserWarning, match="damaged cell summary"):
+    with pytest.warns(UserWarning, match="damaged record"):
         assert log.repair() == 1
 
 
@@ -93,3 +93,70 @@ def test_a_compacted_cell_keeps_one_checksummed_file(tmp_path):
     path = log.compact(KEY)
     assert sorted(p.name for p in log.evals_dir.iterdir()) == [path.name, path.name + ".sha256"]
     assert log.read_cell(KEY).cost.tolist() == list(range(8))
+
+
+MADE_FROM = {"model": "a" * 16, "trials": {"resisted": "b" * 64, "unresisted": "c" * 64}}
+
+
+def _finished_cell(root, made_from: dict | None = MADE_FROM) -> RunLog:
+    """KEY finished: 4 evaluations in two batches, compacted, and its summary, made on `made_from`."""
+    log = RunLog(root)
+    for b in range(2):
+        cost = [2.0 * b, 2.0 * b + 1]
+        log.append(KEY, b, 2 * b, np.zeros((2, 22)), cost, [False] * 2, np.zeros((2, 12)), made_from=made_from)
+    log.compact(KEY)
+    log.write_summary(KEY, _summary(4), made_from)
+    return log
+
+
+def test_a_cell_copied_under_another_cells_name_is_named_then_moved_aside(tmp_path):
+    """Issue 53: P1's finished cell and its evaluations (with their checksums) copied to P2's names must not
+    count as P2's run, nor make `benchmark` skip P2."""
+    log = _finished_cell(tmp_path)
+    other = RunKey("P2", "random", 0, 8)
+    for path in [*log.evals_dir.iterdir(), log.store.record_path(KEY.name)]:
+        (path.parent / path.name.replace(KEY.name, other.name)).write_bytes(path.read_bytes())
+    summary = log.store.record_path(other.name)
+    with pytest.raises(StoreError, match=re.escape(str(summary)) + f": holds the summary of cell {KEY.name}, not of"):
+        log.summary(other)
+    with pytest.warns(UserWarning, match=f"holds evaluations of {re.escape(KEY.name)}, not of {re.escape(other.name)}"):
+        assert log.repair() == 2  # the evaluations and the summary under P2's name
+    assert log.logged_range(other) == 0 and log.summary(other) is None and log.summary(KEY)["nfev"] == 4
+
+
+def test_a_summary_whose_checksum_was_removed_is_damage(tmp_path):
+    log = _finished_cell(tmp_path)
+    path = log.store.record_path(KEY.name)
+    data = json.loads(path.read_text())
+    del data["record_sha256"]
+    path.write_text(json.dumps({**data, "best_cost": 0.001}))
+    with pytest.raises(StoreError, match=re.escape(str(path)) + ": it has no checksum"):
+        log.summary(KEY)
+    with pytest.warns(UserWarning, match="it has no checksum"):
+        assert log.repair() == 1
+    assert log.summary(KEY) is None
+
+
+def test_every_file_of_a_cell_records_its_provenance_and_a_stale_cell_moves_aside_whole(tmp_path):
+    from wrist_env.runs import provenance
+
+    log = _finished_cell(tmp_path)
+    (part,) = log.evals_dir.glob("cell-*.parquet")
+    assert provenance.read_provenance(part) == MADE_FROM  # kept through compaction
+    assert log.summary(KEY)["provenance"] == MADE_FROM
+    assert log.move_aside_stale(KEY, MADE_FROM) == 0
+    log.check_made_from({"P1": MADE_FROM})
+    edited = {**MADE_FROM, "trials": {**MADE_FROM["trials"], "unresisted": "d" * 64}}
+    with pytest.raises(
+        StoreError, match=r"this cell was calibrated on another model or trials of P1 \(trials unresisted"
+    ):
+        log.check_made_from({"P1": edited})
+    with pytest.warns(UserWarning, match=r"made on another model or trials of P1 \(trials unresisted changed\)"):
+        assert log.move_aside_stale(KEY, edited) == 2
+    assert log.logged_range(KEY) == 0 and log.summary(KEY) is None
+
+
+def test_a_cell_that_records_no_provenance_runs_again(tmp_path):
+    log = _finished_cell(tmp_path, made_from=None)
+    with pytest.warns(UserWarning, match="does not record the model and trials"):
+        assert log.move_aside_stale(KEY, MADE_FROM) == 2

@@ -151,3 +151,19 @@ def test_the_checksum_of_a_part_never_moved_into_place_is_cleaned(tmp_path):
     orphan.write_text("0" * 64)
     assert store.clean(min_age_s=0) == 1 and not orphan.exists()
     assert (tmp_path / "p" / "a.parquet.sha256").is_file()
+
+
+def test_the_checksum_command_names_each_file_it_checksums_once(tmp_path, capsys):
+    from wrist_env import cli
+
+    store = RunStore(tmp_path, parts="p")
+    store.write_part("a", TABLE)
+    (tmp_path / "p" / "a.parquet.sha256").unlink()
+    assert cli.main(["checksum", str(tmp_path)]) == 0
+    assert capsys.readouterr().out.splitlines() == [
+        f"checksummed {tmp_path / 'p' / 'a.parquet'}",
+        f"1 files checksummed in {tmp_path}",
+    ]
+    assert cli.main(["checksum", str(tmp_path)]) == 0 and "every file has its checksum" in capsys.readouterr().out
+    assert cli.main(["checksum", str(tmp_path / "nowhere")]) == 2
+    assert capsys.readouterr().err.count("\n") == 1

@@ -38,6 +38,7 @@ from wrist_env.errors import WristEnvError
 from wrist_env.frames import DOF_NAMES
 from wrist_env.identification.likelihood import map_objective
 from wrist_env.participants import builtin
+from wrist_env.runs import provenance
 from wrist_env.task import task
 
 if TYPE_CHECKING:
@@ -233,6 +234,9 @@ def calibrate(
             pass
         options.update(storage=storage_obj, study_name=key.name)
     calibration = task(participant, "calibrate")
+    made_from = provenance.of_participant(participant) if run_log is not None else None
+    if run_log is not None:
+        run_log.move_aside_stale(key, made_from)  # another model's evaluations are not replayed
 
     logged = run_log.read_cell(key) if run_log is not None else None
     logged_x = np.empty((0, N_MATERIAL)) if logged is None else logged[list(X_COLUMNS)].to_numpy()
@@ -274,7 +278,9 @@ def calibrate(
             state["batch"] = max(state["batch"], logged_batches)  # after a replay: the next free batch number
             if run_log is not None:
                 cost, failed, rmse, unsettled = state["pending"]
-                run_log.append(key, state["batch"], n, x, cost, failed, rmse, objective=y, unsettled=unsettled)
+                run_log.append(
+                    key, state["batch"], n, x, cost, failed, rmse, objective=y, unsettled=unsettled, made_from=made_from
+                )
         else:
             state["replayed"] += k
         state["batch"] += 1
@@ -316,5 +322,5 @@ def calibrate(
     )
     if run_log is not None:
         run_log.compact(key)
-        run_log.write_summary(key, run.to_dict(history=False))
+        run_log.write_summary(key, run.to_dict(history=False), made_from)
     return run

@@ -19,6 +19,12 @@ scaphoid and lunate DOF (`rmse.<bone>.<DOF>`, mm and deg; NaN if failed),
 the `objective` the calibrator minimized (the cost, or the MAP objective), and
 `unsettled`, the frames whose hold ran out before equilibrium (null if failed).
 
+Every evaluation file and summary records the participant's model and trials it was made on
+(`wrist_env.runs.provenance`): a resume moves aside a cell made on others (`move_aside_stale`), the
+leaderboard refuses one (`check_made_from`); and a file holds the cell its name says (`repair` and
+`summary` check the rows' and the summary's key against the name: a cell copied under another name is
+moved aside, not trusted).
+
 No evaluation is logged twice: `append` refuses a batch whose file or eval
 indices already exist, and `read` drops duplicate (run key, eval) rows (the
 only way to get them is a crash between writing a compacted cell file and
@@ -43,8 +49,10 @@ from wrist_env.cost import COST_BONES
 from wrist_env.design import N_MATERIAL, NAMES
 from wrist_env.errors import StoreError, WristEnvError
 from wrist_env.frames import DOF_NAMES
+from wrist_env.io import read_json
 from wrist_env.limits import MAX_BUDGET, MAX_SEED, check_int
 from wrist_env.motions import TRIAL_MOTIONS
+from wrist_env.runs import provenance
 from wrist_env.runs.store import RunStore, read_parquet, remove_file, write_parquet
 
 if TYPE_CHECKING:
@@ -117,6 +125,15 @@ def _check_summary(path: Path, summary) -> None:
         raise StoreError(f"{path}: not a whole cell summary (no {', '.join(missing)}); {RERUN}")
 
 
+def _summary_cell(summary: dict) -> str:
+    """The cell name the key fields of a summary (or a row) give (`RunKey.name`), or a description if they
+    are not a key."""
+    try:
+        return RunKey(*(summary[k] for k in KEY_FIELDS)).name
+    except (WristEnvError, TypeError, ValueError):
+        return f"{[summary.get(k) for k in KEY_FIELDS]} (not a cell key)"
+
+
 class DuplicateEvaluationError(WristEnvError, RuntimeError):
     """An attempt to log an evaluation that is already in the log."""
 
@@ -174,12 +191,14 @@ class RunLog:
         rmse: np.ndarray,
         objective: ArrayLike | None = None,
         unsettled: ArrayLike | None = None,
+        made_from: dict | None = None,
     ) -> Path:
         """Log one batch: evaluations start … start + k − 1 of `key`, atomically, never twice.
 
         x (k, 22) normalized materials; cost (k,); failed (k,); rmse (k, 12) in `RMSE_COLUMNS` order;
         objective (k,) the values told to the calibrator (default: the cost); unsettled (k,) frames that
-        did not settle per evaluation, None where it failed (default: all null).
+        did not settle per evaluation, None where it failed (default: all null); made_from: the
+        participant's `provenance.of_participant`, recorded in the file's metadata.
         """
         x = np.atleast_2d(np.asarray(x, dtype=np.float64))
         k = len(x)
@@ -216,6 +235,8 @@ class RunLog:
         if len(columns["unsettled"]) != k:
             raise ValueError(f"unsettled must have {k} entries, but got {len(columns['unsettled'])}")
         table = pa.Table.from_pydict(columns, schema=SCHEMA)
+        if made_from is not None:
+            table = provenance.with_provenance(table, made_from)
         return self.store.write_part(f"part-{key.name}-b{batch:05d}-e{start:06d}-{start + k:06d}", table)
 
     def compact(self, key: RunKey) -> Path | None:
@@ -225,14 +246,56 @@ class RunLog:
             return None
         path = self.evals_dir / f"cell-{key.name}-n{len(frame):06d}.parquet"
         table = pa.Table.from_pandas(frame, schema=SCHEMA, preserve_index=False)
+        recorded = [provenance.read_provenance(p, RERUN) for p in self._files(key)]
+        if recorded and recorded[0] is not None and all(r == recorded[0] for r in recorded):
+            table = provenance.with_provenance(table, recorded[0])  # kept where the files agree on it
         write_parquet(path, table)
         for p in self._files(key):
             if p != path:
                 remove_file(p)
         return path
 
-    def write_summary(self, key: RunKey, summary: dict) -> Path:
-        return self.store.write_record(key.name, summary)
+    def write_summary(self, key: RunKey, summary: dict, made_from: dict | None = None) -> Path:
+        """Write a finished cell's summary, with the provenance it was made on (`made_from`) if given."""
+        return self.store.write_record(key.name, summary | ({} if made_from is None else {provenance.FIELD: made_from}))
+
+    def move_aside_stale(self, key: RunKey, made_from: dict) -> int:
+        """Move to `damaged/` every file of the cell (its evaluations and its summary) if any of them was
+        made on another model or trials than `made_from` (`provenance.of_participant`), or records none:
+        the cell then runs again from scratch (a replay of another model's evaluations would calibrate on
+        them). Returns the files moved."""
+        summary_path = self.store.record_path(key.name)
+        recorded = [(p, provenance.read_provenance(p, RERUN)) for p in self._files(key)]
+        if summary_path.is_file():
+            try:
+                data = read_json(summary_path, "cell summary")
+            except StoreError:
+                data = None  # unreadable: `repair` moves it aside
+            if isinstance(data, dict):
+                recorded.append((summary_path, data.get(provenance.FIELD)))
+        changed = next(((p, d) for p, r in recorded if (d := provenance.differences(r, made_from))), None)
+        if changed is None:
+            return 0
+        why = f"made on another model or trials of {key.participant} ({changed[1]}); the cell runs again"
+        moved = sum(
+            self.store.quarantine(p, why if p == changed[0] else f"{why} (as {changed[0].name})") is not None
+            for p, _ in recorded
+        )
+        return moved
+
+    def check_made_from(self, made_from: dict[str, dict]) -> None:
+        """`StoreError` naming the first finished cell's summary made on another model or trials than
+        `made_from` ({participant: `provenance.of_participant`}) records (the leaderboard's check)."""
+        for name in self.store.record_names():
+            path = self.store.record_path(name)
+            summary = self.store.read_record(name, advice=RERUN)
+            today = made_from.get(summary.get("participant")) if isinstance(summary, dict) else None
+            changed = "" if today is None else provenance.differences(summary.get(provenance.FIELD), today)
+            if changed:
+                raise StoreError(
+                    f"{path}: this cell was calibrated on another model or trials of {summary['participant']} "
+                    f"({changed}); {RERUN} on today's model"
+                )
 
     def lock(self, key: RunKey) -> AbstractContextManager[None]:
         """Hold the cell's lock (an flock, released when the process dies) while running it."""
@@ -253,6 +316,9 @@ class RunLog:
             m = _match(path.name)
             if m is not None:
                 moved += self._drop_from(path, "damaged Parquet file, its evaluations are re-simulated")
+        for path in self._files():
+            if path.exists() and (why := self._misnamed(path)):
+                moved += self._drop_from(path, why)
         for files in self._by_cell().values():
             end = 0
             for start, stop, path in files:
@@ -262,6 +328,22 @@ class RunLog:
                     break
                 end = max(end, stop)
         return moved + self._repair_summaries()
+
+    def _misnamed(self, path: Path) -> str:
+        """Why the evaluations in `path` are not the ones its name says (another cell's rows, or other
+        evaluation numbers: a copy under another name), or "" if they are (or it is unreadable: damage)."""
+        m = _match(path.name)
+        try:
+            cols = read_parquet(path, columns=[*KEY_FIELDS, "eval"], advice=RERUN).to_pydict()
+        except StoreError:
+            return ""
+        cells = {_summary_cell(dict(zip(KEY_FIELDS, k))) for k in zip(*(cols[f] for f in KEY_FIELDS))}
+        first, end = _span(m)
+        if cells != {m["cell"]}:
+            return f"holds evaluations of {', '.join(sorted(cells)) or 'no cell'}, not of {m['cell']} (a copy?), re-simulated"
+        if sorted(cols["eval"]) != list(range(first, end)):
+            return f"holds other evaluations than {first}…{end - 1} its name says (a copy?), re-simulated"
+        return ""
 
     def _by_cell(self) -> dict[str, list[tuple[int, int, Path]]]:
         """{cell name: [(first eval, end eval, file)] sorted}, from the file names."""
@@ -290,8 +372,8 @@ class RunLog:
             except IncompleteCellError as e:
                 reason = f"{str(e).split(': ', 1)[1].split('; ')[0]}; the cell runs again"
                 moved += self.store.quarantine(self.store.record_path(name), reason) is not None
-            except StoreError:
-                reason = "damaged cell summary, the cell runs again (by replay)"
+            except StoreError as e:
+                reason = f"{str(e).split(': ', 1)[-1].split('; ')[0]}; the cell runs again (by replay)"
                 moved += self.store.quarantine(self.store.record_path(name), reason) is not None
         return moved
 
@@ -376,6 +458,12 @@ class RunLog:
         if summary is None:
             return None
         _check_summary(self.store.record_path(name), summary)
+        named = _summary_cell(summary)
+        if named != name:
+            raise StoreError(
+                f"{self.store.record_path(name)}: holds the summary of cell {named}, not of {name} (a copy under "
+                f"another name?); {RERUN}"
+            )
         n = summary["nfev"]
         if progress.get(name, 0) < n:
             raise IncompleteCellError(

@@ -31,6 +31,7 @@ from wrist_env.bench.log import RunKey, RunLog
 from wrist_env.errors import InputError
 from wrist_env.limits import MAX_SEEDS, MAX_THREADS, MAX_WORKERS, check_int, check_unique
 from wrist_env.participants import registry
+from wrist_env.runs import provenance
 from wrist_env.runs.executor import describe, executor, set_threads
 
 if TYPE_CHECKING:
@@ -114,6 +115,7 @@ def run_cell(
         registry.ensure_folder(folder)
     log = RunLog(out_dir)
     with log.lock(key):
+        log.move_aside_stale(key, provenance.of_participant(key.participant))
         summary = log.summary(key)
         if summary is not None:
             return {"status": "skipped", "summary": summary}
@@ -173,6 +175,9 @@ def benchmark(
     _prepare_storage(cells, storage)
     log = RunLog(out_dir)
     log.repair()
+    made_from = {p: provenance.of_participant(p) for p in sorted({k.participant for k in cells})}
+    for k in cells:  # a cell made on another model or trials (an edited folder) runs again
+        log.move_aside_stale(k, made_from[k.participant])
     done = {k for k in cells if log.summary(k) is not None}
     report = BenchmarkReport(out_dir, cells, skipped=[k for k in cells if k in done])
     todo = [k for k in cells if k not in done]

@@ -37,6 +37,7 @@ COMMANDS = {
         "Monte Carlo injury study: n successful idealized sweeps per participant (preprint 2.3.2)",
     ),
     "montecarlo-report": ("study_commands", "Tables 5-6 and Figures 8-10 of a Monte Carlo run log"),
+    "checksum": ("study_commands", "checksum a run log written before wrist-env kept checksums (only one you trust)"),
     "sensitivity": (
         "identification_commands",
         "global sensitivity of the cost and the 12 DOF errors to the 22 materials (SALib)",

@@ -150,3 +150,14 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     _run_log_arguments(s, out="runs/montecarlo-report", runs="runs/montecarlo")
     s.add_argument("--max-runs", type=int, help="fit on a seeded random subset of this many runs (default: all)")
     s.set_defaults(run="studies:montecarlo_report")
+
+    s = command(
+        "checksum",
+        folders_option=False,
+        description="Add the checksums a run log written before wrist-env kept them lacks (a benchmark's --out or "
+        "a Monte Carlo study's): every Parquet part that reads whole gets its .sha256, every cell summary its "
+        "record_sha256, and each is named. A log missing a checksum is otherwise refused as damaged, since a "
+        "deleted checksum looks the same: run this only on a log you trust.",
+    )
+    s.add_argument("run_log", metavar="folder", help="the run-log folder")
+    s.set_defaults(run="studies:checksum")

@@ -80,7 +80,9 @@ def read_metadata(path: str | Path, key: bytes, advice: str = "") -> dict | None
         raw = (pq.read_schema(path).metadata or {}).get(key)
         return None if raw is None else json.loads(raw)
     except (OSError, pa.ArrowException, ValueError) as e:
-        raise StoreError(f"{path}: damaged Parquet part ({type(e).__name__}){f'; {advice}' if advice else ''}") from None
+        raise StoreError(
+            f"{path}: damaged Parquet part ({type(e).__name__}){f'; {advice}' if advice else ''}"
+        ) from None
 
 
 def read_provenance(path: str | Path, advice: str = "") -> dict | None:

@@ -21,6 +21,8 @@ from wrist_env.bench.leaderboard.tables import (
     load_runs,
     unsettled_shares,
 )
+from wrist_env.bench.log import RunLog
+from wrist_env.runs import provenance
 
 
 @dataclass(frozen=True)
@@ -54,9 +56,10 @@ def build(runs: str | Path, references: dict[str, Reference] | None = None) -> L
     evals, summaries, unfinished = load_runs(runs)
     if not summaries:
         raise ValueError(f"{runs}: no finished benchmark cell in this run log")
+    participants = sorted({s["participant"] for s in summaries})
+    RunLog(runs).check_made_from({p: provenance.of_participant(p) for p in participants})  # today's models
     summaries = sorted(summaries, key=lambda s: (s["participant"], s["optimizer"], s["budget"], s["seed"]))
     budgets = {s["budget"] for s in summaries}
-    participants = sorted({s["participant"] for s in summaries})
     labels = sorted({calibrator_label(s["optimizer"], s["budget"], budgets) for s in summaries})
     refs = dict(references or {})
     for p in participants:

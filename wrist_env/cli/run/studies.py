@@ -1,5 +1,5 @@
 """How `wrist-bench` runs the studies: calibrate, benchmark, leaderboard, iohanalyzer, montecarlo,
-montecarlo-report (declared in `wrist_env.cli.study_commands`)."""
+montecarlo-report, checksum (declared in `wrist_env.cli.study_commands`)."""
 
 from __future__ import annotations
 
@@ -173,4 +173,14 @@ def montecarlo_report(args) -> int:
         f"Table 5: {t5['runs']:,} runs, {t5['rows']:,} rows, fit {t5['fit_seconds']} s; "
         f"report {summary['report_seconds']} s; written to {args.out}"
     )
+    return 0
+
+
+def checksum(args) -> int:
+    from wrist_env.runs.store import add_checksums
+
+    done = add_checksums(args.run_log)
+    for path in done:
+        print(f"checksummed {path}")
+    print(f"{len(done)} files checksummed in {args.run_log}" if done else f"{args.run_log}: every file has its checksum")
     return 0
