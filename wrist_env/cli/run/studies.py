@@ -182,5 +182,7 @@ def checksum(args) -> int:
     done = add_checksums(args.run_log)
     for path in done:
         print(f"checksummed {path}")
-    print(f"{len(done)} files checksummed in {args.run_log}" if done else f"{args.run_log}: every file has its checksum")
+    print(
+        f"{len(done)} files checksummed in {args.run_log}" if done else f"{args.run_log}: every file has its checksum"
+    )
     return 0
