@@ -30,3 +30,16 @@ def test_a_bad_row_or_shape_is_named():
     with pytest.raises(DesignError, match=r"shape \(n, 27\), but got \(27,\)"):
         design.from_actions(np.zeros(design.N_DESIGN))
     assert design.from_actions(np.zeros((0, design.N_DESIGN))) == []
+
+
+def test_without_a_reference_the_info_has_the_same_keys_as_none():
+    """`outputs` without a cost report (a folder participant's idealized sweep) gives the keys a scored run
+    gives, the cost's (`REFERENCE_KEYS`) None: not missing (a KeyError in `sensitivity`), not 0 (a perfect
+    fit), not NaN (the info is JSON-ready)."""
+    from wrist_env.task import REFERENCE_KEYS, outputs
+
+    scored = task("P1", "calibrate").evaluate_action(np.zeros(design.N_DESIGN))
+    unscored = outputs(scored.result)
+    assert set(REFERENCE_KEYS) <= set(scored.info) and scored.info["error_p75"]["scaphoid"]
+    assert set(unscored) == set(scored.info)
+    assert all(unscored[k] is None for k in REFERENCE_KEYS)

@@ -10,6 +10,7 @@ from scipy.spatial.transform import Rotation
 from wrist_env.errors import TrialError
 from wrist_env.trial import (
     COLUMNS,
+    MATRIX_COLUMNS,
     MIRROR,
     Trial,
     mirror_trial,
@@ -278,4 +279,98 @@ def test_wrong_shape():
 def test_non_integer_frame(csv_path):
     edit_csv(csv_path, lambda t: t.assign(frame=t.frame.astype(float).where(t.index != 11, 2.5)))
     with raises(csv_path, "column frame must hold integers, but line 13 has '2.5'"):
+        read_trial_csv(csv_path, "u", "calibrate")
+
+
+# --- issue 53: the radius and ulna rows, the frame limit ---------------------------------
+
+
+def _turn_row(bone: str, frame: int, deg: float = 0.0, shift_mm: float = 0.0):
+    """An edit of one bone's row on one frame: a turn about y by `deg` after it, and a shift along x."""
+
+    def edit(t):
+        row = (t.frame == frame) & (t.bone == bone)
+        turn = Rotation.from_euler("y", deg, degrees=True).as_matrix()
+        matrix = t.loc[row, list(MATRIX_COLUMNS)].to_numpy().reshape(3, 4)
+        moved = np.c_[turn @ matrix[:, :3], turn @ matrix[:, 3] + [shift_mm, 0.0, 0.0]]
+        t.loc[row, list(MATRIX_COLUMNS)] = moved.ravel()
+        return t
+
+    return edit
+
+
+@pytest.mark.parametrize(
+    "bone, deg, shift_mm, value",
+    [
+        (
+            "radius",
+            0.0,
+            1.5,
+            r"radius must stay at the identity .*within 1 mm and 2°, but frame 6 has it 1.5 mm and 0°",
+        ),
+        ("radius", 3.0, 0.0, r"radius must stay at the identity .*but frame 6 has it 0 mm and 3°"),
+        (
+            "ulna",
+            0.0,
+            4.0,
+            r"ulna must stay at its static pose relative to the radius .*within 3 mm and 10°, but frame 6",
+        ),
+        ("ulna", 12.0, 0.0, r"ulna must stay .*frame 6 has it [0-9.]+ mm and 12°"),
+    ],
+    ids=["radius shifted", "radius turned", "ulna shifted", "ulna turned"],
+)
+def test_a_radius_or_ulna_off_the_radius_frame_is_refused(csv_path, bone, deg, shift_mm, value):
+    """The radius is the identity in its own coordinate system and the ulna nearly fixed to it: a trial
+    where either moves beyond the tolerances (trial.RADIUS_TOLERANCE_*, ULNA_TOLERANCE_*) is in another
+    frame; the message names the file, the frame and the deviation."""
+    edit_csv(csv_path, _turn_row(bone, 6, deg, shift_mm))
+    with raises(csv_path, value):
+        read_trial_csv(csv_path, "u", "calibrate")
+
+
+def test_the_ulna_is_checked_relative_to_the_radius(csv_path):
+    """Radius and ulna moved together by as much as the radius may move, the ulna stays fixed relative
+    to it: accepted (the ulna's own pose is 1.9° and 0.9 mm from the identity)."""
+    edit_csv(csv_path, _turn_row("radius", 3, 1.9, 0.9))
+    edit_csv(csv_path, _turn_row("ulna", 3, 1.9, 0.9))
+    read_trial_csv(csv_path, "u", "calibrate")
+
+
+def test_small_forearm_motion_within_tracking_noise_is_accepted(csv_path):
+    """The tolerances stay above 4DCT tracking noise: a radius 0.5 mm and 1° off, an ulna 2 mm and 5°."""
+    edit_csv(csv_path, _turn_row("radius", 2, 1.0, 0.5))
+    edit_csv(csv_path, _turn_row("ulna", 9, 5.0, 2.0))
+    read_trial_csv(csv_path, "u", "calibrate")
+
+
+@pytest.mark.parametrize("name", ["P1", "P2", "P3"])
+def test_the_builtin_trials_pass_the_forearm_check(name, tmp_path):
+    """The built-in trials (read through read_trial_csv) and the same written by write_trial_csv."""
+    from wrist_env.participants import builtin
+
+    for trial_name, trial in builtin.trials(name).items():
+        assert {"radius", "ulna"} <= set(trial.bones)
+        write_trial_csv(trial, tmp_path / f"{trial_name}.csv")
+        again = read_trial_csv(tmp_path / f"{trial_name}.csv", trial_name, trial.role)
+        np.testing.assert_array_equal(again.transforms, trial.transforms)
+
+
+def test_a_trial_of_too_many_rows_is_refused_before_it_is_parsed(tmp_path, monkeypatch):
+    """More rows than MAX_TRIAL_FRAMES frames of every bone: refused with the limit, pandas never called."""
+    import wrist_env.trial as trial_module
+
+    monkeypatch.setattr(trial_module, "MAX_TRIAL_FRAMES", 10)
+    path = tmp_path / "long.csv"
+    write_trial_csv(make_trial(n_frames=13), path)  # 13 frames × 5 bones = 65 rows > 10 × 6
+    monkeypatch.setattr(trial_module.pd, "read_csv", lambda *a, **k: pytest.fail("parsed"))
+    with raises(path, r"at most 10 frames \(limits.MAX_TRIAL_FRAMES\), so at most 60 rows .* but the file has 65"):
+        read_trial_csv(path, "u", "calibrate")
+
+
+@pytest.mark.parametrize("frame", [1000, -1, 10**12])
+def test_a_frame_number_beyond_the_limit_is_refused(csv_path, frame):
+    """A frame numbered outside [0, MAX_TRIAL_FRAMES) is refused before the frames are counted (a frame
+    10^12 once made a set of 10^12 numbers to find the gaps)."""
+    edit_csv(csv_path, lambda t: t.assign(frame=t.frame.where(t.index != 30, frame)))
+    with raises(csv_path, rf"n at most 1,000 \(limits.MAX_TRIAL_FRAMES\), but line 32 has frame {frame}"):
         read_trial_csv(csv_path, "u", "calibrate")

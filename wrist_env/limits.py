@@ -43,3 +43,11 @@ def check_unique(name: str, values) -> list:
     if repeats:
         raise InputError(f"{name} must not repeat, but got {values} ({', '.join(repeats)} more than once)")
     return values
+
+
+MAX_TRIAL_FRAMES = 1_000
+"""Frames of one trial (a trial CSV's frames, participant.toml's `frames`). A 4DCT motion has tens of
+frames (the built-in trials 15); every frame is simulated for every design and its outputs kept (~2.2 kB
+per frame and design: poses, contact, bundle forces, the RSC membrane's 45 nodes), so a batch of 64
+designs of 1,000 frames holds ~140 MB and takes ~70 times a built-in trial's time; a trial sampled
+faster is to be subsampled. Checked on the CSV's row count before it is parsed."""

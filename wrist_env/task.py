@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike
 from wrist_env import design as design_vars
 from wrist_env.cost import COST_BONES, CostReport, CostWeights, kinematic_cost
 from wrist_env.design import ALL_LIGAMENT_NAMES, Design
+from wrist_env.errors import ParticipantError
 from wrist_env.model import BONES, PAIRS, Model
 from wrist_env.motions import MOTIONS
 from wrist_env.participants import builtin, registry
@@ -59,10 +60,40 @@ class Evaluations(Sequence):
         return self.each[i]
 
 
+REFERENCE_KEYS = ("cost", "error_p75", "rmse", "cost_terms")
+"""The `info` entries scored against the reference kinematics: None where there is none (`has_reference`)."""
+
+
+def has_reference(participant: str, motion: str) -> bool:
+    """Whether the participant's motion has reference kinematics to score against (found without building
+    its model): a trial with the motion's role, or for "idealized" a built-in participant's hidden truth
+    (a folder participant has none: its sweep's reward is 0 and its `REFERENCE_KEYS` are None)."""
+    if motion == "idealized":
+        return participant in builtin.BUILTIN
+    return any(t.role == motion for t in registry.trials(participant).values())
+
+
+def require_reference(participant: str, motion: str) -> None:
+    """ParticipantError naming the participant, the motion and the motions that have a reference, unless
+    `has_reference` (a study of costs and errors means nothing without one)."""
+    if not has_reference(participant, motion):
+        usable = [m for m in MOTIONS if has_reference(participant, m)]
+        why = (
+            "only the built-in participants' sweeps have one, from their hidden truth"
+            if motion == "idealized"
+            else f"it has no trial with role {motion!r}"
+        )
+        raise ParticipantError(
+            f"participant {participant!r} has no reference kinematics for the {motion} motion ({why}), so its "
+            f"cost and DOF errors are undefined; motions with one: {usable}"
+        )
+
+
 class Task:
     """Participant × motion: "calibrate" (unresisted trial), "validate" (held-out resisted
     trial) or "idealized" (flexion–extension sweep; reference = the hidden truth's
-    sweep for built-in participants, none for user participants → reward 0).
+    sweep for built-in participants, none for user participants → reward 0, and the
+    info's `REFERENCE_KEYS` None).
     load_direction: the loads' lines (`settings.LOAD_DIRECTIONS`, default `settings.DEFAULT_LOADS`): the
     sweep's, and in a trial the radial column's (the capitate is prescribed) at the trial's `load_n`."""
 
@@ -89,7 +120,7 @@ class Task:
     def _driver_and_reference(self) -> tuple[Driver, np.ndarray | None]:
         if self.motion == "idealized":
             driver = idealized(self.model, direction=self.load_direction)
-            if self.participant not in builtin.BUILTIN:
+            if not has_reference(self.participant, self.motion):
                 return driver, None
             truth = simulate(self.model, builtin.truth(self.participant), driver, self.settings)
             return driver, cost_poses(truth.poses)
@@ -133,7 +164,9 @@ def cost_poses(poses: np.ndarray) -> np.ndarray:
 
 
 def outputs(result: Result, report: CostReport | None = None) -> dict:
-    """JSON-ready, NaN-free per-frame outputs (a failed run's arrays are zeros, `failed` True)."""
+    """JSON-ready, NaN-free per-frame outputs (a failed run's arrays are zeros, `failed` True) and the cost's
+    `REFERENCE_KEYS`: without a `report` (no reference kinematics) those are None — the same keys for every
+    participant, and a value no one takes for a score (0 would read as a perfect fit; NaN breaks JSON)."""
 
     def clean(a):
         return np.nan_to_num(np.asarray(a, dtype=np.float64), nan=0.0)
@@ -152,6 +185,7 @@ def outputs(result: Result, report: CostReport | None = None) -> dict:
         "steps": np.asarray(result.steps, dtype=np.int64),
         "settled": np.asarray(result.settled, dtype=bool),
     }
+    info |= dict.fromkeys(REFERENCE_KEYS)
     if report is not None:
         r = report.to_dict()
         info["cost"] = r["total"]

@@ -7,6 +7,13 @@ the identity. CSV format, one row per bone per frame, frames 0..n-1:
     frame,bone,m00,m01,m02,m03,m10,m11,m12,m13,m20,m21,m22,m23
 
 (the top three rows of the 4×4; the bottom row is 0 0 0 1).
+
+The RCS is the radius's own frame, and the solver holds the radius and ulna
+fixed in it: rows of the radius, where given, must be the identity on every
+frame (within `RADIUS_TOLERANCE_MM` and `RADIUS_TOLERANCE_DEG`), and rows of
+the ulna nearly fixed relative to the radius (`ULNA_TOLERANCE_MM`,
+`ULNA_TOLERANCE_DEG`); otherwise the trial is in another frame (scanner
+coordinates, say). A trial has at most `limits.MAX_TRIAL_FRAMES` frames.
 """
 
 from __future__ import annotations
@@ -20,6 +27,7 @@ from numpy.typing import ArrayLike
 
 from wrist_env.errors import TrialError
 from wrist_env.frames import validate_poses
+from wrist_env.limits import MAX_TRIAL_FRAMES
 from wrist_env.model import BONES, CARPALS
 from wrist_env.motions import TRIAL_MOTIONS
 
@@ -32,6 +40,17 @@ METRES_ROTATION_DEG = 5.0  # ... by more than this: translations are in metres
 MAX_TRANSLATION_MM = 100.0
 """A bone's pose moves it at most this far (mm, any axis) from its neutral place: the built-in trials stay
 within 8 mm; a larger value is a unit or export error (1e6 mm was accepted, at cost 1.4e6)."""
+RADIUS_TOLERANCE_MM, RADIUS_TOLERANCE_DEG = 1.0, 2.0
+"""How far the radius may be from the identity on a frame (translation of the RCS origin, rotation angle).
+In the radius's own frame the radius is the identity by definition; what remains is tracking noise (the
+built-in trials' 0.2 mm and 0.5° RMS: `builtin.TRACKING_NOISE_MM`/`_DEG`), which stays well inside 5× and 4×
+that. A radius moved further shifts every carpal's reference by more than the errors calibration resolves
+(~1 mm, ~2°): a trial in scanner coordinates, or a forearm that moved in the scanner."""
+ULNA_TOLERANCE_MM, ULNA_TOLERANCE_DEG = 3.0, 10.0
+"""How far the ulna may move relative to the radius (its pose in the radius's, which is its static pose: the
+identity). The distal radioulnar joint moves a little during wrist motions with the forearm held (ulnar
+variance grows by ~1–2 mm in a power grip; a few degrees of rotation), which the solver ignores (both bones
+fixed); more is forearm rotation the model cannot follow, or an ulna in another frame."""
 MIRROR = np.diag([1.0, 1.0, -1.0, 1.0])
 """Left → right wrist reflection of the RCS (z → −z)."""
 
@@ -145,6 +164,7 @@ def read_trial_csv(
     path = Path(path)
     if not path.is_file():
         raise TrialError(f"trial file {path} does not exist.")
+    _check_row_count(path)
     try:
         table = pd.read_csv(path, skipinitialspace=True)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
@@ -166,6 +186,12 @@ def read_trial_csv(
             kind = "integers" if column == "frame" else "numbers"
             raise TrialError(
                 f"{path}: column {column} must hold {kind}, but line {row + 2} has {str(table[column].iloc[row])!r}."
+            )
+        if column == "frame" and not values.between(0, MAX_TRIAL_FRAMES - 1).all():
+            row = int(np.flatnonzero(~values.between(0, MAX_TRIAL_FRAMES - 1))[0])
+            raise TrialError(
+                f"{path}: frames must be numbered 0..n-1 with n at most {MAX_TRIAL_FRAMES:,} "
+                f"(limits.MAX_TRIAL_FRAMES), but line {row + 2} has frame {str(table[column].iloc[row])}."
             )
         table[column] = values
     table["frame"] = table["frame"].astype(np.int64)
@@ -212,6 +238,7 @@ def read_trial_csv(
     transforms[:, :, :3, :] = matrix.transpose(1, 0, 2, 3)
     transforms[:, :, 3, 3] = 1.0
     transforms = validate_transforms(transforms, str(path), bones)
+    _check_forearm(transforms, bones, path)
     return Trial(name, role, bones, transforms)
 
 
@@ -223,6 +250,52 @@ def write_trial_csv(trial: Trial, path: str | Path) -> None:
     table.insert(0, "bone", np.tile(trial.bones, n_frames))
     table.insert(0, "frame", np.repeat(np.arange(n_frames), n_bones))
     table.to_csv(Path(path), index=False, float_format="%.17g")
+
+
+def _check_row_count(path: Path, chunk: int = 1 << 24) -> None:
+    """TrialError naming the file if it has more rows than a trial of `MAX_TRIAL_FRAMES` frames of every
+    bone: counted in chunks, before pandas reads (and allocates) it."""
+    rows, most = -1, MAX_TRIAL_FRAMES * len(BONES)  # -1: the header
+    with open(path, "rb") as f:
+        last = b"\n"
+        while block := f.read(chunk):
+            rows += block.count(b"\n")
+            last = block[-1:]
+    rows += last != b"\n"  # a last line without its newline
+    if rows > most:
+        raise TrialError(
+            f"{path}: a trial has at most {MAX_TRIAL_FRAMES:,} frames (limits.MAX_TRIAL_FRAMES), so at most "
+            f"{most:,} rows of its {len(BONES)} bones, but the file has {rows:,}; subsample it."
+        )
+
+
+def _check_forearm(transforms: np.ndarray, bones: tuple[str, ...], path: Path) -> None:
+    """TrialError naming the file, the frame and the deviation unless the radius (if given) is the identity
+    and the ulna (if given) nearly fixed relative to it on every frame (module docstring; tolerances
+    `RADIUS_TOLERANCE_*`, `ULNA_TOLERANCE_*`)."""
+    identity = np.eye(4)
+    radius = transforms[bones.index("radius")] if "radius" in bones else np.broadcast_to(identity, transforms.shape[1:])
+    checks = (
+        [("radius", radius, "the identity", RADIUS_TOLERANCE_MM, RADIUS_TOLERANCE_DEG)] if "radius" in bones else []
+    )
+    if "ulna" in bones:
+        relative = np.linalg.inv(radius) @ transforms[bones.index("ulna")]
+        checks.append(
+            ("ulna", relative, "its static pose relative to the radius", ULNA_TOLERANCE_MM, ULNA_TOLERANCE_DEG)
+        )
+    for bone, poses, where, most_mm, most_deg in checks:
+        shift_mm = np.linalg.norm(poses[:, :3, 3], axis=1)
+        cos = np.clip((np.trace(poses[:, :3, :3], axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+        turn_deg = np.degrees(np.arccos(cos))
+        bad = np.flatnonzero((shift_mm > most_mm) | (turn_deg > most_deg))
+        if bad.size:
+            f = int(bad[0])
+            raise TrialError(
+                f"{path}: the {bone} must stay at {where} (the trial is in the radius's coordinate system, with "
+                f"radius and ulna fixed) within {most_mm:g} mm and {most_deg:g}°, but frame {f} has it "
+                f"{shift_mm[f]:.3g} mm and {turn_deg[f]:.3g}° away ({bad.size} frames in all); is the trial in "
+                f"another frame (scanner coordinates)? Express every pose relative to the radius."
+            )
 
 
 def _brief(values: list, limit: int = 10) -> str:

@@ -77,6 +77,28 @@ def test_registered_ids_make_and_step(with_validate):
             assert reward < 0.0 and math.isfinite(info["cost"])
 
 
+@pytest.mark.slow
+def test_a_folder_participants_idealized_info_has_the_builtins_keys(with_validate):
+    """A folder participant's idealized sweep has no reference kinematics (reward 0): its info has the
+    keys of a scored run's, cost, error_p75, rmse and cost_terms None (they were missing, and
+    `sensitivity` failed with KeyError: 'error_p75'); the vector env's infos carry them too."""
+    from wrist_env.task import REFERENCE_KEYS
+
+    wrist_env.register_participant(with_validate)
+    infos = {}
+    for motion in ("calibrate", "idealized"):
+        env = gym.make(env_id("U1", motion))
+        env.reset(seed=0)
+        _, reward, *_, infos[motion] = env.step(np.zeros(27, dtype=np.float32))
+    assert set(infos["idealized"]) == set(infos["calibrate"]) and reward == 0.0
+    assert all(infos["idealized"][k] is None for k in REFERENCE_KEYS)
+    assert math.isfinite(infos["calibrate"]["cost"]) and infos["calibrate"]["error_p75"]["lunate"]
+    vector = gym.make_vec(env_id("U1", "idealized"), num_envs=2, vectorization_mode="vector_entry_point")
+    vector.reset(seed=0)
+    *_, vinfo = vector.step(np.zeros((2, 27), dtype=np.float32))
+    assert set(REFERENCE_KEYS) <= set(vinfo) and list(vinfo["error_p75"]) == [None, None]
+
+
 def test_evaluate_command_with_folder(capsys, with_validate):
     assert main(["evaluate", "U1", "--folder", str(with_validate), "--motion", "validate", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)

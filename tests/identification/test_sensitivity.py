@@ -53,3 +53,25 @@ def test_a_small_study_of_p1_writes_its_table_and_figure(tmp_path, capsys):
     assert table["runs"].iloc[0] == 46 and 0.0 <= table["failed_share"].iloc[0] < 1.0
     assert (tmp_path / "sensitivity_P1_morris.png").stat().st_size > 10_000
     assert "P1 calibrate: cost mu_star" in capsys.readouterr().out
+
+
+def test_a_motion_without_reference_kinematics_is_one_line_before_any_run(tmp_path, capsys, monkeypatch):
+    """A folder participant's idealized sweep has no reference (its cost and errors are undefined): the
+    study stops before building or simulating anything, with one line naming the participant, the motion
+    and the motions that have one (it was `KeyError: 'error_p75'` after the runs)."""
+    import dataclasses
+
+    from wrist_env.participants import builtin
+    from wrist_env.participants.folder import write_participant_folder
+
+    folder = write_participant_folder(dataclasses.replace(builtin.source("P1"), name="S1"), tmp_path / "s1")
+    monkeypatch.setattr(sensitivity, "task", lambda *a, **k: pytest.fail("a task was built"))
+    code = main(["sensitivity", "S1", "--folder", str(folder), "--n", "2", "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert (
+        "participant 'S1' has no reference kinematics for the idealized motion (only the built-in participants' "
+        "sweeps have one"
+        in err
+        and "motions with one: ['calibrate', 'validate']" in err
+    ), err

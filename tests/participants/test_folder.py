@@ -627,3 +627,147 @@ def test_swapped_bones_are_named_before_the_build(folder, first, second, value):
     edit_toml(folder, f'{first} = "bones/SWAP.stl"', f'{first} = "bones/{second}.stl"')
     with raises(ParticipantError, folder / "participant.toml", f"look swapped.*{value}"):
         load_participant_folder(folder)
+
+
+# --- issue 53: islands, one file for two bones, paths -------------------------------------
+
+
+def scaphoid_with_island(radius_mm: float = 1.0, offset_mm: float = 40.0):
+    """The scaphoid and a sphere of `radius_mm` (80 faces after one subdivision, 320 after two)
+    `offset_mm` away from its centre along x: two closed pieces, each wound outward."""
+    vertices, faces = bone_meshes()["scaphoid"]
+    island = trimesh.creation.icosphere(subdivisions=1, radius=radius_mm)
+    island.apply_translation(np.array(CARPALS["scaphoid"][1], float) + [offset_mm, 0.0, 0.0])
+    return np.vstack([vertices, island.vertices]), np.vstack([faces, island.faces + len(vertices)])
+
+
+def test_a_carpal_with_a_detached_piece_is_refused_naming_the_pieces(folder):
+    """A scaphoid with a 2 mm sphere 40 mm away (closed, outward, so every other rule passes) is refused
+    when the folder is read, naming the file and each piece's faces and extent (bounding-box diagonal:
+    the sphere's 2√3 mm)."""
+    replace_mesh(folder, "scaphoid", *scaphoid_with_island())
+    with raises(
+        MeshError,
+        folder / "bones" / "scaphoid.stl",
+        r"one connected piece, but it has 2: 320 faces over 30.\d mm; 80 faces over 3.4\d mm.*drop_islands = true",
+    ):
+        load_participant_folder(folder)
+
+
+def test_pieces_touching_at_a_vertex_are_two(folder):
+    """Pieces are connected through shared edges: two spheres sharing one vertex are two pieces."""
+    a = trimesh.creation.icosphere(subdivisions=2, radius=5.0)
+    top = int(np.argmax(a.vertices[:, 0]))
+    b = a.copy()
+    b.apply_translation([2 * a.vertices[top, 0], 0.0, 0.0])  # its lowest-x vertex onto a's highest-x one
+    merged = trimesh.util.concatenate([a, b])
+    merged.merge_vertices()
+    assert len(merged.vertices) == len(a.vertices) + len(b.vertices) - 1
+    assert len(folder_module.pieces(merged.vertices, merged.faces)) == 2
+
+
+def test_drop_islands_keeps_the_largest_piece(folder):
+    """With drop_islands = true the scaphoid's largest piece is kept, with a warning naming the file and
+    the dropped piece; the other bones are as before."""
+    vertices, faces = bone_meshes()["scaphoid"]
+    replace_mesh(folder, "scaphoid", *scaphoid_with_island())
+    edit_toml(folder, 'units = "mm"', 'units = "mm"\ndrop_islands = true')
+    with pytest.warns(UserWarning, match=rf"{re.escape(str(folder / 'bones' / 'scaphoid.stl'))}.*dropped 1 \(80 faces"):
+        loaded = load_participant_folder(folder)
+    assert loaded.meta["drop_islands"] is True
+    assert_same_triangles(loaded.bones["scaphoid"], (vertices, faces), atol=1e-5)
+
+
+def test_drop_islands_does_not_drop_half_a_bone(folder):
+    """A second piece of more than `ISLAND_AREA_SHARE` of the largest's area (here a sphere of 6 mm radius,
+    ~50 %) is two parts of a bone, not an island: refused even with drop_islands."""
+    replace_mesh(folder, "scaphoid", *scaphoid_with_island(radius_mm=6.0))
+    edit_toml(folder, 'units = "mm"', 'units = "mm"\ndrop_islands = true')
+    with raises(MeshError, folder / "bones" / "scaphoid.stl", r"2 pieces, and the second has \d+% .*not an island"):
+        load_participant_folder(folder)
+
+
+def test_drop_islands_must_be_a_boolean(folder):
+    edit_toml(folder, 'units = "mm"', 'units = "mm"\ndrop_islands = "yes"')
+    with raises(ParticipantError, folder / TOML, "drop_islands must be true or false, but got 'yes'"):
+        load_participant_folder(folder)
+
+
+@pytest.mark.parametrize("name", list(builtin.BUILTIN) + ["template"])
+def test_builtin_and_template_carpals_are_one_piece(name):
+    """The shipped meshes pass the rule (the radius is several pieces, articular solid and shaft, and is
+    not checked); the template's principal bones are those the folders' are carried from."""
+    from wrist_env.anatomy.template import load_template
+
+    meshes = (
+        {b: (s.vertices, s.faces) for b, s in load_template().bones.items() if b in SUPPLIED}
+        if name == "template"
+        else builtin.source(name).bones
+    )
+    for bone, (vertices, faces) in meshes.items():
+        folder_module.validate_bone_mesh(np.asarray(vertices), np.asarray(faces), bone, f"{name} {bone}")
+        if bone in folder_module.CARPALS:
+            assert len(folder_module.pieces(vertices, faces)) == 1, bone
+
+
+@pytest.mark.parametrize("how", ["same path", "same path through a link", "identical copy"])
+def test_two_bones_with_one_file_are_refused_at_load(folder, monkeypatch, how):
+    """Two bones listed with one file are refused before any mesh is read, naming both bones and the file
+    (not, after a build of minutes, as implausible joint spaces)."""
+    lunate = folder / "bones" / "lunate.stl"
+    if how == "same path":
+        edit_toml(folder, 'lunate = "bones/lunate.stl"', 'lunate = "bones/scaphoid.stl"')
+        value = (
+            rf"bones.scaphoid and bones.lunate are the same file {re.escape(str(folder / 'bones' / 'scaphoid.stl'))}"
+        )
+    elif how == "same path through a link":
+        lunate.unlink()
+        lunate.symlink_to(folder / "bones" / "scaphoid.stl")
+        value = "bones.scaphoid and bones.lunate are the same file"
+    else:
+        lunate.write_bytes((folder / "bones" / "scaphoid.stl").read_bytes())
+        value = r"bones.scaphoid and bones.lunate are files of identical content \(.*scaphoid.stl and .*lunate.stl\)"
+    monkeypatch.setattr(folder_module.trimesh, "load_mesh", lambda *a, **k: pytest.fail("a mesh was read"))
+    with raises(ParticipantError, folder / TOML, value):
+        load_participant_folder(folder)
+
+
+def _loop(tmp_path) -> Path:
+    (tmp_path / "loop_a").symlink_to(tmp_path / "loop_b")
+    (tmp_path / "loop_b").symlink_to(tmp_path / "loop_a")
+    return tmp_path / "loop_a"
+
+
+@pytest.mark.parametrize("how", ["null byte", "symlink loop", "under a symlink loop"])
+@pytest.mark.parametrize("enter", ["load_participant_folder", "add_folder", "ensure_folder"])
+def test_a_folder_path_with_a_null_byte_or_a_loop_is_one_line(tmp_path, how, enter):
+    """Wherever a folder path enters, a null byte or a symlink loop is a ParticipantError naming the path
+    (a null byte shown escaped), not a ValueError or RuntimeError traceback."""
+    if how == "null byte":
+        path, shown = str(tmp_path / "my\0wrist"), repr(str(tmp_path / "my\0wrist"))
+    else:
+        path = _loop(tmp_path) if how == "symlink loop" else _loop(tmp_path) / "my_wrist"
+        shown = str(path)
+    call = load_participant_folder if enter == "load_participant_folder" else getattr(registry, enter)
+    with pytest.raises(ParticipantError, match=re.escape(shown)):
+        call(path)
+
+
+@pytest.mark.parametrize("how", ["null byte", "symlink loop"])
+def test_a_listed_file_with_a_null_byte_or_a_loop_is_one_line(folder, how):
+    if how == "symlink loop":
+        (folder / "bones" / "lunate.stl").unlink()
+        _loop(folder / "bones")
+        edit_toml(folder, '"bones/lunate.stl"', '"bones/loop_a"')
+        value = "bones.lunate = 'bones/loop_a' cannot be resolved"
+    else:
+        edit_toml(folder, '"bones/lunate.stl"', '"bones/lunate\\u0000.stl"')
+        value = r"bones.lunate = 'bones/lunate\\x00.stl' cannot be resolved"
+    with raises(ParticipantError, folder / TOML, value):
+        load_participant_folder(folder)
+
+
+def test_frames_in_participant_toml_are_bounded(folder):
+    edit_toml(folder, "frames = 15", "frames = 1000000000000")
+    with raises(ParticipantError, folder / TOML, r"frames must be an integer in \[2, 1,000\].*1000000000000"):
+        load_participant_folder(folder)

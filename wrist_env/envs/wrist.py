@@ -34,7 +34,9 @@ class WristEnv(gym.Env):
     "validate" or "idealized"; load_direction: the idealized sweep's load
     (`settings.LOAD_DIRECTIONS`, default `settings.DEFAULT_LOADS`). info: cost, per-DOF 75th-percentile errors and
     RMSE (mm, deg), per-frame contact (MPa, mm², N), bundle forces (N),
-    energies (N·mm), poses, and `failed` — deterministic, NaN-free.
+    energies (N·mm), poses, and `failed` — deterministic, NaN-free. Without reference kinematics (a folder
+    participant's idealized sweep, reward 0) cost, error_p75, rmse and cost_terms are None
+    (`task.REFERENCE_KEYS`): the keys are those of every participant.
     """
 
     metadata = {"render_modes": []}

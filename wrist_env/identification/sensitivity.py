@@ -27,7 +27,7 @@ from wrist_env.cost import COST_BONES, DOF_NAMES
 from wrist_env.design import full_action
 from wrist_env.figures.sensitivity import plot
 from wrist_env.motions import MOTIONS
-from wrist_env.task import task
+from wrist_env.task import require_reference, task
 
 METHODS = ("morris", "sobol")
 MATERIALS = design.NAMES[: design.N_MATERIAL]
@@ -99,7 +99,10 @@ def study(
 ) -> pd.DataFrame:
     """Indices of every output to every material for each motion: one row per (motion, output,
     material), with the motion's failed share; written to `out`/sensitivity_<participant>_<method>.csv
-    with a figure (.png) when `out` is given."""
+    with a figure (.png) when `out` is given. ParticipantError, before anything is simulated, if a motion has
+    no reference kinematics (a folder participant's idealized sweep): its outputs would be undefined."""
+    for motion in motions:
+        require_reference(participant, motion)
     spec = problem()
     X = sample(method, spec, n, seed)
     frames = []

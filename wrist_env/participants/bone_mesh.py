@@ -1,14 +1,20 @@
 """Bone mesh files of a participant folder: reading one (vertices mm, faces), validating it, and its solid part.
 
-Carpal meshes are closed solids. A radius or ulna may also hold open parts (a
+Carpal meshes are closed solids of one piece. A radius or ulna may also hold open parts (a
 shaft cut short, as the built-in participants' are): those carry ligament
 attachments only, while its closed parts carry contact and mass
 (`solid_mask`); the radius needs a closed articular solid, the ulna none.
+
+A carpal mesh of several connected pieces (an island left by segmentation) is refused, naming
+each piece; `drop_islands` keeps its largest piece and drops pieces of at most `ISLAND_AREA_SHARE`
+of its area. A radius or ulna may be of several pieces (the built-in radius is four: its
+articular solid and the parts of its shaft), so their pieces are not checked.
 """
 
 from __future__ import annotations
 
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -34,12 +40,18 @@ the mesh's bounding-box diagonal: ~10× the float32 rounding of an STL's coordin
 still defined. The built-in carpals' least heights are 1.6e-5–2.7e-5 × their diagonals (0.4–0.9 µm)."""
 FLAT_REL = 1e-3  # a mesh whose vertices lie within this × its diagonal of one plane is flat
 ZERO_VOLUME_REL = 1e-4  # a closed mesh enclosing less than this × area^1.5 is a sheet (a sphere: 0.094)
+ISLAND_AREA_SHARE = 0.1
+"""`drop_islands` drops a carpal's pieces of at most this share of its largest piece's surface area: a
+stray island of segmentation is far smaller (a 2 mm sphere beside a scaphoid: 0.8 %), while a bone in
+two large pieces (a scaphoid waist fracture: each part a third or more) is no island, and stays refused."""
 
 
-def read_bone_mesh(path: str | Path, bone: str) -> tuple[np.ndarray, np.ndarray]:
+def read_bone_mesh(path: str | Path, bone: str, drop_islands: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Vertices (n, 3) float64 mm and faces (m, 3) int64 of one bone mesh file, validated; MeshError if unusable.
 
     A file whose header or lines declare more than `MAX_FACES` faces is refused before it is read.
+    drop_islands: a carpal of several pieces keeps its largest (`drop_small_islands`, with a warning
+    naming the file and what was dropped) instead of being refused.
     """
     path = Path(path)
     _check_face_count(declared_faces(path), bone, str(path))
@@ -53,6 +65,8 @@ def read_bone_mesh(path: str | Path, bone: str) -> tuple[np.ndarray, np.ndarray]
     _check_finite(np.asarray(mesh.vertices), np.asarray(mesh.faces), bone, str(path))
     mesh.merge_vertices()  # formats such as STL store every triangle's corners separately
     vertices, faces = np.asarray(mesh.vertices, np.float64), np.asarray(mesh.faces, np.int64)
+    if drop_islands and bone in CARPALS:
+        vertices, faces = drop_small_islands(vertices, faces, bone, str(path))
     validate_bone_mesh(vertices, faces, bone, str(path))
     return vertices, faces
 
@@ -89,6 +103,8 @@ def validate_bone_mesh(vertices: np.ndarray, faces: np.ndarray, bone: str, sourc
             f"{source}: the {bone} mesh has {int((~unique).sum())} duplicate faces "
             f"(first: face {first} = {faces[first].tolist()})."
         )
+    if bone in CARPALS:
+        _check_one_piece(vertices, faces, bone, source)
     closed = _closed_part(mesh, bone, source)
     if closed is None:
         return  # an ulna of open parts only: ligament attachments, no contact or mass
@@ -105,6 +121,65 @@ def validate_bone_mesh(vertices: np.ndarray, faces: np.ndarray, bone: str, sourc
             f"{source}: the {bone} mesh must have positive volume, but has {volume:.4g} mm³ "
             f"(inverted winding: faces point inward)."
         )
+
+
+def pieces(vertices: np.ndarray, faces: np.ndarray) -> list[np.ndarray]:
+    """The mesh's connected pieces as arrays of face indices, largest surface area first. Faces are
+    connected through shared edges (vertices merged), so two pieces touching at a vertex are two."""
+    mesh = trimesh.Trimesh(vertices, faces, process=False)
+    labels = trimesh.graph.connected_component_labels(mesh.face_adjacency, node_count=len(faces))
+    groups = [np.flatnonzero(labels == k) for k in np.unique(labels)]
+    area = mesh.area_faces
+    return sorted(groups, key=lambda g: -float(area[g].sum()))
+
+
+def drop_small_islands(
+    vertices: np.ndarray, faces: np.ndarray, bone: str, source: str
+) -> tuple[np.ndarray, np.ndarray]:
+    """The mesh's largest piece (by surface area), its other pieces dropped with a warning naming `source`
+    and each dropped piece; MeshError if another piece is larger than `ISLAND_AREA_SHARE` of it (two
+    parts of a bone, not an island). A mesh of one piece is returned as it is."""
+    found = pieces(vertices, faces)
+    if len(found) == 1:
+        return vertices, faces
+    area = trimesh.Trimesh(vertices, faces, process=False).area_faces
+    largest = float(area[found[0]].sum())
+    share = float(area[found[1]].sum()) / largest
+    if share > ISLAND_AREA_SHARE:
+        raise MeshError(
+            f"{source}: the {bone} mesh has {len(found)} pieces, and the second has {share:.0%} of the largest's "
+            f"surface area, more than the {ISLAND_AREA_SHARE:.0%} drop_islands drops (two parts of a bone, not an "
+            f"island): {_describe(vertices, faces, found)}; join or remove the pieces yourself."
+        )
+    kept = trimesh.Trimesh(vertices, faces[found[0]], process=False)
+    kept.remove_unreferenced_vertices()
+    warnings.warn(
+        f"{source}: drop_islands: kept the {bone} mesh's largest piece, dropped {len(found) - 1} "
+        f"({_describe(vertices, faces, found[1:])}).",
+        stacklevel=2,
+    )
+    return np.asarray(kept.vertices, np.float64), np.asarray(kept.faces, np.int64)
+
+
+def _check_one_piece(vertices: np.ndarray, faces: np.ndarray, bone: str, source: str) -> None:
+    """MeshError naming `source` and each piece unless the mesh is one connected piece."""
+    found = pieces(vertices, faces)
+    if len(found) > 1:
+        raise MeshError(
+            f"{source}: the {bone} mesh must be one connected piece, but it has {len(found)}: "
+            f"{_describe(vertices, faces, found)}; remove the stray pieces, or set drop_islands = true in "
+            f"participant.toml to keep the largest."
+        )
+
+
+def _describe(vertices: np.ndarray, faces: np.ndarray, found: list[np.ndarray], limit: int = 5) -> str:
+    """Pieces for a message: faces and extent (bounding-box diagonal, mm) of the first `limit`."""
+    parts = []
+    for group in found[:limit]:
+        corners = vertices[np.unique(faces[group])]
+        parts.append(f"{len(group):,} faces over {float(np.linalg.norm(np.ptp(corners, axis=0))):.3g} mm")
+    more = f" and {len(found) - limit} more" if len(found) > limit else ""
+    return "; ".join(parts) + more
 
 
 def solid_mask(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:

@@ -9,12 +9,15 @@ Meshes and trials are in the RCS, mm, static (neutral) pose. A left wrist
 (side = "left") is mirrored to a right one on loading: vertices z → −z with
 faces re-wound, trial transforms conjugated by diag(1, 1, −1, 1).
 
-Each bone mesh file is read and validated by `wrist_env.participants.bone_mesh`.
+Each bone mesh file is read and validated by `wrist_env.participants.bone_mesh`; a carpal of
+several pieces is refused unless `drop_islands = true` (then its largest piece is kept). Two bones
+listed with one file (the same path, or files of identical bytes) are refused before any is read.
 """
 
 from __future__ import annotations
 
 import json
+import os
 import re
 import tomllib
 from dataclasses import dataclass
@@ -24,13 +27,15 @@ import numpy as np
 import trimesh
 
 from wrist_env.errors import MeshError, ParticipantError
+from wrist_env.io import sha256_file
+from wrist_env.limits import MAX_TRIAL_FRAMES
 from wrist_env.model import SUPPLIED
 from wrist_env.participants.bone_mesh import read_bone_mesh
 from wrist_env.trial import ROLES, Trial, mirror_trial, read_trial_csv, write_trial_csv
 
 PARTICIPANT_FILE = "participant.toml"
 REQUIRED_KEYS = ("name", "side", "units", "bones", "trials")
-OPTIONAL_KEYS = ("sex", "age", "facet_type", "task", "frames")
+OPTIONAL_KEYS = ("sex", "age", "facet_type", "task", "frames", "drop_islands")
 SIDES = ("right", "left")
 NAME_PATTERN = r"[A-Za-z0-9_]{1,64}"
 TRIAL_NAME_PATTERN = r"[A-Za-z0-9_-]{1,64}"
@@ -41,7 +46,7 @@ TRIAL_NAME_PATTERN = r"[A-Za-z0-9_-]{1,64}"
 class ParticipantSource:
     """A participant as given by the user, mirrored to a right wrist.
 
-    meta: the optional fields of participant.toml (sex, age, facet_type, task, frames) plus
+    meta: the optional fields of participant.toml (sex, age, facet_type, task, frames, drop_islands) plus
         side, the side of the files (the arrays here are always a right wrist).
     bones: {bone: (vertices of shape (n, 3) float64 mm, faces of shape (m, 3) int64)}, SUPPLIED order, RCS.
     trials: {name: Trial}. folder: where it was loaded from.
@@ -82,6 +87,7 @@ class ParticipantSource:
 def load_participant_folder(path: str | Path) -> ParticipantSource:
     """The participant in a folder, validated and mirrored to a right wrist; errors name the file and value."""
     folder = Path(path)
+    resolved(folder)  # a null byte or a symlink loop: one line, not a traceback
     if not folder.is_dir():
         raise ParticipantError(f"participant folder {folder} does not exist or is not a folder.")
     toml_path = folder / PARTICIPANT_FILE
@@ -114,7 +120,10 @@ def load_participant_folder(path: str | Path) -> ParticipantSource:
     extra = [b for b in bone_table if b not in SUPPLIED]
     if absent or extra:
         raise ParticipantError(f"{toml_path}: [bones] must list exactly {SUPPLIED}, but {absent=} and {extra=}.")
-    bones = {b: read_bone_mesh(_listed_file(folder, bone_table[b], f"bones.{b}", toml_path), b) for b in SUPPLIED}
+    files = {b: _listed_file(folder, bone_table[b], f"bones.{b}", toml_path) for b in SUPPLIED}
+    _check_distinct_files(files, toml_path)
+    drop = meta.get("drop_islands", False)
+    bones = {b: read_bone_mesh(files[b], b, drop_islands=drop) for b in SUPPLIED}
     _check_arrangement(bones, toml_path)
 
     trial_table = _check_table(config, "trials", toml_path)
@@ -177,6 +186,40 @@ def mirror_mesh(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np
     return np.asarray(vertices, np.float64) * [1.0, 1.0, -1.0], np.asarray(faces, np.int64)[:, [0, 2, 1]]
 
 
+def resolved(path: str | Path) -> Path:
+    """`path` with links resolved (it need not exist); ParticipantError naming it if it holds a null byte
+    or runs into a symlink loop (`Path.resolve` raises ValueError, or RuntimeError (OSError from Python 3.13))."""
+    text = os.fspath(path)
+    if "\0" in str(text):
+        raise ParticipantError(f"participant folder {str(text)!r} contains a null byte.")
+    try:
+        return Path(path).resolve()
+    except (RuntimeError, OSError) as exc:
+        raise ParticipantError(f"participant folder {text} cannot be resolved: {exc}.") from None
+
+
+def _check_distinct_files(files: dict[str, Path], toml_path: Path) -> None:
+    """ParticipantError naming both bones and the file(s) if two bones are listed with one file: the same
+    path once links are resolved, or files of identical bytes (SHA-256, of files of equal size) — a bone
+    copied under another name, which the build would only refuse minutes later as implausible joint spaces."""
+    paths = {b: f.resolve() for b, f in files.items()}
+    sizes = [p.stat().st_size for p in paths.values()]
+    seen: dict[tuple, str] = {}
+    for (bone, path), size in zip(paths.items(), sizes):
+        keys = [("path", path)] + ([("bytes", sha256_file(path))] if sizes.count(size) > 1 else [])
+        for key in keys:
+            other = seen.setdefault(key, bone)
+            if other != bone:
+                same = (
+                    f"the same file {files[other]}"
+                    if key[0] == "path"
+                    else f"files of identical content ({files[other]} and {files[bone]})"
+                )
+                raise ParticipantError(
+                    f"{toml_path}: bones.{other} and bones.{bone} are {same}; each bone needs its own mesh."
+                )
+
+
 def _check_arrangement(bones: dict, toml_path: Path) -> None:
     """ParticipantError naming both entries if two carpals look swapped: the scaphoid must lie radial
     of the lunate (along the ulna → radius direction of the files' own centroids, so either side
@@ -215,9 +258,18 @@ def _check_meta(config: dict, toml_path: Path) -> dict:
         meta["age"] = age
     if "frames" in config:
         frames = config["frames"]
-        if isinstance(frames, bool) or not isinstance(frames, int) or frames < 2:
-            raise ParticipantError(f"{toml_path}: frames must be an integer >= 2, but got {frames!r}.")
+        if isinstance(frames, bool) or not isinstance(frames, int) or not 2 <= frames <= MAX_TRIAL_FRAMES:
+            raise ParticipantError(
+                f"{toml_path}: frames must be an integer in [2, {MAX_TRIAL_FRAMES:,}] (limits.MAX_TRIAL_FRAMES), "
+                f"but got {frames!r}."
+            )
         meta["frames"] = frames
+    if "drop_islands" in config:
+        if not isinstance(config["drop_islands"], bool):
+            raise ParticipantError(
+                f"{toml_path}: drop_islands must be true or false, but got {config['drop_islands']!r}."
+            )
+        meta["drop_islands"] = config["drop_islands"]
     return meta
 
 
@@ -236,7 +288,11 @@ def _listed_file(folder: Path, relative, where: str, toml_path: Path) -> Path:
         raise ParticipantError(f"{toml_path}: {where} = {relative!r} must be relative to the participant folder.")
     file = folder / relative
     root = folder.resolve()
-    if not file.resolve().is_relative_to(root):
+    try:
+        inside = file.resolve().is_relative_to(root)
+    except (ValueError, RuntimeError, OSError) as exc:  # a null byte, a symlink loop
+        raise ParticipantError(f"{toml_path}: {where} = {relative!r} cannot be resolved ({exc}).") from None
+    if not inside:
         raise ParticipantError(
             f"{toml_path}: {where} = {relative!r} resolves outside the participant folder "
             f"{root} (through '..' or a link); refused, not read."
@@ -248,11 +304,13 @@ def _listed_file(folder: Path, relative, where: str, toml_path: Path) -> Path:
 
 
 def _toml_value(value) -> str:
-    """A TOML literal of a string, integer or finite float."""
+    """A TOML literal of a string, boolean, integer or finite float."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
     if isinstance(value, str):
         return json.dumps(value, ensure_ascii=False)
     if isinstance(value, (int, np.integer)) and not isinstance(value, bool):
         return str(int(value))
     if isinstance(value, (float, np.floating)) and np.isfinite(value):
         return repr(float(value))
-    raise ParticipantError(f"participant.toml values must be strings or finite numbers, but got {value!r}.")
+    raise ParticipantError(f"participant.toml values must be strings, booleans or finite numbers, but got {value!r}.")

@@ -66,7 +66,7 @@ def add_folder(folder: str | Path) -> str:
         raise ParticipantError(
             f"{Path(folder) / 'participant.toml'}: name {source.name!r} is taken by a built-in participant"
         )
-    if source.name in _FOLDERS and _FOLDERS[source.name].resolve() != Path(folder).resolve():
+    if source.name in _FOLDERS and _FOLDERS[source.name].resolve() != folder_module.resolved(folder):
         raise ParticipantError(
             f"{Path(folder) / 'participant.toml'}: name {source.name!r} is taken by the folder {_FOLDERS[source.name]}"
         )
@@ -78,7 +78,7 @@ def add_folder(folder: str | Path) -> str:
 def ensure_folder(folder: str | Path) -> str:
     """`add_folder` unless this folder is registered already (a worker or a runner given the folders a
     caller registered: read once, not again); returns its name."""
-    here = Path(folder).resolve()
+    here = folder_module.resolved(folder)  # ParticipantError for a null byte or a symlink loop
     for name, path in _FOLDERS.items():
         if path.resolve() == here:
             return name
