@@ -222,7 +222,7 @@ class _NoWorkers:
         if waited_s >= self.dask.no_workers_timeout_s:
             address = self.dask.scheduler
             raise SchedulerError(
-                f"the dask scheduler {address} has had no workers for {waited_s:.0f} s, so no task can run; "
+                f"the dask scheduler {address} has had no workers for {round(waited_s, 1):g} s, so no task can run; "
                 f"start one with `dask worker {address}` (on a machine that sees this folder and has wrist-env)"
             )
 
