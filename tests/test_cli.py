@@ -317,3 +317,133 @@ def test_an_out_path_the_system_refuses_is_one_line_naming_it(make_argv, capsys,
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("wrist-bench: error: ") and "Traceback" not in err
     assert ("/proc/" in err) if "/proc/" in " ".join(argv) else str(tmp_path / "a-file") in err
+
+
+def _refuse(monkeypatch, owner, name):
+    """Make `owner.name` (a long run) fail the test if a command reaches it before its checks."""
+
+    def reached(*args, **kwargs):
+        raise AssertionError(f"{name} ran before the command's checks")
+
+    monkeypatch.setattr(owner, name, reached)
+
+
+def _one_line_error(capsys, argv, status=2) -> str:
+    assert main(argv) == status
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("wrist-bench: ") and "Traceback" not in err, err
+    return err
+
+
+OUTPUTS_CHECKED_FIRST = {
+    "calibrate --out a folder": (lambda t: ["calibrate", "P1", "--out", str(t)], "a folder, not a file"),
+    "calibrate --out under a file": (lambda t: ["calibrate", "P1", "--out", str(_file(t) / "x.json")], "is a file"),
+    "calibrate --out under /proc": (lambda t: ["calibrate", "P1", "--out", "/proc/wrist/x.json"], "cannot write in"),
+    "calibrate --out empty": (lambda t: ["calibrate", "P1", "--out", ""], "--out is empty"),
+    "posterior --out a file": (lambda t: ["posterior", "P1", "--out", str(_file(t))], "a file, not a folder"),
+    "posterior --report under /proc": (
+        lambda t: ["posterior", "P1", "--out", str(t), "--report", "/proc/wrist/r"],
+        "--report /proc/wrist/r: cannot write in",
+    ),
+}
+
+
+@pytest.mark.parametrize("make_argv, message", OUTPUTS_CHECKED_FIRST.values(), ids=OUTPUTS_CHECKED_FIRST)
+def test_an_output_is_checked_before_the_run_not_after(make_argv, message, capsys, tmp_path, monkeypatch):
+    """calibrate --out and posterior --out were written after the whole run, which an unwritable path lost."""
+    from wrist_env.cli.run import identification, studies
+
+    _refuse(monkeypatch, studies.bench, "calibrate")
+    _refuse(monkeypatch, identification, "study")
+    argv = make_argv(tmp_path)
+    err = _one_line_error(capsys, argv)
+    assert message in err and ("--report" in err or "--out" in err), err
+
+
+STORAGE_CHECKED_FIRST = {
+    "unknown scheme": (["--optimizer", "optuna-tpe", "--storage", "foo://x"], "the Optuna storage 'foo://x' cannot"),
+    "not a URL": (["--optimizer", "optuna-tpe", "--storage", "runs/x.db"], "the Optuna storage 'runs/x.db' cannot"),
+    "unwritable SQLite": (
+        ["--optimizer", "optuna-cmaes", "--storage", "sqlite:////proc/wrist/x.db"],
+        "'sqlite:////proc/wrist/x.db' cannot be opened (OperationalError",
+    ),
+    "a calibrator without a study": (
+        ["--optimizer", "cmaes", "--storage", "sqlite:///x.db"],
+        "cmaes keeps no Optuna study; --storage is for optuna-cmaes, optuna-tpe",
+    ),
+}
+
+
+@pytest.mark.parametrize("options, message", STORAGE_CHECKED_FIRST.values(), ids=STORAGE_CHECKED_FIRST)
+def test_calibrate_checks_the_storage_url_before_the_run(options, message, capsys, monkeypatch):
+    from wrist_env.cli.run import studies
+
+    _refuse(monkeypatch, studies.bench, "calibrate")
+    assert message in _one_line_error(capsys, ["calibrate", "P1", *options])
+
+
+def test_calibrate_storage_memory_is_none(monkeypatch):
+    from wrist_env.cli.run import studies
+
+    seen = {}
+
+    def fake(participant, name, budget, seed, *, log, storage):
+        seen["storage"] = storage
+        raise KeyboardInterrupt  # stop here: the storage is what is tested
+
+    monkeypatch.setattr(studies.bench, "calibrate", fake)
+    assert main(["calibrate", "P1", "--optimizer", "optuna-tpe", "--storage", "memory"]) == 130
+    assert seen == {"storage": None}
+
+
+def test_ctrl_c_in_calibrate_says_what_was_saved(capsys, tmp_path, monkeypatch):
+    from wrist_env.cli.run import studies
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(studies.bench, "calibrate", interrupted)
+    err = _one_line_error(capsys, ["calibrate", "P1"], status=130)
+    assert "calibration interrupted; nothing was saved (with --log <folder> a run can be resumed)" in err
+    log = tmp_path / "log"
+    err = _one_line_error(capsys, ["calibrate", "P1", "--log", str(log)], status=130)
+    assert f"the evaluations logged in {log} are kept: rerun the same command to resume" in err
+
+
+def test_ctrl_c_in_a_benchmark_says_what_was_saved_and_how_to_resume(capsys, tmp_path, monkeypatch):
+    from wrist_env.cli.run import studies
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(studies.bench, "benchmark", interrupted)
+    out = tmp_path / "bench"
+    argv = ["benchmark", "--participants", "P1", "--optimizers", "random", "--out", str(out), "--no-progress"]
+    err = _one_line_error(capsys, argv, status=130)
+    assert f"benchmark interrupted; 0 evaluations logged in {out} are kept" in err
+    assert "rerun the same command to resume" in err
+
+
+def test_a_leaderboard_of_a_log_with_no_finished_cell_is_one_line(capsys, tmp_path):
+    runs = tmp_path / "runs"
+    (runs / "evals").mkdir(parents=True)
+    err = _one_line_error(capsys, ["leaderboard", "--runs", str(runs), "--out", str(tmp_path / "lb")])
+    assert f"{runs}: holds no finished benchmark cell" in err and f"benchmark --out {runs}" in err
+    assert not (tmp_path / "lb").exists()
+
+
+def test_export_refuses_an_empty_name_or_folder(capsys, tmp_path):
+    err = _one_line_error(capsys, ["export", "P1", str(tmp_path / "w"), "--name", ""])
+    assert "--name is empty" in err and not (tmp_path / "w").exists()
+    assert "export's folder is empty" in _one_line_error(capsys, ["export", "P1", ""])
+
+
+def test_posterior_model_trials_of_a_folder_participant_is_refused_saying_why(capsys, tmp_path, monkeypatch):
+    """A folder participant has no hidden truth to simulate: it was a traceback after building its model."""
+    from wrist_env.cli.run import identification
+    from wrist_env.participants import registry
+
+    _refuse(monkeypatch, identification, "study")
+    registry._FOLDERS["U1"] = tmp_path  # registered (the autouse fixture forgets it)
+    err = _one_line_error(capsys, ["posterior", "U1", "--model-trials", "--out", str(tmp_path / "p")])
+    assert "--model-trials simulates a participant's hidden truth, which U1 (read from a folder)" in err

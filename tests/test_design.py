@@ -83,3 +83,16 @@ def test_a_design_file_with_an_unknown_key_or_a_non_number_is_named(tmp_path, ed
     path.write_text(json.dumps(data))
     with pytest.raises(DesignError, match=re.escape(str(path)) + ": design variables " + match):
         design.read_json(path)
+
+
+@pytest.mark.parametrize("data, match", [(None, "but got NoneType."), ([0.5] * 27, r"but got list \[0.5")])
+def test_a_design_that_is_not_a_mapping_is_named(data, match):
+    """`Design.from_dict(None)` was a TypeError from deep inside ("argument of type 'NoneType' ...")."""
+    with pytest.raises(DesignError, match="a design is a mapping of the 27 variables .*" + match):
+        design.Design.from_dict(data)
+
+
+def test_an_empty_batch_of_actions_is_no_designs_but_a_wrong_width_is_named():
+    assert design.from_actions(np.zeros((0, design.N_DESIGN))) == [] and design.from_actions([]) == []
+    with pytest.raises(DesignError, match=r"shape \(n, 27\), but got \(0, 5\)"):
+        design.from_actions(np.zeros((0, 5)))

@@ -115,3 +115,49 @@ def test_the_registry_rebuilds_a_damaged_cached_model_and_says_which(built, mode
         warnings.simplefilter("always")
         registry.load_model("P1")
     assert rebuilt == ["P1", "P1"] and any("'P2'" in str(w.message) for w in caught)
+
+
+def _fifo(path):
+    import os
+
+    os.mkfifo(path)
+
+
+SPECIAL = {
+    "a link to /dev/zero": lambda p: p.symlink_to("/dev/zero"),  # endless: a read never ends
+    "a FIFO": _fifo,  # no writer: opening it waits forever
+}
+
+
+@pytest.mark.timeout(30)
+@pytest.mark.parametrize("suffix", [".json", ".npz"])
+@pytest.mark.parametrize("special", sorted(SPECIAL))
+def test_a_cache_file_that_is_not_a_regular_file_is_refused_not_read(tmp_path, special, suffix):
+    """A cached model's file linked to a device (or a FIFO) made loading hang: it is named instead."""
+    path = _saved(tmp_path)
+    path.with_suffix(suffix).unlink()
+    SPECIAL[special](path.with_suffix(suffix))
+    with pytest.raises(StoreError, match="not a regular file") as err:
+        load_dataclass(Thing, path)
+    assert str(path.with_suffix(suffix)) in str(err.value) and "delete it to rebuild" in str(err.value)
+
+
+@pytest.mark.timeout(30)
+@pytest.mark.parametrize("special", sorted(SPECIAL))
+def test_read_json_refuses_what_is_not_a_regular_file(tmp_path, special):
+    from wrist_env.io import read_json
+
+    path = tmp_path / "study.json"
+    SPECIAL[special](path)
+    with pytest.raises(StoreError, match=r"study.json: this manifest is a (character device|FIFO).*; restore it"):
+        read_json(path, "manifest", "restore it")
+
+
+@pytest.mark.timeout(30)
+def test_a_model_whose_cached_json_is_a_device_is_refused(tmp_path):
+    """`Model.load` (the registry's cache, `registry.cache_dir()`) reads through `load_dataclass`."""
+    from wrist_env.model import Model
+
+    (tmp_path / "P1-abc.json").symlink_to("/dev/zero")
+    with pytest.raises(StoreError, match=r"P1-abc.json: this file is a character device"):
+        Model.load(tmp_path / "P1-abc")

@@ -43,3 +43,25 @@ def test_without_a_reference_the_info_has_the_same_keys_as_none():
     assert set(REFERENCE_KEYS) <= set(scored.info) and scored.info["error_p75"]["scaphoid"]
     assert set(unscored) == set(scored.info)
     assert all(unscored[k] is None for k in REFERENCE_KEYS)
+
+
+def _unbuilt_task():
+    """A Task with no model: an empty batch must not reach one."""
+    from wrist_env.task import Task
+
+    return Task.__new__(Task)
+
+
+def test_an_empty_batch_is_empty_evaluations_of_the_right_shape():
+    """`evaluate_batch([])` and `evaluate_actions` of shape (0, 27) simulate nothing and return empty arrays."""
+    t = _unbuilt_task()
+    for batch in (t.evaluate_batch([]), t.evaluate_actions(np.zeros((0, design.N_DESIGN)))):
+        assert isinstance(batch, Evaluations) and len(batch) == 0 and list(batch) == []
+        assert batch.cost.shape == batch.reward.shape == batch.failed.shape == (0,) and batch.failed.dtype == bool
+    with pytest.raises(DesignError, match=r"shape \(n, 27\), but got \(0, 26\)"):
+        t.evaluate_actions(np.zeros((0, 26)))
+
+
+def test_a_batch_item_that_is_not_a_design_is_named():
+    with pytest.raises(DesignError, match="item 1 of the designs is a ndarray, not a Design"):
+        _unbuilt_task().evaluate_batch([design.population(), np.zeros(design.N_DESIGN)])

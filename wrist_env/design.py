@@ -12,6 +12,7 @@ Normalized action a in [-1, 1]^27 ↔ physical value:
 from __future__ import annotations
 
 import numbers
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -164,7 +165,13 @@ class Design:
 
     @classmethod
     def from_dict(cls, data: dict) -> "Design":
-        """From {name: value} in physical units, exactly the 27 `NAMES`, each a JSON number."""
+        """From {name: value} in physical units, exactly the 27 `NAMES`, each a JSON number; `DesignError` if
+        `data` is not a mapping (None, a list)."""
+        if not isinstance(data, Mapping):
+            raise DesignError(
+                f"a design is a mapping of the 27 variables of `design.NAMES` to numbers, but got {type(data).__name__}"
+                f"{'' if data is None else f' {str(data)[:80]}'}."
+            )
         missing = [n for n in NAMES if n not in data]
         if missing:
             raise DesignError(f"design is missing variables {missing}.")
@@ -222,9 +229,10 @@ def from_action(action: ArrayLike) -> Design:
 
 
 def from_actions(actions: ArrayLike) -> list[Design]:
-    """Physical designs of a batch of normalized actions (n, 27) in [-1, 1]; a DesignError names the row."""
+    """Physical designs of a batch of normalized actions (n, 27) in [-1, 1]; a DesignError names the row.
+    An empty batch, shape (0, 27) (or an empty list), gives no designs; another shape is a DesignError."""
     raw = np.asarray(actions)
-    if raw.size == 0:
+    if raw.shape == (0,):
         return []
     if raw.ndim != 2 or raw.shape[1] != N_DESIGN:
         raise DesignError(f"a batch of actions must have shape (n, {N_DESIGN}), but got {raw.shape}.")

@@ -39,3 +39,8 @@ class StoreError(InputError):
 
 class UsageError(InputError):
     """A command-line argument the command cannot take (exit status 2, like argparse's)."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C during a long command: its message says what was saved and how to resume (the command line
+    prints it in one line and exits 130, the shell's code for SIGINT)."""

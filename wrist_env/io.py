@@ -4,7 +4,8 @@ Array fields (and tuples of arrays) go to the `.npz`; everything else must be
 JSON-able and goes to the `.json`, with the class name, a format version and
 the SHA-256 of the `.npz`. Both are written to a temporary name and moved into
 place, the `.npz` first, so a reader sees a whole pair or no `.json`; a load
-checks the hash and the fields and raises `StoreError` naming the file.
+checks the hash and the fields and raises `StoreError` naming the file; so do it and `read_json`
+for a path that is not a regular file (a link to /dev/zero, a FIFO: reading it would never end).
 `fields_equal` is such a dataclass's `__eq__` (arrays compared by value).
 """
 
@@ -14,6 +15,7 @@ import dataclasses
 import hashlib
 import json
 import os
+import stat
 import time
 import uuid
 import zipfile
@@ -62,6 +64,8 @@ def load_dataclass(cls: type[_D], path: str | Path) -> _D:
     pair is damaged, its `.npz` is not the one the `.json` was written with, or a field is missing."""
     path = Path(path)
     js, npz = path.with_suffix(".json"), path.with_suffix(".npz")
+    for p in (js, npz):
+        check_regular(p, "delete it to rebuild")
     try:
         header = json.loads(js.read_text())
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
@@ -110,6 +114,31 @@ def fields_equal(a: DataclassInstance, b: DataclassInstance, scalars: tuple[str,
     return all(getattr(a, k) == getattr(b, k) for k in scalars) and all(
         np.array_equal(getattr(a, k), getattr(b, k)) for k in arrays
     )
+
+
+def check_regular(path: str | Path, advice: str = "", what: str = "file") -> None:
+    """`StoreError` naming `path` (and `advice`) if it exists but is not a regular file (after symbolic links):
+    a device such as /dev/zero, a FIFO or a socket would make a read hang or never end. A missing path
+    passes (the read that follows names it)."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return
+    if not stat.S_ISREG(mode):
+        kind = _KINDS.get(stat.S_IFMT(mode), "special file")
+        raise StoreError(
+            f"{path}: this {what} is a {kind}, not a regular file, so it is not read"
+            + (f"; {advice}" if advice else "")
+        )
+
+
+_KINDS = {
+    stat.S_IFDIR: "folder",
+    stat.S_IFCHR: "character device",
+    stat.S_IFBLK: "block device",
+    stat.S_IFIFO: "FIFO (named pipe)",
+    stat.S_IFSOCK: "socket",
+}
 
 
 def sha256_file(path: str | Path) -> str:
@@ -191,6 +220,7 @@ def json_sha256(data: object) -> str:
 def read_json(path: str | Path, what: str = "file", advice: str = "") -> dict | list:
     """The JSON in `path`; `StoreError` naming the file (and `advice`) if it is missing, truncated or garbage."""
     path = Path(path)
+    check_regular(path, advice, what)
     try:
         return json.loads(path.read_text())
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:

@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike
 from wrist_env import design as design_vars
 from wrist_env.cost import COST_BONES, CostReport, CostWeights, kinematic_cost
 from wrist_env.design import ALL_LIGAMENT_NAMES, Design
-from wrist_env.errors import ParticipantError
+from wrist_env.errors import DesignError, ParticipantError
 from wrist_env.model import BONES, PAIRS, Model
 from wrist_env.motions import MOTIONS
 from wrist_env.participants import builtin, registry
@@ -133,8 +133,18 @@ class Task:
         return self._score(design, simulate(self.model, design, self.driver, prepared=self.prepared))
 
     def evaluate_batch(self, designs: Iterable[Design]) -> Evaluations:
-        """Simulate many designs at once (`simulate_batch`: one thread per core); the same numbers as one at a time."""
+        """Simulate many designs at once (`simulate_batch`: one thread per core); the same numbers as one at a time.
+
+        No designs: empty `Evaluations` (reward, cost and failed of shape (0,)), nothing simulated, as a batch
+        filtered down to nothing is still a batch. `DesignError` naming the item if one is not a `Design`."""
         designs = list(designs)
+        for i, d in enumerate(designs):
+            if not isinstance(d, Design):
+                raise DesignError(
+                    f"item {i} of the designs is a {type(d).__name__}, not a Design (actions: evaluate_actions)"
+                )
+        if not designs:
+            return Evaluations(())
         results = simulate_batch(self.model, designs, self.driver, prepared=self.prepared)
         return Evaluations(tuple(self._score(d, r) for d, r in zip(designs, results)))
 
@@ -143,7 +153,8 @@ class Task:
         return self.evaluate(design_vars.from_action(action))
 
     def evaluate_actions(self, actions: ArrayLike) -> Evaluations:
-        """`evaluate_batch` of normalized actions (n, 27) in [-1, 1] (`design.from_actions`)."""
+        """`evaluate_batch` of normalized actions (n, 27) in [-1, 1] (`design.from_actions`); shape (0, 27)
+        gives empty `Evaluations`, any other shape a `DesignError` naming it."""
         return self.evaluate_batch(design_vars.from_actions(actions))
 
     def _score(self, design: Design, result: Result) -> Evaluation:

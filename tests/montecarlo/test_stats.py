@@ -116,3 +116,17 @@ def test_summary_numbers_at_30_degrees_extension(frames):
     at = frames[np.isclose(frames["angle"], -30) & (frames["any_injury"] == 0)]
     total = at[["SLIL_v.force_n", "SLIL_p.force_n", "SLIL_d.force_n"]].sum(axis=1).mean()
     assert s["all"]["intact_total_slil_force_at_angle_n"] == pytest.approx(total)
+
+
+def test_too_few_runs_is_a_fit_error_naming_the_least_it_takes():
+    """A tiny study's fit raised numpy's 'Singular matrix': it says how many runs Table 5 needs instead."""
+    frames = stats.frame_table(synthetic_runs(n_runs=5 + stats.MIN_RUNS_TABLE5 - 1))  # the first 5 are excluded
+    with pytest.raises(stats.FitError, match=r"Table 5 needs at least 7 runs, but the study has 6 to fit"):
+        stats.fit_pressure(frames)
+    assert stats.MIN_RUNS_TABLE5 == 7  # the intercept, five tears and the variance between runs
+
+
+def test_a_tear_seen_in_no_run_is_a_fit_error_naming_it(frames):
+    intact = frames.assign(RSC=0.0)
+    with pytest.raises(stats.FitError, match=r"each tear both present and absent, but in all 795 runs RSC intact"):
+        stats.fit_pressure(intact)

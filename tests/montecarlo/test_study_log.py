@@ -204,3 +204,85 @@ def test_the_report_refuses_parts_of_one_participant_made_on_two_models(study, t
         and f"{part.name}: made on another model or trials of P1 than" in err
         and "model ffffffffffff…" in err
     )
+
+
+def test_the_report_of_a_tiny_study_says_how_many_runs_the_fit_needs(tmp_path, capsys):
+    """A finished study of 2 runs: the fit's 'singular matrix' traceback became one line naming the folder."""
+    out = tmp_path / "tiny"
+    assert run_study(StudyConfig(("P1",), n=2, seed=0), out).done
+    status, err = _cli(capsys, "montecarlo-report", "--runs", str(out), "--out", str(tmp_path / "report"))
+    assert status == 2 and err.count("\n") == 1, err
+    assert f"error: {out}: the mixed-effects fit of Table 5 needs at least 7 runs, but the study has 2" in err
+
+
+def test_the_report_of_a_singular_fit_is_one_line_naming_the_folder(study, tmp_path, capsys):
+    """The stand-in solver's outputs are constant within a run: Table 6's fit of its 2 intact runs is singular."""
+    out, _ = study
+    status, err = _cli(capsys, "montecarlo-report", "--runs", str(out), "--out", str(tmp_path / "report"))
+    assert status == 2 and err.count("\n") == 1 and "Traceback" not in err, err
+    assert f"{out}: the mixed-effects fit of Table 6 hit a singular matrix" in err and "at least 2 intact runs" in err
+
+
+def test_ctrl_c_says_how_many_runs_are_kept_and_how_to_resume(tmp_path, capsys, monkeypatch):
+    calls = []
+
+    def interrupted_on_the_second_chunk(*args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return _fake_chunk(*args, **kwargs)
+
+    monkeypatch.setattr(sampler, "run_chunk", interrupted_on_the_second_chunk)
+    out = tmp_path / "mc"
+    status, err = _cli(capsys, "montecarlo", "P1", "--n", "10", "--batch", "4", "--out", str(out), "--no-progress")
+    assert status == 130 and err.count("\n") == 1, err
+    assert f"interrupted; 4 runs logged in {out} are kept (every finished batch): rerun the same command" in err
+    monkeypatch.setattr(sampler, "run_chunk", _fake_chunk)
+    assert run_study(CONFIG, out, batch=4).simulated == 6  # the rerun resumes
+
+
+def test_a_scheduler_lost_mid_run_says_the_runs_are_kept(tmp_path, capsys, monkeypatch):
+    """The scheduler stopped after a part was written (its tasks cancelled): one line, the part kept."""
+    from wrist_env.montecarlo import study as study_module
+    from wrist_env.runs.executor import Inline, SchedulerError
+
+    class Lost(Inline):
+        def results(self, handles, on_poll=None, poll_seconds=0.5):
+            for n, item in enumerate(super().results(handles, on_poll, poll_seconds)):
+                if n == 1:
+                    raise SchedulerError("the dask scheduler tcp://x:1 cancelled a task (FutureCancelledError)")
+                yield item
+
+    monkeypatch.setattr(study_module, "executor", lambda *a, **k: Lost())
+    out = tmp_path / "mc"
+    status, err = _cli(capsys, "montecarlo", "P1", "--n", "10", "--batch", "4", "--out", str(out), "--no-progress")
+    assert status == 2 and err.count("\n") == 1, err
+    assert "cancelled a task" in err and f"4 runs logged in {out} are kept" in err and "rerun the same command" in err
+
+
+def test_an_empty_out_is_refused_not_the_current_folder(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    status, err = _cli(capsys, "montecarlo", "P1", "--n", "2", "--out", "", "--no-progress")
+    assert status == 2 and err.count("\n") == 1 and "--out is empty" in err, err
+    assert list(tmp_path.iterdir()) == []
+    with pytest.raises(InputError, match="out is empty"):
+        run_study(CONFIG, "")
+
+
+def test_a_scheduler_with_no_workers_is_one_line_saying_how_to_add_one(tmp_path, capsys, monkeypatch):
+    """`montecarlo --scheduler <addr>` on a scheduler without a worker waited forever, silently."""
+    import importlib
+
+    distributed = pytest.importorskip("distributed")
+    monkeypatch.setattr(importlib.import_module("wrist_env.runs.executor"), "NO_WORKERS_TIMEOUT_S", 0.5)
+    out = tmp_path / "mc"
+    with distributed.LocalCluster(n_workers=0, processes=False, dashboard_address=None) as cluster:
+        address = cluster.scheduler_address
+        status, err = _cli(
+            capsys, "montecarlo", "P1", "--n", "4", "--scheduler", address, "--out", str(out), "--no-progress"
+        )
+    assert status == 2 and err.count("\n") == 1, err
+    assert re.search(
+        rf"the dask scheduler {re.escape(address)} has had no workers for 0\.[5-9] s, so no task can run", err
+    )
+    assert f"`dask worker {address}`" in err and f"0 runs logged in {out} are kept" in err

@@ -67,3 +67,54 @@ def test_an_unreachable_scheduler_is_one_line_naming_it(monkeypatch, tmp_path, c
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "cannot reach the dask scheduler 'tcp://127.0.0.1:1' within 1 s" in err
+
+
+def _cluster(workers: int):
+    """An in-process dask cluster (no processes, no dashboard) with `workers` workers."""
+    distributed = pytest.importorskip("distributed")
+    return distributed.LocalCluster(n_workers=workers, processes=False, dashboard_address=None, threads_per_worker=1)
+
+
+def test_a_scheduler_with_no_workers_is_named_with_how_to_add_one(monkeypatch):
+    """Tasks on a scheduler without a worker would wait forever: after the timeout, one error says why."""
+    import importlib
+
+    from wrist_env.runs.executor import SchedulerError
+
+    monkeypatch.setattr(importlib.import_module("wrist_env.runs.executor"), "NO_WORKERS_TIMEOUT_S", 0.5)
+    with _cluster(0) as cluster, executor(cluster.scheduler_address) as ex:
+        handles = [ex.submit(_square, 2)]
+        with pytest.raises(SchedulerError) as err:
+            list(ex.results(handles, poll_seconds=0.05))
+    message = str(err.value)
+    assert "has had no workers" in message and f"dask worker {cluster.scheduler_address}" in message
+    assert "\n" not in message
+
+
+def test_a_cancelled_task_is_the_schedulers_error_not_the_tasks():
+    """A scheduler stopped mid-run cancels the tasks (FutureCancelledError): that is no task's failure."""
+    from wrist_env.runs.executor import SchedulerError
+
+    with _cluster(0) as cluster, executor(cluster.scheduler_address) as ex:  # no worker: the task waits
+        handle = ex.submit(_square, 2)
+        ex.client.cancel([handle])
+        with pytest.raises(SchedulerError, match=f"scheduler {cluster.scheduler_address} cancelled a task"):
+            list(ex.results([handle], poll_seconds=0.05))
+
+
+@pytest.mark.parametrize(
+    "address, match",
+    [
+        ("tls://127.0.0.1:1", "is TLS, but dask has no client certificate configured"),
+        ("http://127.0.0.1:1", "scheme 'http', which this client cannot use"),
+        ("ucx://127.0.0.1:1", "scheme 'ucx', which this client cannot use"),
+        ("", "address is empty"),
+    ],
+)
+def test_a_scheduler_address_this_client_cannot_use_is_one_line(address, match, tmp_path, capsys):
+    from wrist_env.cli import main
+
+    argv = ["montecarlo", "P1", "--n", "2", "--scheduler", address, "--out", str(tmp_path), "--no-progress"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and match in err, err

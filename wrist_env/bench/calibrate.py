@@ -34,7 +34,7 @@ from wrist_env import design as design_vars
 from wrist_env.bench.log import X_COLUMNS, RunKey, RunLog
 from wrist_env.cost import COST_BONES
 from wrist_env.design import N_MATERIAL, Design
-from wrist_env.errors import WristEnvError
+from wrist_env.errors import InputError, WristEnvError
 from wrist_env.frames import DOF_NAMES
 from wrist_env.identification.likelihood import map_objective
 from wrist_env.participants import builtin
@@ -94,14 +94,24 @@ def open_storage(url: str) -> str | RDBStorage:
     vs 0.8 s) on this machine; with these pragmas 14 s and 19 s. The storage
     is a convenience copy (Optuna's tools read it): the Parquet log is the
     record a run resumes from, so a storage lost in a power cut costs nothing.
+
+    Opened here, before any simulation: an `InputError` naming the URL if Optuna cannot open it (not a
+    URL, an unknown database or driver, a SQLite file in a folder that is missing or not writable).
     """
     import optuna
 
-    if not url.startswith("sqlite:"):
-        return url
+    try:
+        if not url.startswith("sqlite:"):
+            return optuna.storages.RDBStorage(url)
+        storage = optuna.storages.RDBStorage(url, engine_kwargs={"connect_args": {"timeout": 120}})
+    except Exception as e:  # noqa: BLE001  (SQLAlchemy's and the drivers' errors share no base class)
+        reason = str(e).strip().splitlines()[0][:200] if str(e).strip() else "no reason given"
+        raise InputError(
+            f"the Optuna storage {url!r} cannot be opened ({type(e).__name__}: {reason}); give a URL such as "
+            "sqlite:///runs/optuna.db (its folder existing and writable), or none (--storage memory) to keep the study "
+            "in memory"
+        ) from None
     import sqlalchemy
-
-    storage = optuna.storages.RDBStorage(url, engine_kwargs={"connect_args": {"timeout": 120}})
 
     def pragmas(dbapi_connection, _record):
         cursor = dbapi_connection.cursor()

@@ -93,8 +93,8 @@ def _named(argv: Sequence[str]) -> str | None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run one `wrist-bench` command; returns the exit status (2 for a project or file-system error: one line on
-    stderr)."""
+    """Run one `wrist-bench` command; returns the exit status (2 for a project or file-system error, 130 for
+    Ctrl-C: one line on stderr)."""
     argv = list(sys.argv[1:] if argv is None else argv)
     name = _named(argv)
     args = parser(name or "").parse_args(argv)
@@ -111,6 +111,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except WristEnvError as exc:  # every project error (unknown calibrators too): one line, exit 2
         print(f"wrist-bench: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt as exc:  # Ctrl-C: a study's runner says what was saved (`errors.Interrupted`)
+        print(f"wrist-bench: {exc or 'interrupted'}", file=sys.stderr)
+        return 130
     except BrokenPipeError:  # `wrist-bench ... --json | head`: the reader left; say nothing more
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0

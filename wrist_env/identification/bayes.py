@@ -39,6 +39,7 @@ import numpy as np
 
 from wrist_env import design
 from wrist_env.cost import COST_BONES
+from wrist_env.errors import ParticipantError
 from wrist_env.frames import pose_to_dof
 from wrist_env.identification import likelihood
 from wrist_env.identification.map import laplace_covariance, map_estimate
@@ -63,7 +64,9 @@ def model_trials(t: Task, seed: int) -> Task:
     (`builtin.tracking_noise`, drawn from `seed`): data without model error, to tell the calibrator's
     honesty from the model's fidelity."""
     if t.participant not in builtin.BUILTIN:
-        raise ValueError(f"model trials need a hidden truth; {t.participant!r} is not a built-in participant")
+        raise ParticipantError(
+            f"model trials need a hidden truth; {t.participant!r} is not a built-in participant {builtin.BUILTIN}"
+        )
     run = t.evaluate(builtin.truth(t.participant))
     if run.failed:
         raise RuntimeError(f"{t.participant} {t.motion}: the hidden truth's run failed ({run.result.message})")
@@ -80,6 +83,10 @@ def _tasks(participant: str, trials: str, seed: int) -> tuple[Task, Task]:
     """The calibration and held-out tasks: the participant's trials or `model_trials`."""
     if trials not in TRIALS:
         raise ValueError(f"trials must be one of {TRIALS}, but got {trials!r}")
+    if trials == "model" and participant not in builtin.BUILTIN:  # before building its model
+        raise ParticipantError(
+            f"model trials need a hidden truth; {participant!r} is not a built-in participant {builtin.BUILTIN}"
+        )
     pair = task(participant, "calibrate"), task(participant, "validate")
     return pair if trials == "built-in" else tuple(model_trials(t, seed) for t in pair)
 

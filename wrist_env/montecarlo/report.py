@@ -147,10 +147,13 @@ def write_report(
     frames = stats.frame_table(table)
     if frames.empty:
         raise StudyError(f"{runs}: no run succeeded")
+    try:
+        t5 = stats.fit_pressure(frames, max_runs=max_runs, seed=seed)
+        intact = frames[frames["any_injury"] == 0]
+        t6 = stats.fit_slil(frames, max_runs=max_runs, seed=seed) if intact["group"].nunique() >= 2 else None
+    except stats.FitError as e:  # the fits cannot name the study's folder
+        raise StudyError(f"{runs}: {e}") from None
     out.mkdir(parents=True, exist_ok=True)
-    t5 = stats.fit_pressure(frames, max_runs=max_runs, seed=seed)
-    intact = frames[frames["any_injury"] == 0]
-    t6 = stats.fit_slil(frames, max_runs=max_runs, seed=seed) if intact["group"].nunique() >= 2 else None
     t5.table.to_csv(out / "table5.csv", index=False)
     (out / "table5.md").write_text(markdown_table(t5, "MPa") + "\n\n" + _fit_note(t5) + "\n")
     if t6 is not None:

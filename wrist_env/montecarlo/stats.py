@@ -26,6 +26,11 @@ Size: at the preprint's full size (25,000 runs × 17 frames = 425,000 rows)
 a fit takes tens of seconds here, so it is done on every row by default.
 `max_runs` fits on the frames of a seeded random subset of runs instead
 (the choice and the subset size are reported with the table).
+
+Too few runs: with a random intercept per run, the run-level terms (the intercept and, in Table 5, the five
+tears) are told apart only between runs, so a fit needs more runs than those terms (`MIN_RUNS_TABLE5`,
+`MIN_RUNS_TABLE6`) and each tear both present and absent. A fit short of them (or whose matrix is singular)
+raises `FitError` saying so, instead of a LinAlgError.
 """
 
 from __future__ import annotations
@@ -42,12 +47,25 @@ import pyarrow.compute as pc
 from numpy.typing import ArrayLike
 
 from wrist_env.design import INJURABLE
+from wrist_env.errors import WristEnvError
 
 ALPHA = 0.001
 SLIL = ("SLIL_v", "SLIL_p", "SLIL_d")
 BUNDLE_LABELS = {"SLIL_v": "Volar SLIL", "SLIL_p": "Proximal SLIL", "SLIL_d": "Dorsal SLIL", "RSC": "RSC", "LRL": "LRL"}
 PRESSURE_FORMULA = "rs_mean_mpa ~ s1 + s2 + " + " + ".join(INJURABLE)
 SLIL_FORMULA = "force_n ~ s1 + s2 + proximal + volar + s1:proximal + s2:proximal"
+MIN_RUNS_TABLE5 = 2 + len(INJURABLE)
+"""Fewest included runs Table 5's fit takes: one more than its run-level terms (intercept and the five tears),
+so that the variance between runs is left to estimate."""
+MIN_RUNS_TABLE6 = 2
+"""Fewest intact runs Table 6's fit takes (its one run-level term is the intercept)."""
+
+
+MORE_RUNS = "run a larger study (--n), or fit more of its runs (--max-runs)"
+
+
+class FitError(WristEnvError, ValueError):
+    """A mixed-effects fit that the runs cannot support (too few, a tear never or always present)."""
 
 
 def angle_basis(angle: ArrayLike, lower: float, upper: float) -> np.ndarray:
@@ -138,15 +156,43 @@ class Fit:
         }
 
 
-def _mixedlm(formula: str, data: pd.DataFrame):
+def _mixedlm(formula: str, data: pd.DataFrame, table: str, min_runs: int, kind: str = "runs"):
+    """The REML fit of `formula` on `data` with a random intercept per run; `FitError` naming `table`
+    and `min_runs` (of `kind`) if the runs cannot support it (`_check_runs`) or its matrix turns out singular."""
     import statsmodels.formula.api as smf
     from statsmodels.tools.sm_exceptions import ConvergenceWarning
 
+    _check_runs(data, table, min_runs, kind)
     model = smf.mixedlm(formula, data, groups=data["group"])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConvergenceWarning)
-        result = model.fit(reml=True)
+        try:
+            result = model.fit(reml=True)
+        except np.linalg.LinAlgError as e:
+            raise FitError(
+                f"the mixed-effects fit of {table} hit a singular matrix ({e}) on its {data['group'].nunique():,} "
+                f"{kind}: too few or too alike to tell the variance between runs from the fixed effects (it needs "
+                f"at least {min_runs} {kind}, and more when they are alike); {MORE_RUNS}"
+            ) from None
     return result
+
+
+def _check_runs(data: pd.DataFrame, table: str, min_runs: int, kind: str) -> None:
+    """`FitError` unless `data` holds at least `min_runs` runs, each tear column it has both 0 and 1 among
+    them."""
+    runs = data["group"].nunique()
+    if runs < min_runs:
+        raise FitError(
+            f"the mixed-effects fit of {table} needs at least {min_runs} {kind}, but the study has {runs:,} "
+            f"to fit: {MORE_RUNS}"
+        )
+    constant = [lig for lig in INJURABLE if lig in data and data[lig].nunique() < 2]
+    if constant:
+        states = ", ".join(f"{lig} {'torn' if data[lig].iloc[0] else 'intact'}" for lig in constant)
+        raise FitError(
+            f"the mixed-effects fit of {table} needs each tear both present and absent, but in all {runs:,} runs "
+            f"{states}: {MORE_RUNS}"
+        )
 
 
 def _table(result, rows: list[tuple[str, str, str]], mean: float | None) -> pd.DataFrame:
@@ -176,7 +222,7 @@ def fit_pressure(frames: pd.DataFrame, *, max_runs: int | None = None, seed: int
     """Table 5: radioscaphoid mean pressure on the angle spline and the five tear indicators."""
     start = time.perf_counter()
     data, runs, available, bounds = _prepare(frames, max_runs, seed)
-    result = _mixedlm(PRESSURE_FORMULA, data)
+    result = _mixedlm(PRESSURE_FORMULA, data, "Table 5", MIN_RUNS_TABLE5)
     mean = float(data["rs_mean_mpa"].mean())
     rows = [
         ("Angle spline", "Intercept", "Intercept (full extension)"),
@@ -207,7 +253,7 @@ def fit_slil(frames: pd.DataFrame, *, max_runs: int | None = None, seed: int = 0
     """Table 6: SLIL bundle forces in intact runs (dorsal the base), angle spline, proximal interactions."""
     start = time.perf_counter()
     data, runs, available, bounds = _prepare(slil_long(frames), max_runs, seed)
-    result = _mixedlm(SLIL_FORMULA, data)
+    result = _mixedlm(SLIL_FORMULA, data, "Table 6", MIN_RUNS_TABLE6, "intact runs")
     rows = [
         ("Angle spline", "Intercept", "Intercept (dorsal SLIL, full extension)"),
         ("Angle spline", "s1", "Angle spline 1"),

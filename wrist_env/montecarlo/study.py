@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from wrist_env.errors import InputError
 from wrist_env.limits import MAX_BATCH, MAX_WORKERS, check_int
 from wrist_env.montecarlo import sampler
 from wrist_env.montecarlo.config import StudyConfig, StudyError
@@ -181,8 +182,11 @@ def run_study(
     address or Client (default: local). workers: local worker processes (0 or 1: this process).
     folders: user participant folders (registered here and on every worker). progress: a tqdm
     bar of successful runs (postfix: excluded and failed so far). A second run on the same `out`
-    while this one is running is refused (`StoreBusyError`).
+    while this one is running is refused (`StoreBusyError`), and so is an empty `out` (it would be the
+    current folder).
     """
+    if not str(out).strip():
+        raise InputError("out is empty; give the study's folder (run_study(config, 'runs/montecarlo'))")
     batch = check_int("batch", batch, 1, MAX_BATCH)
     workers = check_int("workers", workers, 0, MAX_WORKERS, "0 or 1: this process")
     out = Path(out)

@@ -157,40 +157,122 @@ class Processes(Executor):
 
 
 class Dask(Executor):
-    """Tasks on a dask.distributed scheduler (an address, or a `distributed.Client` the caller keeps)."""
+    """Tasks on a dask.distributed scheduler (an address, or a `distributed.Client` the caller keeps).
 
-    def __init__(self, scheduler):
+    `results` raises `SchedulerError` (not a task's error: nothing can run) when the scheduler has had no
+    worker for `no_workers_timeout_s` while tasks wait (it would otherwise wait for one forever, silently),
+    or when it cancelled a task (it was stopped or restarted, or lost the task)."""
+
+    def __init__(self, scheduler, no_workers_timeout_s: float | None = None):
         from distributed import Client
 
         self.own = not isinstance(scheduler, Client)
         self.client = _connect(scheduler) if self.own else scheduler
         self.scheduler = scheduler if isinstance(scheduler, str) else str(scheduler)
+        self.no_workers_timeout_s = NO_WORKERS_TIMEOUT_S if no_workers_timeout_s is None else no_workers_timeout_s
 
     def submit(self, fn: Callable, *args: Any, **kwargs: Any) -> distributed.Future:
         return self.client.submit(fn, *args, pure=False, key=f"wrist-env-{os.getpid()}-{time.time_ns()}", **kwargs)
+
+    def results(
+        self, handles: Iterable[Any], on_poll: Callable[[], None] | None = None, poll_seconds: float = POLL_SECONDS
+    ) -> Iterator[tuple[object, object, BaseException | None]]:
+        from concurrent.futures import CancelledError  # distributed's FutureCancelledError is one
+
+        watch = _NoWorkers(self, on_poll)
+        for handle, value, error in super().results(handles, watch.poll, poll_seconds):
+            if isinstance(error, CancelledError):
+                raise SchedulerError(
+                    f"the dask scheduler {self.scheduler} cancelled a task ({describe(error)[:200]}): it was "
+                    "stopped or restarted, or lost the task's workers"
+                ) from None
+            watch.since = None  # a task finished: some worker is there
+            yield handle, value, error
+
+    def workers_count(self) -> int:
+        """The workers the scheduler has now; `SchedulerError` if it does not answer."""
+        try:
+            return len(self.client.scheduler_info(n_workers=-1).get("workers", {}))
+        except (OSError, TimeoutError) as e:  # distributed's CommClosedError is an OSError
+            raise SchedulerError(
+                f"the dask scheduler {self.scheduler} stopped answering ({describe(e)[:200]})"
+            ) from None
 
     def close(self) -> None:
         if self.own:
             self.client.close()
 
 
+class _NoWorkers:
+    """`poll()`: the caller's `on_poll`, then `SchedulerError` once the scheduler of `dask` has had no worker
+    for its `no_workers_timeout_s` (s, counted from the first poll that found none)."""
+
+    def __init__(self, dask: Dask, on_poll: Callable[[], None] | None):
+        self.dask, self.on_poll, self.since = dask, on_poll, None
+
+    def poll(self) -> None:
+        if self.on_poll is not None:
+            self.on_poll()
+        if self.dask.workers_count():
+            self.since = None
+            return
+        now = time.monotonic()
+        self.since = now if self.since is None else self.since
+        waited_s = now - self.since
+        if waited_s >= self.dask.no_workers_timeout_s:
+            address = self.dask.scheduler
+            raise SchedulerError(
+                f"the dask scheduler {address} has had no workers for {round(waited_s, 1):g} s, so no task can run; "
+                f"start one with `dask worker {address}` (on a machine that sees this folder and has wrist-env)"
+            )
+
+
 CONNECT_TIMEOUT_S = 30.0
 """How long to wait for a dask scheduler to answer (s)."""
+NO_WORKERS_TIMEOUT_S = 60.0
+"""How long tasks wait on a dask scheduler that has no worker before `Dask.results` gives up (s)."""
+SCHEMES = ("tcp", "ws", "tls", "wss", "inproc")
+"""Address schemes of a dask scheduler this client can reach: tls and wss only with a client certificate
+configured in dask's `distributed.comm.tls` settings (`_check_address`)."""
 
 
 class SchedulerError(WristEnvError, ConnectionError):
-    """A dask scheduler that cannot be reached."""
+    """A dask scheduler that cannot be reached, has no worker, or dropped the tasks."""
+
+
+def _check_address(address: str) -> None:
+    """`SchedulerError` naming `address` unless it is one this client can reach (`SCHEMES`): a scheme
+    without a transport here, or TLS without the certificates it needs, in one line instead of
+    distributed's traceback."""
+    if not address.strip():
+        raise SchedulerError("the dask scheduler address is empty; give one such as tcp://host:8786")
+    scheme = address.split("://", 1)[0].lower() if "://" in address else "tcp"
+    if scheme not in SCHEMES:
+        raise SchedulerError(
+            f"the dask scheduler address {address!r} has the scheme {scheme!r}, which this client cannot use; "
+            f"give a {', '.join(s + '://' for s in SCHEMES if s != 'inproc')} address (e.g. tcp://host:8786)"
+        )
+    if scheme in ("tls", "wss"):
+        from distributed.security import Security
+
+        if Security().get_connection_args("client").get("ssl_context") is None:
+            raise SchedulerError(
+                f"the dask scheduler address {address!r} is TLS, but dask has no client certificate configured: "
+                "set distributed.comm.tls.ca-file, .client.cert and .client.key in dask's configuration "
+                "(https://distributed.dask.org/en/stable/tls.html), or use the scheduler's tcp:// address"
+            )
 
 
 def _connect(address: str) -> distributed.Client:
-    """A client of the scheduler at `address`; `SchedulerError` naming it if it does not answer
-    within `CONNECT_TIMEOUT_S`."""
+    """A client of the scheduler at `address` (`_check_address` first); `SchedulerError` naming it if it
+    does not answer within `CONNECT_TIMEOUT_S`."""
     from distributed import Client
 
+    _check_address(address)
     timeout_s = CONNECT_TIMEOUT_S
     try:
         return Client(address, timeout=f"{timeout_s}s")
-    except (OSError, TimeoutError, ValueError) as e:
+    except (OSError, TimeoutError, ValueError, TypeError) as e:  # TypeError: distributed's, on a TLS misconfiguration
         raise SchedulerError(
             f"cannot reach the dask scheduler {address!r} within {timeout_s:g} s ({type(e).__name__}: "
             f"{str(e).splitlines()[0][:200] if str(e) else 'no answer'}); is it running, and is the address right?"

@@ -22,6 +22,7 @@ from wrist_env.bench.leaderboard.tables import (
     unsettled_shares,
 )
 from wrist_env.bench.log import RunLog
+from wrist_env.errors import StoreError
 from wrist_env.runs import provenance
 
 
@@ -55,7 +56,7 @@ def build(runs: str | Path, references: dict[str, Reference] | None = None) -> L
     `Reference`} already simulated; the others are simulated here)."""
     evals, summaries, unfinished = load_runs(runs)
     if not summaries:
-        raise ValueError(f"{runs}: no finished benchmark cell in this run log")
+        raise StoreError(f"{runs}: no finished benchmark cell in this run log")
     participants = sorted({s["participant"] for s in summaries})
     RunLog(runs).check_made_from({p: provenance.of_participant(p) for p in participants})  # today's models
     summaries = sorted(summaries, key=lambda s: (s["participant"], s["optimizer"], s["budget"], s["seed"]))

@@ -4,10 +4,12 @@
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 import numpy as np
 
-from wrist_env.errors import UsageError
+from wrist_env.cli.run.outputs import out_folder
+from wrist_env.errors import Interrupted, UsageError
 from wrist_env.identification import fisher
 from wrist_env.identification import sensitivity as global_sensitivity
 from wrist_env.identification.settings import SamplerSettings
@@ -56,6 +58,15 @@ def posterior(args) -> int:
     registry.require(*args.participants)
     if args.seeds < 1:
         raise UsageError(f"needs --seeds >= 1, but got {args.seeds}")
+    no_truth = [p for p in args.participants if p not in builtin.BUILTIN]
+    if args.model_trials and no_truth:
+        raise UsageError(
+            f"--model-trials simulates a participant's hidden truth, which {', '.join(no_truth)} (read from a "
+            f"folder) does not have; leave --model-trials out, or give built-in participants {list(builtin.BUILTIN)}"
+        )
+    out_folder(args.out)
+    if args.report is not None:
+        out_folder(args.report, "--report")
     settings = SamplerSettings(
         args.sampler, args.walkers, args.steps, args.particles, args.mcmc_steps, args.map_starts, args.prior_refresh
     )
@@ -77,16 +88,23 @@ def posterior(args) -> int:
             flush=True,
         )
 
-    table = study(
-        args.participants,
-        args.seeds,
-        args.out,
-        settings,
-        progress=not args.no_progress,
-        on_run=report,
-        report=args.report,
-        trials="model" if args.model_trials else "built-in",
-    )
+    try:
+        table = study(
+            args.participants,
+            args.seeds,
+            args.out,
+            settings,
+            progress=not args.no_progress,
+            on_run=report,
+            report=args.report,
+            trials="model" if args.model_trials else "built-in",
+        )
+    except KeyboardInterrupt:
+        saved = len(list(Path(args.out).glob("posterior_*.json")))
+        raise Interrupted(
+            f"posterior interrupted; {saved} finished run(s) saved in {args.out} are kept and loaded, not sampled "
+            "again, on a rerun (the run in progress starts over): rerun the same command to resume"
+        ) from None
     if "coverage_90" in table:
         for participant, rows in table.groupby("participant", sort=False):
             print(

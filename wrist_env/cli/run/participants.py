@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from wrist_env import design
+from wrist_env.cli.run.outputs import out_folder
 from wrist_env.errors import DesignError, ParticipantError, UsageError
 from wrist_env.frames import DOF_NAMES, DOF_UNITS
 from wrist_env.model import BONES, PAIRS
@@ -64,8 +65,12 @@ def export(args: argparse.Namespace) -> int:
             f"export takes a built-in participant {list(builtin.BUILTIN)}, but got {args.participant!r} "
             "(a folder participant is a folder already)"
         )
-    out = Path(args.out_folder)
-    name = args.name or out.resolve().name
+    if args.name is not None and not args.name.strip():
+        raise ParticipantError(
+            "--name is empty; give the exported participant's name, or leave --name out to use the folder's"
+        )
+    out = out_folder(args.out_folder, "export's folder")
+    name = args.name if args.name is not None else out.resolve().name
     if name in builtin.BUILTIN or not re.fullmatch(NAME_PATTERN, name):
         raise ParticipantError(
             f"the exported participant needs a name matching {NAME_PATTERN} that is not a built-in one, "

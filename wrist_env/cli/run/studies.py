@@ -11,25 +11,44 @@ from pathlib import Path
 
 import optimizers
 from wrist_env import bench
-from wrist_env.bench.calibrate import PRIOR_SUFFIX
+from wrist_env.bench.calibrate import PRIOR_SUFFIX, accepts_storage, split_prior
 from wrist_env.bench.iohanalyzer import export
 from wrist_env.bench.leaderboard import reference, write_leaderboard
-from wrist_env.bench.runner import make_cells
+from wrist_env.bench.log import RunLog
+from wrist_env.bench.runner import NO_STORAGE, make_cells
+from wrist_env.cli.run.outputs import out_file, out_folder
 from wrist_env.design import LIGAMENT_NAMES
-from wrist_env.errors import UsageError
+from wrist_env.errors import Interrupted, StoreError, UsageError, WristEnvError
 from wrist_env.montecarlo.config import StudyConfig
+from wrist_env.montecarlo.log import read_runs
 from wrist_env.montecarlo.report import write_report
 from wrist_env.montecarlo.study import run_study
 from wrist_env.motions import TRIAL_MOTIONS
 from wrist_env.participants import builtin, registry
+from wrist_env.runs.executor import SchedulerError
+
+RESUME = "rerun the same command to resume"
 
 
 def calibrate(args) -> int:
 
     registry.require(args.participant)
+    if args.out is not None:
+        out_file(args.out)
+    if args.log is not None:
+        out_folder(args.log, "--log")
+    storage = _calibrate_storage(args.storage, args.optimizer)
     start = time.perf_counter()
     name = args.optimizer + (PRIOR_SUFFIX if args.prior and not args.optimizer.endswith(PRIOR_SUFFIX) else "")
-    run = bench.calibrate(args.participant, name, args.budget, args.seed, log=args.log, storage=args.storage)
+    saved = (
+        f"the evaluations logged in {args.log} are kept: {RESUME}"
+        if args.log
+        else "nothing was saved (with --log <folder> a run can be resumed)"
+    )
+    try:
+        run = bench.calibrate(args.participant, name, args.budget, args.seed, log=args.log, storage=storage)
+    except KeyboardInterrupt:
+        raise Interrupted(f"calibration interrupted; {saved}") from None
     wall = time.perf_counter() - start
     ref = reference(args.participant)
     out = run.to_dict(history=True)
@@ -69,8 +88,29 @@ def calibrate(args) -> int:
     return 0
 
 
+def _calibrate_storage(storage: str | None, optimizer: str) -> str | None:
+    """The Optuna storage URL of `calibrate --storage` (None: in memory), checked before the run: "memory" is
+    none, a calibrator that keeps no Optuna study refuses one (it would be ignored), and a URL that Optuna
+    cannot open is named by `bench.calibrate.open_storage`."""
+    if storage is None or storage in NO_STORAGE:
+        return None
+    cls = optimizers.get(split_prior(optimizer)[0])  # an unknown name: UnknownOptimizerError lists them
+    if not accepts_storage(cls):
+        takes = [n for n in optimizers.available() if accepts_storage(optimizers.get(n))]
+        raise UsageError(
+            f"--storage {storage!r}: {optimizer} keeps no Optuna study; --storage is for {', '.join(takes)}"
+        )
+    from wrist_env.bench.calibrate import open_storage
+
+    open_storage(storage)  # InputError naming the URL if it cannot be opened (tables created, as the run would)
+    return storage
+
+
 def benchmark(args) -> int:
 
+    out_folder(args.out)
+    if args.leaderboard is not None:
+        out_folder(args.leaderboard, "--leaderboard")
     participants = args.participants or list(builtin.BUILTIN)
     names = args.optimizers or list(optimizers.available())
     if args.prior:
@@ -82,19 +122,24 @@ def benchmark(args) -> int:
         f"{args.seeds} seeds, budget {args.budget}; on {where}; run log {args.out}",
         flush=True,
     )
-    report = bench.benchmark(
-        participants,
-        names,
-        args.seeds,
-        args.budget,
-        args.out,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        progress=not args.no_progress,
-        storage=args.storage,
-        threads=args.threads,
-        folders=tuple(args.folder or ()),
-    )
+    try:
+        report = bench.benchmark(
+            participants,
+            names,
+            args.seeds,
+            args.budget,
+            args.out,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            progress=not args.no_progress,
+            storage=args.storage,
+            threads=args.threads,
+            folders=tuple(args.folder or ()),
+        )
+    except KeyboardInterrupt:
+        raise Interrupted(f"benchmark interrupted; {_benchmark_saved(args.out)}") from None
+    except SchedulerError as e:
+        raise SchedulerError(f"{e}; {_benchmark_saved(args.out)}") from None
     print(
         f"ran {len(report.ran)} cells, skipped {len(report.skipped)} already finished, "
         f"{len(report.failed)} failed; {report.evaluations} evaluations logged"
@@ -111,10 +156,27 @@ def benchmark(args) -> int:
     return 1 if report.failed else 0
 
 
+def _benchmark_saved(out: str) -> str:
+    """What an interrupted benchmark leaves in `out`, and how to go on."""
+    try:
+        evaluations = sum(RunLog(out).progress().values())
+    except (WristEnvError, OSError):
+        return f"what is logged in {out} is kept: {RESUME}"
+    return (
+        f"{evaluations:,} evaluations logged in {out} are kept (finished cells are skipped, cut ones resume): {RESUME}"
+    )
+
+
 def leaderboard(args) -> int:
 
     if not Path(args.runs).is_dir():
         raise UsageError(f"no run log at {args.runs}")
+    out_folder(args.out)
+    if not RunLog(args.runs).summaries():
+        raise StoreError(
+            f"{args.runs}: holds no finished benchmark cell, so there is no leaderboard to write; run "
+            f"`wrist-bench benchmark --out {args.runs}` (again, to finish its cells)"
+        )
     path = write_leaderboard(args.runs, args.out, title=args.title)
     print(path)
     return 0
@@ -126,6 +188,7 @@ def iohanalyzer(args) -> int:
         raise SystemExit('wrist-bench iohanalyzer needs ioh, which is not installed: pip install -e ".[ioh]"')
     if not Path(args.runs).is_dir():
         raise UsageError(f"no run log at {args.runs}")
+    out_folder(args.out)
     for folder in export(args.runs, args.out):
         print(folder)
     return 0
@@ -134,6 +197,7 @@ def iohanalyzer(args) -> int:
 def montecarlo(args) -> int:
 
     registry.require(*args.participants)
+    out_folder(args.out)
     config = StudyConfig(
         tuple(args.participants), args.n, args.seed, args.tear_probability, load_direction=args.load_direction
     )
@@ -150,23 +214,39 @@ def montecarlo(args) -> int:
         f"batch {args.batch}, on {where}; run log {args.out}",
         flush=True,
     )
-    summary = run_study(
-        config,
-        args.out,
-        batch=args.batch,
-        scheduler=args.scheduler,
-        workers=args.workers,
-        folders=tuple(args.folder or ()),
-        progress=not args.no_progress,
-    )
+    try:
+        summary = run_study(
+            config,
+            args.out,
+            batch=args.batch,
+            scheduler=args.scheduler,
+            workers=args.workers,
+            folders=tuple(args.folder or ()),
+            progress=not args.no_progress,
+        )
+    except KeyboardInterrupt:
+        raise Interrupted(f"Monte Carlo study interrupted; {_montecarlo_saved(args.out)}") from None
+    except SchedulerError as e:
+        raise SchedulerError(f"{e}; {_montecarlo_saved(args.out)}") from None
     print(summary.line())
     return 0
+
+
+def _montecarlo_saved(out: str) -> str:
+    """What an interrupted Monte Carlo study leaves in `out`, and how to go on."""
+    try:
+        table = read_runs(out)
+    except (WristEnvError, OSError):
+        return f"the runs logged in {out} are kept: {RESUME}"
+    runs = 0 if table is None else table.num_rows
+    return f"{runs:,} runs logged in {out} are kept (every finished batch): {RESUME}"
 
 
 def montecarlo_report(args) -> int:
 
     if not Path(args.runs).is_dir():
         raise UsageError(f"no Monte Carlo run log at {args.runs}")
+    out_folder(args.out)
     summary = write_report(args.runs, args.out, max_runs=args.max_runs)
     t5 = summary["table5"]
     print(
