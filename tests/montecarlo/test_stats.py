@@ -6,7 +6,9 @@ import pyarrow as pa
 import pytest
 
 from wrist_env.design import INJURABLE, LIGAMENT_NAMES
+from wrist_env.errors import InputError
 from wrist_env.montecarlo import stats
+from wrist_env.montecarlo.config import StudyError
 
 ANGLES = np.linspace(40.0, -40.0, 17)
 PRESSURE_TEARS = {"SLIL_v": 0.0, "SLIL_p": 0.1, "SLIL_d": 0.8, "RSC": 0.3, "LRL": -0.05}  # MPa
@@ -116,3 +118,20 @@ def test_summary_numbers_at_30_degrees_extension(frames):
     at = frames[np.isclose(frames["angle"], -30) & (frames["any_injury"] == 0)]
     total = at[["SLIL_v.force_n", "SLIL_p.force_n", "SLIL_d.force_n"]].sum(axis=1).mean()
     assert s["all"]["intact_total_slil_force_at_angle_n"] == pytest.approx(total)
+
+
+@pytest.mark.parametrize("max_runs", [0, -5, 1, stats.MIN_FIT_RUNS - 1, 2.5])
+def test_a_subset_smaller_than_the_fit_needs_is_refused_saying_how_many(frames, max_runs):
+    """Fewer runs than Table 5's intercept and tear indicators cannot be fitted: refused before the fit,
+    naming the least (issue 53: --max-runs 0, -5 and 1 ended in tracebacks)."""
+    with pytest.raises(InputError, match=rf"max_runs must be an integer in \[{stats.MIN_FIT_RUNS}, "):
+        stats.fit_pressure(frames, max_runs=max_runs)
+    assert stats.MIN_FIT_RUNS == 1 + len(INJURABLE)
+
+
+def test_a_subset_the_model_cannot_fit_is_one_error_naming_it(frames):
+    """Runs in which a tear never occurs leave its column constant: a `StudyError` naming the runs, not
+    statsmodels' LinAlgError."""
+    never_torn = frames[frames["SLIL_v"] == 0]
+    with pytest.raises(StudyError, match=r"cannot be fitted on these [\d,]+ runs .*fit on more runs"):
+        stats.fit_pressure(never_torn)

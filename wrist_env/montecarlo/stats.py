@@ -42,6 +42,8 @@ import pyarrow.compute as pc
 from numpy.typing import ArrayLike
 
 from wrist_env.design import INJURABLE
+from wrist_env.limits import MAX_SUBSET_RUNS, check_int
+from wrist_env.montecarlo.config import FIT_RUNS_WHY, MIN_FIT_RUNS, StudyError
 
 ALPHA = 0.001
 SLIL = ("SLIL_v", "SLIL_p", "SLIL_d")
@@ -99,12 +101,22 @@ def frame_table(runs: pa.Table) -> pd.DataFrame:
 
 
 def subsample_runs(frames: pd.DataFrame, max_runs: int | None, seed: int = 0) -> tuple[pd.DataFrame, int]:
-    """The frames of at most `max_runs` runs (a seeded random subset of groups); (frames, runs kept)."""
+    """The frames of at most `max_runs` runs (a seeded random subset of groups); (frames, runs kept).
+    `max_runs` is checked first: at least `MIN_FIT_RUNS`, at most `MAX_SUBSET_RUNS`."""
+    check_max_runs(max_runs)
     groups = frames["group"].unique()
     if max_runs is None or len(groups) <= max_runs:
         return frames, len(groups)
     keep = np.random.default_rng(seed).choice(groups, size=int(max_runs), replace=False)
     return frames[frames["group"].isin(set(keep))], int(max_runs)
+
+
+def check_max_runs(max_runs: int | None) -> int | None:
+    """`max_runs` (None: every run) if it is an integer in [`MIN_FIT_RUNS`, `MAX_SUBSET_RUNS`]; `InputError`
+    saying how many runs the fit needs at least."""
+    if max_runs is None:
+        return None
+    return check_int("max_runs", max_runs, MIN_FIT_RUNS, MAX_SUBSET_RUNS, FIT_RUNS_WHY)
 
 
 @dataclass
@@ -145,7 +157,13 @@ def _mixedlm(formula: str, data: pd.DataFrame):
     model = smf.mixedlm(formula, data, groups=data["group"])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConvergenceWarning)
-        result = model.fit(reml=True)
+        try:
+            result = model.fit(reml=True)
+        except np.linalg.LinAlgError as exc:  # e.g. a tear in all or none of a small subset's runs
+            raise StudyError(
+                f"the mixed model {formula} cannot be fitted on these {data['group'].nunique():,} runs ({exc}; "
+                "is a tear in all or none of them?); fit on more runs (max_runs)"
+            ) from None
     return result
 
 
