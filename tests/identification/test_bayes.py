@@ -305,7 +305,17 @@ def test_against_truth_places_the_truth_in_a_gaussian_posterior_as_closed_form_s
         (["--prior-refresh", "1"], "prior_refresh must be a share in [0, 1), but got 1.0"),
         (["--walkers", "40"], "walkers must be an integer in [44, 4,096] (2 per material, 22 materials), but got 40"),
         (["--map-starts", "0"], "map_starts must be an integer in [1, 1,000] (one Gauss-Newton run), but got 0"),
-        (["--seeds", "0"], "needs --seeds >= 1, but got 0"),
+        (["--seeds", "0"], "seeds must be an integer in [1, 10,000], but got 0"),
+        # issue 53: sizes with no bound, and a least number of steps that gave "split R-hat max nan"
+        (["--walkers", "5000000"], "walkers must be an integer in [44, 4,096]"),
+        (["--particles", "5000000"], "particles must be an integer in [44, 4,096]"),
+        (["--steps", "4"], f"steps must be an integer in [{MIN_STEPS}, 100,000]"),
+        (["--steps", "10000000"], "steps must be an integer in [8, 100,000]"),
+        (["--mcmc-steps", "100000"], "mcmc_steps must be an integer in [1, 1,000]"),
+        (["--map-starts", "1000000"], "map_starts must be an integer in [1, 1,000]"),
+        (["--seeds", "1000000"], "seeds must be an integer in [1, 10,000], but got 1000000"),
+        (["--prior-refresh", "nan"], "prior_refresh must be a finite number in [0, 1], but got nan"),
+        (["--walkers", "4096", "--steps", "10000"], "walkers x steps must be at most 4,000,000"),
     ],
 )
 def test_the_command_refuses_sampler_settings_out_of_range(bad, says, capsys):
@@ -351,6 +361,13 @@ def test_the_least_steps_give_a_finite_split_rhat():
     with warnings.catch_warnings():  # numpy warns of the variance of one step
         warnings.simplefilter("ignore", RuntimeWarning)
         assert np.all(np.isnan(mcmc.split_rhat(chain[:2])))  # 4 steps: 2 kept, halves of 1
+
+
+def test_the_command_says_why_a_saved_runs_rhat_is_not_available():
+    from wrist_env.cli.run.identification import _rhat
+
+    assert _rhat(np.array([1.01, np.nan, 1.2])) == "split R-hat max 1.20"
+    assert "not available" in _rhat(np.full(design.N_MATERIAL, np.nan))
 
 
 def test_the_study_refuses_seeds_out_of_range_before_any_run(tmp_path):
