@@ -91,7 +91,8 @@ def test_a_commands_help_and_usage_errors_load_nothing_it_runs(command):
     light ones, and `main` imports its run module once the arguments have parsed (issue 52)."""
     code = (
         "import sys\nfrom wrist_env.cli import main\nfor option in ('--help', '--no-such-option'):\n"
-        "    try:\n        main([%r, option])\n    except SystemExit as exit:\n        print('status:', exit.code)\n"
+        "    try:\n        print('status:', main([%r, option]))\n    except SystemExit as exit:\n"
+        "        print('status:', exit.code)\n"
         "print('loaded:', *(m for m in sys.modules if m.startswith('wrist_env.cli.run') or m in %r))"
     ) % (command, HEAVY)
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)

@@ -91,3 +91,12 @@ def test_carpal_meshes_are_watertight_and_fine(template):
         mesh = template.bones[bone].trimesh()
         assert mesh.is_watertight
         assert 0.4 < mesh.edges_unique_length.mean() < 1.0
+
+
+@pytest.mark.parametrize("sweep", [(float("nan"), float("nan")), (20.0, float("inf")), (-1.0, 10.0), (120.0, 10.0)])
+def test_a_template_is_not_swept_through_angles_out_of_range(sweep):
+    """Issue 53: `--fossa-sweep nan nan` swept (and cached) a template from NaN angles."""
+    from wrist_env.errors import InputError
+
+    with pytest.raises(InputError, match=r"fossa_sweep_deg \w+ must be a finite number in \[0, 90\]"):
+        load_template(sweep, True)

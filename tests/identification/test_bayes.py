@@ -3,6 +3,7 @@ diagnostics, and a short run on P1 through the command."""
 
 import dataclasses
 import json
+import warnings
 
 import numpy as np
 import pytest
@@ -13,7 +14,14 @@ from wrist_env.errors import InputError
 from wrist_env.identification import bayes, mcmc, posterior, smc
 from wrist_env.identification import map as map_
 from wrist_env.identification import study as study_
-from wrist_env.identification.settings import MAP_STARTS, MCMC_STEPS, PRIOR_REFRESH, STEPS, SamplerSettings
+from wrist_env.identification.settings import (
+    MAP_STARTS,
+    MCMC_STEPS,
+    MIN_STEPS,
+    PRIOR_REFRESH,
+    STEPS,
+    SamplerSettings,
+)
 from wrist_env.participants.registry import load_model
 
 
@@ -295,20 +303,32 @@ def test_against_truth_places_the_truth_in_a_gaussian_posterior_as_closed_form_s
     "bad, says",
     [
         (["--prior-refresh", "1"], "prior_refresh must be a share in [0, 1), but got 1.0"),
-        (["--walkers", "40"], "walkers must be an integer >= 44 (2 per material, 22 materials), but got 40"),
-        (["--map-starts", "0"], "map_starts must be an integer >= 1 (one Gauss-Newton run), but got 0"),
-        (["--seeds", "0"], "needs --seeds >= 1, but got 0"),
+        (["--walkers", "40"], "walkers must be an integer in [44, 4,096] (2 per material, 22 materials), but got 40"),
+        (["--map-starts", "0"], "map_starts must be an integer in [1, 1,000] (one Gauss-Newton run), but got 0"),
+        (["--seeds", "0"], "seeds must be an integer in [1, 10,000], but got 0"),
+        # issue 53: sizes with no bound, and a least number of steps that gave "split R-hat max nan"
+        (["--walkers", "5000000"], "walkers must be an integer in [44, 4,096]"),
+        (["--particles", "5000000"], "particles must be an integer in [44, 4,096]"),
+        (["--steps", "4"], f"steps must be an integer in [{MIN_STEPS}, 100,000]"),
+        (["--steps", "10000000"], "steps must be an integer in [8, 100,000]"),
+        (["--mcmc-steps", "100000"], "mcmc_steps must be an integer in [1, 1,000]"),
+        (["--map-starts", "1000000"], "map_starts must be an integer in [1, 1,000]"),
+        (["--seeds", "1000000"], "seeds must be an integer in [1, 10,000], but got 1000000"),
+        (["--prior-refresh", "nan"], "prior_refresh must be a finite number in [0, 1], but got nan"),
+        (["--walkers", "4096", "--steps", "10000"], "walkers x steps must be at most 4,000,000"),
     ],
 )
 def test_the_command_refuses_sampler_settings_out_of_range(bad, says, capsys):
     assert main(["posterior", "P1", *bad]) == 2  # a usage error, one line naming the setting and the value
-    assert says in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert says in err and err.count("\n") == 1, err
 
 
 @pytest.mark.parametrize(
     "field, value",
     [("sampler", "nuts"), ("walkers", 43), ("walkers", 48.0), ("steps", 3), ("particles", True), ("mcmc_steps", 0),
-     ("prior_refresh", -0.1), ("prior_refresh", float("nan"))],
+     ("prior_refresh", -0.1), ("prior_refresh", float("nan")), ("steps", MIN_STEPS - 1), ("walkers", 10**6),
+     ("map_starts", 10**6)],
 )  # fmt: skip
 def test_sampler_settings_refuse_values_out_of_range(field, value):
     with pytest.raises(InputError, match=f"SamplerSettings.{field} must be"):
@@ -330,3 +350,35 @@ def test_the_commands_defaults_are_the_samplers_own(capsys):
     for flag, value in [("--steps", STEPS), ("--map-starts", MAP_STARTS)]:
         assert f"{flag.upper().lstrip('-').replace('-', '_')} " in text and f"default {value}" in text
     assert f"(default {PRIOR_REFRESH})" in text
+
+
+def test_the_least_steps_give_a_finite_split_rhat():
+    """At `MIN_STEPS` the kept half splits into halves of two steps, each with a variance: split R-hat is
+    finite (issue 53: at the old least, 4, it was NaN and the command printed "split R-hat max nan")."""
+    walkers = 2 * design.N_MATERIAL
+    chain = np.random.default_rng(0).normal(size=(MIN_STEPS, walkers, design.N_MATERIAL))
+    assert np.all(np.isfinite(mcmc.split_rhat(chain[MIN_STEPS // 2 :])))
+    with warnings.catch_warnings():  # numpy warns of the variance of one step
+        warnings.simplefilter("ignore", RuntimeWarning)
+        assert np.all(np.isnan(mcmc.split_rhat(chain[:2])))  # 4 steps: 2 kept, halves of 1
+
+
+def test_the_command_says_why_a_saved_runs_rhat_is_not_available():
+    from wrist_env.cli.run.identification import _rhat
+
+    assert _rhat(np.array([1.01, np.nan, 1.2])) == "split R-hat max 1.20"
+    assert "not available" in _rhat(np.full(design.N_MATERIAL, np.nan))
+
+
+def test_the_study_refuses_seeds_out_of_range_before_any_run(tmp_path):
+    for seeds, says in [(0, "seeds must be an integer in [1, 10,000], but got 0"), ([-1], "seed must be an integer")]:
+        with pytest.raises(InputError) as refused:
+            study_.study(["P1"], seeds, tmp_path)
+        assert says in str(refused.value)
+    assert not any(tmp_path.iterdir())
+
+
+def test_an_emcee_chain_larger_than_memory_holds_is_refused_before_it_runs():
+    with pytest.raises(InputError, match=r"walkers x steps must be at most 4,000,000 .* 4,096 x 1,000 = 4,096,000"):
+        SamplerSettings(walkers=4096, steps=1000)
+    SamplerSettings("smc", walkers=4096, steps=1000)  # SMC has no chain: its walkers and steps are not used

@@ -75,3 +75,28 @@ def test_a_motion_without_reference_kinematics_is_one_line_before_any_run(tmp_pa
         in err
         and "motions with one: ['calibrate', 'validate']" in err
     ), err
+
+
+@pytest.mark.parametrize(
+    "method, n, seed, says",
+    [
+        ("morris", 0, 0, "n must be an integer in [2, 4,096]"),
+        ("morris", 2_000_000, 0, "n must be an integer in [2, 4,096]"),
+        (
+            "sobol",
+            3,
+            0,
+            "sobol needs n a power of 2 (Sobol' sequences), at least 2, but got 3: the nearest are 2 and 4",
+        ),
+        ("morris", 20, -1, "seed must be an integer in [0, 4,294,967,295], but got -1"),
+    ],
+)
+def test_a_study_refuses_its_size_and_seed_before_anything_runs(method, n, seed, says, tmp_path):
+    """Issue 53: n 2 million took 2.5 GB while sampling, n 0 and seed -1 were SALib's to fail on, sobol's
+    n 3 a traceback; now one `InputError` before any sample or model."""
+    from wrist_env.errors import InputError
+
+    with pytest.raises(InputError) as refused:
+        sensitivity.study("P1", method, n, seed=seed, out=tmp_path)
+    assert says in str(refused.value)
+    assert not any(tmp_path.iterdir())

@@ -6,6 +6,7 @@ import pyarrow as pa
 import pytest
 
 from wrist_env.design import INJURABLE, LIGAMENT_NAMES
+from wrist_env.errors import InputError
 from wrist_env.montecarlo import stats
 
 ANGLES = np.linspace(40.0, -40.0, 17)
@@ -130,3 +131,20 @@ def test_a_tear_seen_in_no_run_is_a_fit_error_naming_it(frames):
     intact = frames.assign(RSC=0.0)
     with pytest.raises(stats.FitError, match=r"each tear both present and absent, but in all 795 runs RSC intact"):
         stats.fit_pressure(intact)
+
+
+@pytest.mark.parametrize("max_runs", [0, -5, 1, stats.MIN_FIT_RUNS - 1, 2.5])
+def test_a_subset_smaller_than_the_fit_needs_is_refused_saying_how_many(frames, max_runs):
+    """Fewer runs than Table 5's intercept and tear indicators cannot be fitted: refused before the fit,
+    naming the least (issue 53: --max-runs 0, -5 and 1 ended in tracebacks)."""
+    with pytest.raises(InputError, match=rf"max_runs must be an integer in \[{stats.MIN_FIT_RUNS}, "):
+        stats.fit_pressure(frames, max_runs=max_runs)
+    assert stats.MIN_FIT_RUNS == 2 + len(INJURABLE)
+
+
+def test_a_subset_the_model_cannot_fit_is_one_error_naming_it(frames):
+    """Runs in which a tear never occurs leave its column constant: a `FitError` naming the tear, not
+    statsmodels' LinAlgError."""
+    never_torn = frames[frames["SLIL_v"] == 0]
+    with pytest.raises(stats.FitError, match=r"each tear both present and absent, .* SLIL_v intact"):
+        stats.fit_pressure(never_torn)

@@ -29,6 +29,7 @@ from numpy.typing import ArrayLike
 from wrist_env.anatomy.midcarpal import DISTAL_ROW, read_seat
 from wrist_env.anatomy.myosim import load_myosim_anatomy
 from wrist_env.anatomy.radius_cap import build_radius_cap
+from wrist_env.builder.params import check_fossa_sweep
 from wrist_env.model import BODY_PARTS, BONES, CARPALS, CARRIED_WITH, PARTS, SUPPLIED
 
 ROW = ("scaphoid", "lunate")  # the proximal row bones that articulate with the radius
@@ -214,6 +215,7 @@ def load_template(fossa_sweep_deg: tuple = (0.0, 0.0), distal_row: bool = False)
     the radius fossae ((0, 0): moulded to the neutral row). distal_row: the lunate body
     carries the triquetrum and the capitate body the trapezium, trapezoid and hamate.
     """
+    fossa_sweep_deg = check_fossa_sweep(fossa_sweep_deg)  # NaN or out-of-range angles: refused, not swept
     m, oriented = oriented_parts()
     seat = read_seat()
     m |= {b: _transform(m[b], seat) for b in DISTAL_ROW}

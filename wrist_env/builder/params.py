@@ -2,11 +2,33 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from wrist_env.errors import InputError
+from wrist_env.limits import MAX_FOSSA_SWEEP_DEG, bounded_float, check_float
+
 if TYPE_CHECKING:
     import argparse
+
+SWEEP_WHY = "deg; 0 0 moulds the fossae to the neutral row"
+
+
+def check_fossa_sweep(sweep_deg: Sequence[float]) -> tuple[float, float]:
+    """(flexion, deviation) half-ranges, deg, as floats, if there are two, each finite and in
+    [0, `MAX_FOSSA_SWEEP_DEG`]; `InputError` naming the value (before a template is swept or a model is
+    built and cached from it)."""
+    try:
+        pair = tuple(sweep_deg)
+    except TypeError:
+        pair = ()
+    if len(pair) != 2:
+        raise InputError(f"fossa_sweep_deg must be two angles (flexion, deviation), deg, but got {sweep_deg!r}")
+    return tuple(
+        check_float(f"fossa_sweep_deg {axis}", a, 0.0, MAX_FOSSA_SWEEP_DEG, SWEEP_WHY)
+        for axis, a in zip(("flexion", "deviation"), pair)
+    )
 
 
 @dataclass(frozen=True)
@@ -34,6 +56,9 @@ class BuildParams:
     """Build the fixed TC and TH with the distal row (False: the lunate body is tied to the
     distal row by contact alone; for studying what they do)."""
 
+    def __post_init__(self):
+        check_fossa_sweep(self.fossa_sweep_deg)  # refused before anything is built or cached from it
+
     @property
     def anatomy(self) -> tuple:
         """The template variant of these parameters: (fossa_sweep_deg, distal_row)."""
@@ -46,7 +71,7 @@ def add_anatomy_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--fossa-sweep",
         nargs=2,
-        type=float,
+        type=bounded_float("fossa sweep half-range", 0.0, MAX_FOSSA_SWEEP_DEG, SWEEP_WHY),
         default=d.fossa_sweep_deg,
         metavar=("FLEXION", "DEVIATION"),
         help="anatomy variant: radius fossae as the envelope of the row swept +-these angles (deg); "

@@ -9,7 +9,7 @@ from collections.abc import Sequence
 from importlib import import_module
 from pkgutil import resolve_name
 
-from wrist_env.errors import WristEnvError
+from wrist_env.errors import UsageError, WristEnvError
 
 COMMANDS = {
     "participants": ("participant_commands", "list the known participants"),
@@ -56,11 +56,21 @@ help. A command's module is loaded only when that command is named, so `wrist-be
 them; what runs it (`wrist_env.cli.run`, the solver and the rest) only once its arguments have parsed."""
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser, whose usage errors (an option's value out of its bounds, a missing or unknown
+    argument) are `UsageError`s: one line naming the command, the option and the value, exit 2, as every
+    other error of `main` (argparse would print the usage and exit)."""
+
+    def error(self, message: str):
+        command = self.prog.removeprefix("wrist-bench").strip()
+        raise UsageError(f"{command}: {message}" if command else message)
+
+
 def parser(selected: str | None = None) -> argparse.ArgumentParser:
     """The `wrist-bench` argument parser, every command with `--folder`: each command's own arguments
     from its module, for every command (`selected` None) or only for the commands of `selected`'s module
     (the others listed by name and help alone, their modules not imported; "" for none)."""
-    p = argparse.ArgumentParser(prog="wrist-bench", description=__doc__)
+    p = _Parser(prog="wrist-bench", description=__doc__)
     sub = p.add_subparsers(dest="command", required=True)
     folders = argparse.ArgumentParser(add_help=False)
     folders.add_argument(
@@ -93,15 +103,14 @@ def _named(argv: Sequence[str]) -> str | None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run one `wrist-bench` command; returns the exit status (2 for a project or file-system error, 130 for
-    Ctrl-C: one line on stderr)."""
+    """Run one `wrist-bench` command; returns the exit status (2 for a usage, project or file-system error, 130
+    for Ctrl-C: one line on stderr)."""
     argv = list(sys.argv[1:] if argv is None else argv)
     name = _named(argv)
-    args = parser(name or "").parse_args(argv)
-    os.environ.setdefault("MPLBACKEND", "Agg")  # the commands save figures; none is shown
-    run = resolve_name(f"{__name__}.run.{args.run}")  # "module:function" of wrist_env.cli.run, imported now
-
     try:
+        args = parser(name or "").parse_args(argv)  # every option's bounds checked here, before any work
+        os.environ.setdefault("MPLBACKEND", "Agg")  # the commands save figures; none is shown
+        run = resolve_name(f"{__name__}.run.{args.run}")  # "module:function" of wrist_env.cli.run, imported now
         if getattr(args, "folder", None):
             from wrist_env.participants import registry  # only when a folder is named: it loads the builder
 

@@ -9,6 +9,7 @@ from collections.abc import Callable
 from wrist_env.builder.params import add_anatomy_arguments
 from wrist_env.cli.options import PARTICIPANT_HELP, json_option, load_direction_option, out_option, participant_argument
 from wrist_env.cli.participant_commands import FIGURES_HELP, add_solver_argument
+from wrist_env.limits import MAX_LOAD_N, bounded_float
 
 
 def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
@@ -27,7 +28,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     add_anatomy_arguments(s)
     s.add_argument(
         "--load",
-        type=float,
+        type=bounded_float("load", 0.0, MAX_LOAD_N, "N, compressive"),
         help="compressive load on the capitate in the sweeps, N (default: the idealized "
         "driver's; the load-share check always takes 100 N)",
     )

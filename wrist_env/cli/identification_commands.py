@@ -11,10 +11,16 @@ from wrist_env.cli.options import (
     progress_option,
     seed_option,
 )
-from wrist_env.identification.settings import SAMPLERS, SamplerSettings
+from wrist_env.identification.settings import BOUNDS, SAMPLERS, SamplerSettings
+from wrist_env.limits import MAX_SEEDS, MAX_SENSITIVITY_N, MIN_SENSITIVITY_N, bounded_float, bounded_int
 from wrist_env.motions import MOTIONS
 
 DEFAULTS = SamplerSettings()
+
+
+def _setting(name: str):
+    """The argparse type of the sampler setting `name`: the bounds `SamplerSettings` refuses outside of."""
+    return bounded_int(name, *BOUNDS[name])
 
 
 def add_commands(command: Callable[..., object]) -> None:
@@ -28,7 +34,12 @@ def add_commands(command: Callable[..., object]) -> None:
     )
     participants_argument(s)
     s.add_argument("--method", choices=("morris", "sobol"), default="morris", help="default morris")
-    s.add_argument("--n", type=int, default=20, help="Morris trajectories or Sobol base size (default 20)")
+    s.add_argument(
+        "--n",
+        type=bounded_int("n", MIN_SENSITIVITY_N, MAX_SENSITIVITY_N, "Morris trajectories or Sobol base size"),
+        default=20,
+        help="Morris trajectories or Sobol base size, a power of 2 (default 20)",
+    )
     s.add_argument(
         "--motions",
         nargs="+",
@@ -64,12 +75,23 @@ def add_commands(command: Callable[..., object]) -> None:
         "the truth.",
     )
     participants_argument(s)
-    s.add_argument("--seeds", type=int, default=1, help="runs per participant, seeds 0 .. N-1 (default 1)")
     s.add_argument(
-        "--walkers", type=int, default=DEFAULTS.walkers, help="ensemble walkers (default %(default)s; >= 44)"
+        "--seeds",
+        type=bounded_int("seeds", 1, MAX_SEEDS),
+        default=1,
+        help="runs per participant, seeds 0 .. N-1 (default 1)",
     )
     s.add_argument(
-        "--steps", type=int, default=DEFAULTS.steps, help="ensemble steps (default %(default)s, ~12 min a run)"
+        "--walkers",
+        type=_setting("walkers"),
+        default=DEFAULTS.walkers,
+        help=f"ensemble walkers (default %(default)s; >= {BOUNDS['walkers'][0]})",
+    )
+    s.add_argument(
+        "--steps",
+        type=_setting("steps"),
+        default=DEFAULTS.steps,
+        help=f"ensemble steps (default %(default)s, ~12 min a run; >= {BOUNDS['steps'][0]})",
     )
     s.add_argument(
         "--sampler",
@@ -79,23 +101,26 @@ def add_commands(command: Callable[..., object]) -> None:
         "heavy-tailed start around the MAP; files get a _smc suffix)",
     )
     s.add_argument(
-        "--particles", type=int, default=DEFAULTS.particles, help="SMC particles (default %(default)s; >= 44)"
+        "--particles",
+        type=_setting("particles"),
+        default=DEFAULTS.particles,
+        help=f"SMC particles (default %(default)s; >= {BOUNDS['particles'][0]})",
     )
     s.add_argument(
         "--mcmc-steps",
-        type=int,
+        type=_setting("mcmc_steps"),
         default=DEFAULTS.mcmc_steps,
         help="SMC random-walk steps per particle and stage (default %(default)s)",
     )
     s.add_argument(
         "--map-starts",
-        type=int,
+        type=_setting("map_starts"),
         default=DEFAULTS.map_starts,
         help="Gauss-Newton starts of the MAP search that both samplers start from (default %(default)s)",
     )
     s.add_argument(
         "--prior-refresh",
-        type=float,
+        type=bounded_float("prior_refresh", 0.0, 1.0),  # 1 itself: SamplerSettings refuses it
         default=DEFAULTS.prior_refresh,
         help="emcee's share of moves that redraw one material from its prior (default %(default)s)",
     )

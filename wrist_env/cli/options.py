@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from wrist_env.limits import MAX_SEED, bounded_int
 from wrist_env.solver.settings import DEFAULT_LOADS, LOAD_DIRECTIONS
 
 
@@ -45,7 +46,7 @@ def json_option(s: argparse.ArgumentParser, what: str) -> None:
 
 def seed_option(s: argparse.ArgumentParser, what: str) -> None:
     """`--seed` (default 0)."""
-    s.add_argument("--seed", type=int, default=0, help=f"{what} seed (default 0)")
+    s.add_argument("--seed", type=bounded_int("seed", 0, MAX_SEED), default=0, help=f"{what} seed (default 0)")
 
 
 def progress_option(s: argparse.ArgumentParser) -> None:

@@ -10,6 +10,7 @@ from wrist_env.cli.options import (
     json_option,
     participant_argument,
 )
+from wrist_env.limits import MAX_FRAMES, MAX_SWEEP_DEG, bounded_float, bounded_int
 from wrist_env.motions import MOTIONS
 from wrist_env.solver.settings import SOLVERS
 
@@ -83,9 +84,14 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "driver with identity transforms)",
     )
     s.add_argument("--design", default="population", help=DESIGN_HELP)
-    s.add_argument("--frames", type=int, help="number of output frames (default 17 idealized, 3 static)")
-    s.add_argument("--flexion", type=float, default=40.0, help="idealized: first frame's flexion, deg (default 40)")
-    s.add_argument("--extension", type=float, default=40.0, help="idealized: last frame's extension, deg (default 40)")
+    s.add_argument(
+        "--frames",
+        type=bounded_int("frames", 1, MAX_FRAMES),
+        help="number of output frames (default 17 idealized, 3 static)",
+    )
+    angle = bounded_float("the sweep's angle", -MAX_SWEEP_DEG, MAX_SWEEP_DEG, "deg")
+    s.add_argument("--flexion", type=angle, default=40.0, help="idealized: first frame's flexion, deg (default 40)")
+    s.add_argument("--extension", type=angle, default=40.0, help="idealized: last frame's extension, deg (default 40)")
     s.add_argument("--warm-up", action="store_true", help="run a one-frame simulation first (compile_seconds)")
     json_option(s, "all per-frame outputs")
     add_solver_argument(s)

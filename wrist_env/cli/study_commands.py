@@ -18,7 +18,21 @@ from wrist_env.cli.options import (
     seed_option,
 )
 from wrist_env.design import INJURABLE, SPAN_SD
-from wrist_env.montecarlo.config import EXCLUDE_ABOVE_MPA, TEAR_PROBABILITY
+from wrist_env.limits import (
+    MAX_BATCH,
+    MAX_BUDGET,
+    MAX_RUNS,
+    MAX_SEEDS,
+    MAX_SUBSET_RUNS,
+    MAX_THREADS,
+    MAX_WORKERS,
+    bounded_float,
+    bounded_int,
+)
+from wrist_env.montecarlo.config import EXCLUDE_ABOVE_MPA, FIT_RUNS_WHY, MIN_FIT_RUNS, TEAR_PROBABILITY
+
+BUDGET = bounded_int("budget", 1, MAX_BUDGET)
+"""`--budget` of calibrate and benchmark: simulations of one calibration."""
 
 
 def _run_log_arguments(s: argparse.ArgumentParser, *, out: str, runs: str = "runs/benchmark") -> None:
@@ -43,7 +57,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     s.add_argument(
         "--optimizer", default="cmaes", help=f"calibrator: {', '.join(optimizers.available())} (default cmaes)"
     )
-    s.add_argument("--budget", type=int, default=300, help="simulations allowed (default 300)")
+    s.add_argument("--budget", type=BUDGET, default=300, help="simulations allowed (default 300)")
     seed_option(s, "calibrator")
     s.add_argument("--log", help="run-log folder: log every batch, resume this run if it was cut short")
     s.add_argument("--storage", help="Optuna storage URL for Optuna calibrators (default: in memory)")
@@ -71,12 +85,23 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     s.add_argument(
         "--prior", action="store_true", help="also run every calibrator on the MAP objective ('<name>+prior')"
     )
-    s.add_argument("--seeds", type=int, default=5, help="seeds 0 .. N-1 per participant and calibrator (default 5)")
-    s.add_argument("--budget", type=int, default=300, help="simulations per run (default 300)")
+    s.add_argument(
+        "--seeds",
+        type=bounded_int("seeds", 1, MAX_SEEDS),
+        default=5,
+        help="seeds 0 .. N-1 per participant and calibrator (default 5)",
+    )
+    s.add_argument("--budget", type=BUDGET, default=300, help="simulations per run (default 300)")
     out_option(s, "runs/benchmark", "run-log folder")
     scheduler_option(s, "cell")
-    s.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
-    s.add_argument("--threads", type=int, help="Numba threads per local worker (default: cores / workers)")
+    s.add_argument(
+        "--workers", type=bounded_int("workers", 1, MAX_WORKERS), help="local worker processes (default: one per core)"
+    )
+    s.add_argument(
+        "--threads",
+        type=bounded_int("threads", 1, MAX_THREADS),
+        help="Numba threads per local worker (default: cores / workers)",
+    )
     s.add_argument(
         "--storage",
         help="Optuna storage URL, '{cell}' replaced by the cell's key (default: "
@@ -115,11 +140,16 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         f"command again to resume.",
     )
     participants_argument(s)
-    s.add_argument("--n", type=int, default=12500, help="successful runs per participant (default 12500)")
+    s.add_argument(
+        "--n",
+        type=bounded_int("n", 1, MAX_RUNS, "a round's draws are held in memory"),
+        default=12500,
+        help="successful runs per participant (default 12500)",
+    )
     seed_option(s, "study")
     s.add_argument(
         "--tear-probability",
-        type=float,
+        type=bounded_float("tear probability", 0.0, 1.0),
         default=TEAR_PROBABILITY,
         help=f"chance of each tear (default {TEAR_PROBABILITY:g})",
     )
@@ -127,11 +157,14 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     out_option(s, "runs/montecarlo", "run-log folder")
     scheduler_option(s, "batch")
     s.add_argument(
-        "--batch", type=int, default=64, help="runs per batch: one vector-env step, one log part (default 64)"
+        "--batch",
+        type=bounded_int("batch", 1, MAX_BATCH),
+        default=64,
+        help="runs per batch: one vector-env step, one log part (default 64)",
     )
     s.add_argument(
         "--workers",
-        type=int,
+        type=bounded_int("workers", 0, MAX_WORKERS, "0 or 1: this process"),
         default=0,
         help="local worker processes, which die with this one (default 0, or 1: this process, "
         "Numba threads on every core)",
@@ -148,7 +181,11 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "as PNG, summary.json and report.md.",
     )
     _run_log_arguments(s, out="runs/montecarlo-report", runs="runs/montecarlo")
-    s.add_argument("--max-runs", type=int, help="fit on a seeded random subset of this many runs (default: all)")
+    s.add_argument(
+        "--max-runs",
+        type=bounded_int("max_runs", MIN_FIT_RUNS, MAX_SUBSET_RUNS, FIT_RUNS_WHY),
+        help=f"fit on a seeded random subset of this many runs, at least {MIN_FIT_RUNS} (default: all)",
+    )
     s.set_defaults(run="studies:montecarlo_report")
 
     s = command(

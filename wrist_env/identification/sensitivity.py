@@ -25,7 +25,9 @@ from tqdm import tqdm
 from wrist_env import design
 from wrist_env.cost import COST_BONES, DOF_NAMES
 from wrist_env.design import full_action
+from wrist_env.errors import InputError
 from wrist_env.figures.sensitivity import plot
+from wrist_env.limits import MAX_SEED, MAX_SENSITIVITY_N, MIN_SENSITIVITY_N, check_int
 from wrist_env.motions import MOTIONS
 from wrist_env.task import require_reference, task
 
@@ -41,16 +43,30 @@ def problem(names=MATERIALS, bounds=(-1.0, 1.0)) -> dict:
     return {"num_vars": len(names), "names": list(names), "bounds": [list(bounds)] * len(names)}
 
 
+def check_size(method: str, n: int, seed: int) -> int:
+    """`n` if `method` can take it: an integer in [`MIN_SENSITIVITY_N`, `MAX_SENSITIVITY_N`] (Morris
+    trajectories), for Sobol also a power of 2; `seed` a non-negative 32-bit integer. `InputError` saying
+    what n would do, before anything is sampled."""
+    if method not in METHODS:
+        raise InputError(f"method must be one of {METHODS}, but got {method!r}")
+    check_int("seed", seed, 0, MAX_SEED)
+    n = check_int("n", n, MIN_SENSITIVITY_N, MAX_SENSITIVITY_N, "Morris trajectories or Sobol base size")
+    if method == "sobol" and n & (n - 1):
+        below = 1 << (n.bit_length() - 1)
+        raise InputError(
+            f"sobol needs n a power of 2 (Sobol' sequences), at least {MIN_SENSITIVITY_N}, but got {n}: "
+            f"the nearest are {below} and {2 * below}"
+        )
+    return n
+
+
 def sample(method: str, spec: dict, n: int, seed: int) -> np.ndarray:
     """Sample points (m, num_vars): Morris with n trajectories (m = n (d + 1)), Sobol (Saltelli) with
-    base size n, a power of 2 (m = n (d + 2), no second-order indices)."""
+    base size n, a power of 2 (m = n (d + 2), no second-order indices); n checked first (`check_size`)."""
+    n = check_size(method, n, seed)
     if method == "morris":
         return morris_sample.sample(spec, n, num_levels=4, seed=seed)
-    if method == "sobol":
-        if n < 2 or n & (n - 1):
-            raise ValueError(f"sobol: n must be a power of 2 (Sobol' sequences), but got {n}")
-        return sobol_sample.sample(spec, n, calc_second_order=False, seed=seed)
-    raise ValueError(f"method must be one of {METHODS}, but got {method!r}")
+    return sobol_sample.sample(spec, n, calc_second_order=False, seed=seed)
 
 
 def indices(method: str, spec: dict, X: np.ndarray, Y: np.ndarray, seed: int = 0) -> pd.DataFrame:
@@ -99,8 +115,9 @@ def study(
 ) -> pd.DataFrame:
     """Indices of every output to every material for each motion: one row per (motion, output,
     material), with the motion's failed share; written to `out`/sensitivity_<participant>_<method>.csv
-    with a figure (.png) when `out` is given. ParticipantError, before anything is simulated, if a motion has
-    no reference kinematics (a folder participant's idealized sweep): its outputs would be undefined."""
+    with a figure (.png) when `out` is given. The method, n and seed are checked before anything runs
+    (`sample`'s `check_size`); ParticipantError, before anything is simulated, if a motion has no reference
+    kinematics (a folder participant's idealized sweep): its outputs would be undefined."""
     for motion in motions:
         require_reference(participant, motion)
     spec = problem()

@@ -8,6 +8,15 @@ from dataclasses import dataclass
 
 from wrist_env.design import N_MATERIAL
 from wrist_env.errors import InputError
+from wrist_env.limits import (
+    MAX_CHAIN_DRAWS,
+    MAX_MAP_STARTS,
+    MAX_MCMC_STEPS,
+    MAX_PARTICLES,
+    MAX_STEPS,
+    MAX_WALKERS,
+    check_int,
+)
 
 SAMPLERS = ("emcee", "smc")
 """The Bayesian calibrator's samplers: emcee's ensemble MCMC (`mcmc`) or SMCPy's tempered SMC (`smc`)."""
@@ -25,15 +34,19 @@ MAP_STARTS = 24
 """Gauss–Newton starts of the MAP search: on P1's model trials (seed 0) 10 of 24 random starts reached
 the basin of the best fit (objective 35) and 14 stopped at 91–146; 8 starts all missed it there."""
 
-# (field, least value, why): the ensemble and the particle cloud need two members per material to span
-# the 22 dimensions (emcee refuses fewer); half the steps are burn-in and split R-hat halves the rest
-_AT_LEAST = (
-    ("walkers", 2 * N_MATERIAL, f"2 per material, {N_MATERIAL} materials"),
-    ("steps", 4, "half burn-in, the kept half split in two for R-hat"),
-    ("particles", 2 * N_MATERIAL, f"2 per material, {N_MATERIAL} materials"),
-    ("mcmc_steps", 1, "one move per stage"),
-    ("map_starts", 1, "one Gauss-Newton run"),
-)
+MIN_STEPS = 8
+"""Least ensemble steps: the first half is burn-in and split R-hat halves the kept half again, and each
+half needs two steps for its variance (4 steps gave "split R-hat max nan")."""
+BOUNDS = {
+    "walkers": (2 * N_MATERIAL, MAX_WALKERS, f"2 per material, {N_MATERIAL} materials"),
+    "steps": (MIN_STEPS, MAX_STEPS, "half burn-in, the kept half split in two halves of 2+ for R-hat"),
+    "particles": (2 * N_MATERIAL, MAX_PARTICLES, f"2 per material, {N_MATERIAL} materials"),
+    "mcmc_steps": (1, MAX_MCMC_STEPS, "one move per stage"),
+    "map_starts": (1, MAX_MAP_STARTS, "one Gauss-Newton run"),
+}
+"""(least, most, why) of each integer setting: the ensemble and the particle cloud need two members per
+material to span the 22 dimensions (emcee refuses fewer); the most are `wrist_env.limits`'. The command
+line's options take the same bounds (`wrist_env.cli.identification_commands`)."""
 
 
 @dataclass(frozen=True)
@@ -55,11 +68,13 @@ class SamplerSettings:
     def __post_init__(self):
         if self.sampler not in SAMPLERS:
             raise InputError(f"SamplerSettings.sampler must be one of {SAMPLERS}, but got {self.sampler!r}")
-        for name, least, why in _AT_LEAST:
-            value = getattr(self, name)
-            if not isinstance(value, numbers.Integral) or isinstance(value, bool) or value < least:
-                raise InputError(f"SamplerSettings.{name} must be an integer >= {least} ({why}), but got {value!r}")
-            object.__setattr__(self, name, int(value))
+        for name, (least, most, why) in BOUNDS.items():
+            object.__setattr__(self, name, check_int(f"SamplerSettings.{name}", getattr(self, name), least, most, why))
+        if self.sampler == "emcee" and self.walkers * self.steps > MAX_CHAIN_DRAWS:
+            raise InputError(
+                f"SamplerSettings.walkers x steps must be at most {MAX_CHAIN_DRAWS:,} (the chain holds every draw), "
+                f"but got {self.walkers:,} x {self.steps:,} = {self.walkers * self.steps:,}"
+            )
         share = self.prior_refresh
         if not isinstance(share, numbers.Real) or isinstance(share, bool) or not 0 <= share < 1:
             raise InputError(f"SamplerSettings.prior_refresh must be a share in [0, 1), but got {share!r}")

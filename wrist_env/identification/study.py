@@ -3,6 +3,7 @@ coverage table against the hidden truths and the figures."""
 
 from __future__ import annotations
 
+import numbers
 from collections.abc import Callable
 from pathlib import Path
 
@@ -16,6 +17,7 @@ from wrist_env.identification.bayes import _tasks, calibrate
 from wrist_env.identification.mcmc import log_probability
 from wrist_env.identification.posterior import Posterior
 from wrist_env.identification.settings import SamplerSettings
+from wrist_env.limits import MAX_SEED, MAX_SEEDS, check_int
 from wrist_env.participants import builtin
 from wrist_env.task import task
 
@@ -41,7 +43,11 @@ def study(
     (default `out`); a saved run sampled with other settings is an error; trials: "built-in" or "model"
     (`model_trials`; files and figures get a `_model` suffix); settings: the sampler and its settings
     (default `SamplerSettings()`, emcee; SMC's files get a `_smc` suffix). A saved run sampled on
-    another model (`Posterior.model_hash`, the model's `source_hash`) is an error too."""
+    another model (`Posterior.model_hash`, the model's `source_hash`) is an error too. seeds: a count
+    (seeds 0 .. seeds - 1, at most `MAX_SEEDS`) or the seeds themselves, checked before any run."""
+    if isinstance(seeds, numbers.Integral):
+        seeds = range(check_int("seeds", seeds, 1, MAX_SEEDS))
+    seeds = [check_int("seed", seed, 0, MAX_SEED) for seed in seeds]
     out = Path(out)
     settings = SamplerSettings() if settings is None else settings
     sampler = settings.sampler
@@ -49,7 +55,7 @@ def study(
     rows, posteriors = [], {}
     for participant in participants:
         truth = design.z_scores(builtin.truth(participant)) if participant in builtin.BUILTIN else None
-        for seed in range(seeds) if isinstance(seeds, int) else seeds:
+        for seed in seeds:
             path = out / f"posterior_{participant}_seed{seed}{suffix}.npz"
             loaded = path.exists()
             if loaded:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from wrist_env.design import INJURABLE
 from wrist_env.errors import WristEnvError
 from wrist_env.limits import MAX_RUNS, MAX_SEED, check_int, check_unique
 from wrist_env.solver.settings import DEFAULT_LOADS, LOAD_DIRECTIONS
@@ -16,6 +17,15 @@ TEAR_PROBABILITY = 0.3
 EXCLUDE_ABOVE_MPA = 16.5
 """A run is excluded when its radioscaphoid mean pressure exceeds this (MPa) at any frame of the sweep
 (preprint 2.3.2; how we read it: `sampler`)."""
+MIN_FIT_RUNS = 2 + len(INJURABLE)
+"""Runs the report's Table 5 fit needs at least (`montecarlo-report --max-runs`, `stats.subsample_runs`,
+`stats.MIN_RUNS_TABLE5`): its intercept and five tear indicators are constant within a run, so they are told
+apart only between runs, and one run more leaves the variance between runs to estimate; fewer is singular
+whatever runs are drawn (more can still be, when a tear is in all or none of them: `stats` names it)."""
+FIT_RUNS_WHY = (
+    f"Table 5's intercept, {len(INJURABLE)} tear indicators and the variance between runs need {MIN_FIT_RUNS} runs"
+)
+"""Why `MIN_FIT_RUNS`, in the one line that refuses fewer."""
 
 
 class StudyError(WristEnvError):

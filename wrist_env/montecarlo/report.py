@@ -138,6 +138,7 @@ def write_report(
     """Fit, draw and write the report of the study logged in `runs`; returns the summary dict."""
     start = time.perf_counter()
     runs, out = Path(runs), Path(out)
+    stats.check_max_runs(max_runs)  # before the log is read or `out` made
     config = config_of(runs)
     check_log(runs, config)  # every part made with study.json's settings, on one model, where its name says
     table = read_runs(runs)

@@ -48,15 +48,16 @@ from numpy.typing import ArrayLike
 
 from wrist_env.design import INJURABLE
 from wrist_env.errors import WristEnvError
+from wrist_env.limits import MAX_SUBSET_RUNS, check_int
+from wrist_env.montecarlo.config import FIT_RUNS_WHY, MIN_FIT_RUNS
 
 ALPHA = 0.001
 SLIL = ("SLIL_v", "SLIL_p", "SLIL_d")
 BUNDLE_LABELS = {"SLIL_v": "Volar SLIL", "SLIL_p": "Proximal SLIL", "SLIL_d": "Dorsal SLIL", "RSC": "RSC", "LRL": "LRL"}
 PRESSURE_FORMULA = "rs_mean_mpa ~ s1 + s2 + " + " + ".join(INJURABLE)
 SLIL_FORMULA = "force_n ~ s1 + s2 + proximal + volar + s1:proximal + s2:proximal"
-MIN_RUNS_TABLE5 = 2 + len(INJURABLE)
-"""Fewest included runs Table 5's fit takes: one more than its run-level terms (intercept and the five tears),
-so that the variance between runs is left to estimate."""
+MIN_RUNS_TABLE5 = MIN_FIT_RUNS
+"""Fewest included runs Table 5's fit takes (`config.MIN_FIT_RUNS`)."""
 MIN_RUNS_TABLE6 = 2
 """Fewest intact runs Table 6's fit takes (its one run-level term is the intercept)."""
 
@@ -117,12 +118,22 @@ def frame_table(runs: pa.Table) -> pd.DataFrame:
 
 
 def subsample_runs(frames: pd.DataFrame, max_runs: int | None, seed: int = 0) -> tuple[pd.DataFrame, int]:
-    """The frames of at most `max_runs` runs (a seeded random subset of groups); (frames, runs kept)."""
+    """The frames of at most `max_runs` runs (a seeded random subset of groups); (frames, runs kept).
+    `max_runs` is checked first: at least `MIN_FIT_RUNS`, at most `MAX_SUBSET_RUNS`."""
+    check_max_runs(max_runs)
     groups = frames["group"].unique()
     if max_runs is None or len(groups) <= max_runs:
         return frames, len(groups)
     keep = np.random.default_rng(seed).choice(groups, size=int(max_runs), replace=False)
     return frames[frames["group"].isin(set(keep))], int(max_runs)
+
+
+def check_max_runs(max_runs: int | None) -> int | None:
+    """`max_runs` (None: every run) if it is an integer in [`MIN_FIT_RUNS`, `MAX_SUBSET_RUNS`]; `InputError`
+    saying how many runs the fit needs at least."""
+    if max_runs is None:
+        return None
+    return check_int("max_runs", max_runs, MIN_FIT_RUNS, MAX_SUBSET_RUNS, FIT_RUNS_WHY)
 
 
 @dataclass

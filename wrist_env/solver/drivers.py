@@ -18,6 +18,8 @@ from numpy.typing import ArrayLike
 from scipy.spatial.transform import Rotation
 
 from wrist_env.anatomy.tendons import model_lines
+from wrist_env.errors import InputError
+from wrist_env.limits import MAX_FRAMES, MAX_SWEEP_DEG, check_float, check_int
 from wrist_env.model import CAPITATE, Model
 from wrist_env.solver import arrays, kernel
 from wrist_env.solver.settings import DEFAULT_LOADS, LOAD_DIRECTIONS
@@ -143,8 +145,10 @@ def loaded(
     total load `load_n` (N; a scalar or one per frame) on the lines of `direction` (see `loads`)."""
     rotation = np.ascontiguousarray(np.asarray(rotations, dtype=np.float64))
     n = len(rotation)
-    com = np.tile(model.com[CAPITATE], (n, 1))
     load = np.broadcast_to(np.asarray(load_n, dtype=np.float64), (n,)).copy()
+    if not np.all(np.isfinite(load) & (load >= 0)):  # a NaN would reach the solver, a pull is not this load
+        raise InputError(f"load_n must be finite and >= 0 N (a compressive load), but got {load_n!r}")
+    com = np.tile(model.com[CAPITATE], (n, 1))
     angle = np.full(n, np.nan) if angle_deg is None else np.asarray(angle_deg, dtype=np.float64)
     return Driver(arrays.LOADED, rotation, com, angle, load, loads(model, direction))
 
@@ -169,9 +173,8 @@ def loads(model: Model, direction: str | ArrayLike) -> Loads:
 
 def static(model: Model, n_frames: int = 3) -> Driver:
     """The capitate held at neutral for `n_frames` frames (experimental driver, identity poses, no load)."""
-    if int(n_frames) < 1:
-        raise ValueError(f"n_frames must be at least 1, but got {n_frames}")
-    return experimental(model, np.tile(np.eye(4), (int(n_frames), 1, 1)))
+    n_frames = check_int("n_frames", n_frames, 1, MAX_FRAMES)
+    return experimental(model, np.tile(np.eye(4), (n_frames, 1, 1)))
 
 
 def idealized(
@@ -187,7 +190,19 @@ def idealized(
     """Idealized flexion–extension (preprint 2.2.3.2): the capitate from `flexion_deg` of
     flexion to `extension_deg` of extension about the RCS z axis in `n_frames` equal steps
     (or through `angles_deg`, flexion +), other rotations held, translations free under
-    a small compressive load `load_n` (N) along `direction` (see `loaded`)."""
-    angle = np.linspace(flexion_deg, -extension_deg, n_frames) if angles_deg is None else np.asarray(angles_deg, float)
+    a small compressive load `load_n` (N) along `direction` (see `loaded`). The frames (at most `MAX_FRAMES`)
+    and the angles (finite, within +-`MAX_SWEEP_DEG`) are checked before anything is allocated."""
+    if angles_deg is None:
+        n_frames = check_int("n_frames", n_frames, 1, MAX_FRAMES)
+        first = check_float("flexion_deg", flexion_deg, -MAX_SWEEP_DEG, MAX_SWEEP_DEG, "deg")
+        last = check_float("extension_deg", extension_deg, -MAX_SWEEP_DEG, MAX_SWEEP_DEG, "deg")
+        angle = np.linspace(first, -last, n_frames)
+    else:
+        angle = np.asarray(angles_deg, float)
+        if angle.ndim != 1 or not 1 <= len(angle) <= MAX_FRAMES or not np.all(np.abs(angle) <= MAX_SWEEP_DEG):
+            raise InputError(
+                f"angles_deg must be 1 to {MAX_FRAMES:,} finite angles within +-{MAX_SWEEP_DEG:g} deg, "
+                f"but got shape {angle.shape}, largest |angle| {np.max(np.abs(angle)) if angle.size else None}"
+            )
     rotations = Rotation.from_euler("z", angle[:, None], degrees=True).as_matrix()
     return loaded(model, rotations, load_n, angle, direction)

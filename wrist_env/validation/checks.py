@@ -9,6 +9,7 @@ import numpy as np
 
 from wrist_env import design as design_mod
 from wrist_env.builder.params import BuildParams
+from wrist_env.limits import MAX_FRAMES, MAX_LOAD_N, check_float, check_int
 from wrist_env.model import BONES, MIDCARPAL, PAIRS, Model
 from wrist_env.participants.registry import load_model
 from wrist_env.solver import drivers
@@ -52,9 +53,12 @@ def validate(
     load_n: the compressive load (N) of the sweeps; the neutral pose takes `NEUTRAL_LOAD_N`.
     load_direction: the loads' direction in the sweeps and at neutral (`settings.LOAD_DIRECTIONS`).
     settings: the solver's (`settings.SolverSettings`), default its defaults.
+    The load and the frames are checked before the model loads (a NaN load used to fail the whole run).
     """
 
     start = time.perf_counter()
+    load_n = check_float("load_n", load_n, 0.0, MAX_LOAD_N, "N, compressive")
+    n_frames = check_int("n_frames", n_frames, 1, MAX_FRAMES)
     params = params or BuildParams()
     model = model if model is not None else load_model(name, params)
     intact_design = d if d is not None else design_mod.population()

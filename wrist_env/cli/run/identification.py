@@ -53,11 +53,18 @@ def identifiability(args) -> int:
     return 0
 
 
+def _rhat(rhat: np.ndarray) -> str:
+    """The largest split R-hat, or why there is none (a run saved from a chain too short to split, or whose
+    walkers never moved: no within-half variance)."""
+    finite = rhat[np.isfinite(rhat)]
+    if finite.size == 0:
+        return "split R-hat not available (the kept chain is too short to split, or no walker moved)"
+    return f"split R-hat max {finite.max():.2f}"
+
+
 def posterior(args) -> int:
 
     registry.require(*args.participants)
-    if args.seeds < 1:
-        raise UsageError(f"needs --seeds >= 1, but got {args.seeds}")
     no_truth = [p for p in args.participants if p not in builtin.BUILTIN]
     if args.model_trials and no_truth:
         raise UsageError(
@@ -78,7 +85,7 @@ def posterior(args) -> int:
             else f"sampled in {post.wall_seconds / 60:.1f} min ({post.evaluations} simulations),"
         )
         mixing = (
-            f"ESS min {np.nanmin(post.ess):.0f}, split R-hat max {np.nanmax(post.rhat):.2f}"
+            f"ESS min {np.nanmin(post.ess):.0f}, {_rhat(post.rhat)}"
             if post.sampler == "emcee"
             else f"{post.stages} stages, {post.ess[0]:.0f} distinct particles, log evidence {post.log_evidence:.1f}"
         )

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 from wrist_env import design
 from wrist_env.cli.run.outputs import out_folder
-from wrist_env.errors import DesignError, ParticipantError, UsageError
+from wrist_env.errors import DesignError, ParticipantError
 from wrist_env.frames import DOF_NAMES, DOF_UNITS
 from wrist_env.model import BONES, PAIRS
 from wrist_env.participants import builtin, registry
@@ -115,8 +115,6 @@ def make_driver(model: Model, motion: str, frames: int | None, flexion: float, e
 
 def simulate(args) -> int:
 
-    if args.frames is not None and args.frames < 1:
-        raise UsageError("--frames must be at least 1")
     start = time.perf_counter()
     model = registry.load_model(args.participant)
     load_seconds = time.perf_counter() - start
