@@ -84,6 +84,7 @@ def test_calibrates_a_participant_and_resumes(tmp_path):
     """A benchmark cell with TwoPointsDE on P1, cut short after its first batch, resumes by replay to the same run."""
     from wrist_env.bench.calibrate import calibrate
     from wrist_env.bench.log import RunKey, RunLog
+    from wrist_env.runs import provenance
 
     options = {"batch_size": 3}
     full = calibrate("P1", "ng-twopointsde", budget=6, seed=2, log=tmp_path / "full", options=options)
@@ -91,8 +92,16 @@ def test_calibrates_a_participant_and_resumes(tmp_path):
     key = RunKey("P1", "ng-twopointsde", 2, 6)
     first = RunLog(tmp_path / "full").read_cell(key).iloc[:3]
     columns = lambda prefix: first[[c for c in first.columns if c.startswith(prefix)]].to_numpy()  # noqa: E731
+    made_from = provenance.of_participant("P1")  # what the cut log was made on, as calibrate records it
     RunLog(tmp_path / "cut").append(
-        key, 0, 0, columns("x."), first["cost"].to_numpy(), first["failed"].to_numpy(), columns("rmse.")
+        key,
+        0,
+        0,
+        columns("x."),
+        first["cost"].to_numpy(),
+        first["failed"].to_numpy(),
+        columns("rmse."),
+        made_from=made_from,
     )
     resumed = calibrate("P1", "ng-twopointsde", budget=6, seed=2, log=tmp_path / "cut", options=options)
     assert resumed.replayed == 3
