@@ -259,6 +259,10 @@ class RunLog:
         """Write a finished cell's summary, with the provenance it was made on (`made_from`) if given."""
         return self.store.write_record(key.name, summary | ({} if made_from is None else {provenance.FIELD: made_from}))
 
+    def logged(self, key: RunKey) -> bool:
+        """Whether anything of the cell is in the log (an evaluation file or its summary)."""
+        return bool(self._files(key)) or self.store.record_path(key.name).is_file()
+
     def move_aside_stale(self, key: RunKey, made_from: dict) -> int:
         """Move to `damaged/` every file of the cell (its evaluations and its summary) if any of them was
         made on another model or trials than `made_from` (`provenance.of_participant`), or records none:

@@ -175,8 +175,10 @@ def benchmark(
     _prepare_storage(cells, storage)
     log = RunLog(out_dir)
     log.repair()
-    made_from = {p: provenance.of_participant(p) for p in sorted({k.participant for k in cells})}
-    for k in cells:  # a cell made on another model or trials (an edited folder) runs again
+    made_from: dict[str, dict] = {}  # loaded only for participants with something logged (no build here)
+    for k in (k for k in cells if log.logged(k)):  # a cell made on another model or trials runs again
+        if k.participant not in made_from:
+            made_from[k.participant] = provenance.of_participant(k.participant)
         log.move_aside_stale(k, made_from[k.participant])
     done = {k for k in cells if log.summary(k) is not None}
     report = BenchmarkReport(out_dir, cells, skipped=[k for k in cells if k in done])
