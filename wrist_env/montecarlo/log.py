@@ -7,6 +7,7 @@ moving damaged or stray parts aside."""
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -61,10 +62,11 @@ def _differences(old: dict, key: dict) -> str:
     return ", ".join(f"{k} {old[k]!r} (asked {key[k]!r})" for k in sorted(key) if old[k] != key[k])
 
 
-def check_settings(out: str | Path, config: StudyConfig, made_from: dict[str, dict] | None = None) -> None:
+def check_settings(out: str | Path, config: StudyConfig, made_from: Callable[[str], dict] | None = None) -> None:
     """StudyError if a logged part was made under other settings than `config`'s, or on another model or
-    trials than `made_from` ({participant: `provenance.of_participant`}, where given), or if neither its
-    parts nor `study.json` say what they were made with (damaged parts are left to `repair`)."""
+    trials than `made_from(participant)` gives (`provenance.of_participant`, where given: called only for
+    participants with logged parts), or if neither its parts nor `study.json` say what they were made with
+    (damaged parts are left to `repair`)."""
     out, key = Path(out), config.key()
     store, unrecorded = runs_log(out), []
     for name in store.part_names():
@@ -85,12 +87,13 @@ def check_settings(out: str | Path, config: StudyConfig, made_from: dict[str, di
             f"is no {MANIFEST} to say them; restore it, or use another --out"
         )
     for name in store.part_names():
-        today = (made_from or {}).get(part_participant(name))
+        if made_from is None:
+            break
         try:
             recorded = provenance.read_provenance(store.part_path(name), RERUN)
         except StoreError:
             continue
-        changed = "" if today is None else provenance.differences(recorded, today)
+        changed = provenance.differences(recorded, made_from(part_participant(name)))
         if changed:
             raise StudyError(
                 f"{store.part_path(name)}: its runs were made on another model or trials of "

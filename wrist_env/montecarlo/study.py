@@ -29,6 +29,7 @@ process), or on a `dask.distributed` scheduler (`scheduler="tcp://…"`, or a
 
 from __future__ import annotations
 
+import functools
 import time
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import asdict, dataclass, field
@@ -212,8 +213,8 @@ def _run_locked(
     start_time = time.perf_counter()
     for f in folders:
         registry.ensure_folder(f)
-    made_from = {p: provenance.of_participant(p) for p in config.participants}  # what every part records
-    check_settings(out, config, made_from)
+    made_from = functools.cache(provenance.of_participant)  # what every part records; loaded when first
+    check_settings(out, config, made_from)  # needed (by then a worker has built a folder's model)
     _manifest(out, config)
     repair(out)
     log = runs_log(out)
@@ -264,7 +265,7 @@ def _run_locked(
                     cols = table.select(["participant", "sample_id", "ok", "excluded"]).to_pydict()
                     p = cols["participant"][0]
                     ids = tuple(int(s) for s in cols["sample_id"])
-                    log.write_part(part_name(p, ids), with_settings(table, config, made_from[p]))
+                    log.write_part(part_name(p, ids), with_settings(table, config, made_from(p)))
                     good = 0
                     for s, ok, ex_ in zip(ids, cols["ok"], cols["excluded"]):
                         outcomes[p][s] = (bool(ok), bool(ex_))
