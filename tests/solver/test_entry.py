@@ -60,17 +60,17 @@ def test_a_default_simulation_compiles_one_entry_point_and_workers_compile_none(
 
 @pytest.mark.slow
 def test_the_parts_a_second_process_compiles_are_the_ones_the_entry_point_calls(tmp_path):
-    """`precompile.part_signatures` types the block mass's kernels as `kernel.run_preconditioned` calls
+    """`parts.part_signatures` types the block mass's kernels as `kernel.run_preconditioned` calls
     them: compiled first (as the second process does), the entry point's own compile reuses each of them
     and adds no second signature (a mismatch would compile it again, and the second process would save
     nothing). An empty Numba cache, one process (~1 min)."""
     probe = (
-        "from wrist_env.solver import precompile, simulate\n"
+        "from wrist_env.solver import parts, precompile, simulate\n"
         "from wrist_env.solver.settings import SolverSettings\n"
-        "precompile.start = lambda settings: None\n"
-        "precompile.compile_parts(SolverSettings())\n"
+        "precompile._start = lambda entry, smooth: None\n"
+        "parts.compile_parts(SolverSettings())\n"
         "simulate.warm()\n"
-        "for dispatcher, _ in precompile.part_signatures(SolverSettings()):\n"
+        "for dispatcher, _ in parts.part_signatures(SolverSettings()):\n"
         "    print(dispatcher.py_func.__name__, len(dispatcher.signatures))\n"
     )
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
@@ -101,8 +101,8 @@ def test_the_second_process_imports_this_package_not_one_in_the_working_folder(t
     (tmp_path / "wrist_env").mkdir()
     monkeypatch.chdir(tmp_path)
     command, home = precompile.helper_command(True)
-    probe = "import wrist_env.solver.precompile as p; print(p.__file__)"
+    probe = "import wrist_env.solver.parts as p; print(p.__file__)"
     done = subprocess.run([command[0], "-c", probe], cwd=home, capture_output=True, text=True)
     assert done.returncode == 0, done.stderr[-2000:]
     assert Path(done.stdout.strip()).resolve().parents[2] == Path(wrist_env.__file__).resolve().parents[1]
-    assert command[1:] == ["-m", "wrist_env.solver.precompile", "smooth"]
+    assert command[1:] == ["-m", "wrist_env.solver.parts", "smooth"]

@@ -3,7 +3,7 @@
 A cold compile of the default entry point (`kernel.run_preconditioned`) takes about a minute on one core,
 a third of it the block mass's own kernels: the tangent (`tangent.tangent`), the membrane's substeps
 (`membrane.substep`) and the mass (`preconditioner.block_mass`), which the entry point reaches only after
-the force kernels. When the entry point's cache is empty, `start` runs this module in a second process: it
+the force kernels. When the entry point's cache is empty, `start` runs `parts` in a second process: it
 compiles those three for the entry point's argument types (Numba writes each to its cache), and the entry
 point, compiling in the first process meanwhile, loads each from the cache when it reaches it instead of
 compiling it, if it is there by then (a part still compiling is compiled twice: the answer is the same).
@@ -11,7 +11,8 @@ compiling it, if it is there by then (a part still compiling is compiled twice: 
 on P1's trial from an empty cache, a warm-up took 38–39 s instead of 57 s on 2 cores (the tangent and the
 substeps loaded, the mass compiled in both).
 
-Run: `python -m wrist_env.solver.precompile {smooth,trilinear}` (what `start` runs).
+The second process runs `wrist_env.solver.parts` (`python -m wrist_env.solver.parts {smooth,trilinear}`),
+which holds what it compiles; this module only decides whether to start it, and starts it.
 """
 
 from __future__ import annotations
@@ -22,53 +23,10 @@ import sys
 from contextlib import contextmanager
 from pathlib import Path
 
-import numpy as np
-from numba import typeof, types
-
-from wrist_env.design import population
-from wrist_env.model import N_BODIES
-from wrist_env.solver import arrays, kernel, membrane, preconditioner, tangent
-from wrist_env.solver.settings import SolverSettings
+from wrist_env.solver import kernel
 
 NORMALS = ("smooth", "trilinear")
 """The two kinds of contact normal, each its own compiled kernels (`SolverSettings.smooth_normals`)."""
-
-
-def part_signatures(settings: SolverSettings) -> list[tuple[object, tuple]]:
-    """(kernel, argument types) of each part as the preconditioned entry point calls it, in the order in
-    which the entry point reaches them after the force kernels, typed on built-in P1's arrays (the types
-    do not depend on the model's sizes)."""
-    from wrist_env.participants.registry import load_model  # the registry builds on the solver
-    from wrist_env.solver.simulate import prepare, stiffness
-
-    p = prepare(load_model("P1"), settings, arrays.EXPERIMENTAL)
-    R, x = np.zeros((N_BODIES, 3, 3)), np.zeros((N_BODIES, 3))
-    nodes = np.zeros((len(p.model.membrane_nodes), 3))
-    design = stiffness(p, population())
-    work = kernel.new_work(p.grids, nodes)
-    m = preconditioner.metric()
-    smooth = types.literal(bool(settings.smooth_normals))  # a compile-time constant in the entry point
-
-    def typed(*args):
-        return tuple(a if isinstance(a, types.Type) else typeof(a) for a in args)
-
-    return [
-        (tangent.tangent, typed(R, x, nodes, p.system, design, work.active, work.n_active, m, smooth)),
-        (
-            membrane.substep,
-            typed(
-                R, x, p.bodies.com0, p.membrane, nodes, nodes, design.m_l0, design.m_K, 0.0, p.settings,
-                membrane.new_scratch(nodes), smooth,
-            ),
-        ),
-        (preconditioner.block_mass, typed(R, p.bodies, p.settings, m)),
-    ]  # fmt: skip
-
-
-def compile_parts(settings: SolverSettings) -> None:
-    """Compile (or load from Numba's cache) each part for the entry point's argument types."""
-    for dispatcher, signature in part_signatures(settings):
-        dispatcher.compile(signature)
 
 
 def cold(entry) -> bool:
@@ -100,7 +58,7 @@ def helper_command(smooth: bool) -> tuple[list[str], Path]:
     `-m` imports it and not another copy found first from the working folder (a checkout beside an
     installed copy): its cache is the one this process reads."""
     normals = NORMALS[0] if smooth else NORMALS[1]
-    return [sys.executable, "-m", "wrist_env.solver.precompile", normals], Path(__file__).resolve().parents[2]
+    return [sys.executable, "-m", "wrist_env.solver.parts", normals], Path(__file__).resolve().parents[2]
 
 
 @contextmanager
@@ -116,9 +74,3 @@ def compiling(settings):
         if helper is not None:
             helper.terminate()
             helper.wait()
-
-
-if __name__ == "__main__":
-    if len(sys.argv) != 2 or sys.argv[1] not in NORMALS:
-        raise SystemExit(f"usage: python -m wrist_env.solver.precompile {{{','.join(NORMALS)}}}")
-    compile_parts(SolverSettings(smooth_normals=sys.argv[1] == NORMALS[0]))
