@@ -304,13 +304,14 @@ def shifted_model(name: str, shift_mm: float, axis: np.ndarray) -> Model:
     return model
 
 
-def _lc_gap(name, model, result) -> float:
-    """The capitate's smallest neutral gap (mm) to the lunate (`part_gaps`)."""
-    return next(
-        r["gap_min_mm"]
-        for r in part_gaps(name, model, result.poses[0])
-        if r["pair"] == "lunocapitate" and r["part"] == "capitate"
-    )
+def _lc_gap(model) -> float:
+    """The capitolunate facet's bone-to-bone closest approach at neutral (mm): the lunate bone's vertices
+    to the capitate bone's surface (the seat's measure, `midcarpal.facet_gaps`; 1.23 mm on the template)."""
+    import igl
+
+    lunate = model.part_mesh("lunate")[0]
+    v, f = model.part_mesh("capitate")
+    return float(np.sqrt(igl.point_mesh_squared_distance(lunate, v, np.asarray(f, np.int64))[0].min()))
 
 
 def seat_rows(name: str, model, rig: str) -> tuple[list[dict], np.ndarray]:
@@ -319,17 +320,15 @@ def seat_rows(name: str, model, rig: str) -> tuple[list[dict], np.ndarray]:
     axis = capitate_axis(model)
     base = drivers.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=rig)
     result = neutral(model, base)
-    rows = [{"how": "as built", "shift": 0.0, "lc_gap": _lc_gap(name, model, result)} | shares(model, result)]
+    rows = [{"how": "as built", "shift": 0.0, "lc_gap": _lc_gap(model)} | shares(model, result)]
     for shift in (-SEAT_SHIFT_MM, SEAT_SHIFT_MM):
         moved = dataclasses.replace(base, com=base.com + shift * axis)
         result = neutral(model, moved)
-        rows.append(
-            {"how": "driver's target", "shift": shift, "lc_gap": _lc_gap(name, model, result)} | shares(model, result)
-        )
+        rows.append({"how": "driver's target", "shift": shift, "lc_gap": _lc_gap(model)} | shares(model, result))
     for shift in (-SEAT_SHIFT_MM, SEAT_SHIFT_MM):
         m = shifted_model(name, shift, axis)
         result = neutral(m, drivers.loaded(m, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=rig))
-        rows.append({"how": "rebuilt seat", "shift": shift, "lc_gap": _lc_gap(name, m, result)} | shares(m, result))
+        rows.append({"how": "rebuilt seat", "shift": shift, "lc_gap": _lc_gap(m)} | shares(m, result))
     return rows, axis
 
 
@@ -465,8 +464,7 @@ def print_a(name, model, rig) -> None:
     print("| component | held (net moment on the driven body) | the body's own tendon lines alone |\n|---|---|---|")
     for r in held_rows(model, rig):
         lines = "" if np.isnan(r["lines_nm"]) else f"{r['lines_nm']:+.3f}"
-        unit = "" if "force" in r["component"] else ""
-        print(f"| {r['component']} | {r['held_nm']:+.3f}{unit} | {lines} |")
+        print(f"| {r['component']} | {r['held_nm']:+.3f} | {lines} |")
     print(
         f"\n{name} (0a): one ray group's lines at a time, scaled to {NEUTRAL_LOAD_N:g} N (population design, neutral)"
     )
@@ -501,7 +499,7 @@ def print_c(name, model, rig) -> None:
         f"{NEUTRAL_LOAD_N:g} N on the {rig} lines"
     )
     print(
-        f"| how | shift (mm) | capitate–lunate min. gap at equilibrium (mm) | {SHARE_HEAD} |\n|---|---|---|---|---|---|---|---|---|"
+        f"| how | shift (mm) | capitolunate bone gap at neutral (mm) | {SHARE_HEAD} |\n|---|---|---|---|---|---|---|---|---|"
     )
     for r in rows:
         print(f"| {r['how']} | {r['shift']:+.2f} | {r['lc_gap']:+.3f} | {share_cells(r)} |")
