@@ -19,12 +19,10 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from wrist_env import design
-from wrist_env.model import CAPITATE
 from wrist_env.participants.registry import load_model
-from wrist_env.solver import drivers, kernel
+from wrist_env.solver import drivers
 from wrist_env.solver import simulate as sim
-from wrist_env.solver.outputs import articulation_forces
-from wrist_env.solver.rigid import pose_state
+from wrist_env.solver.outputs import articulation_forces, driven_body_load
 from wrist_env.solver.settings import LOAD_DIRECTIONS
 from wrist_env.validation import NEUTRAL_LOAD_N, load_shares_pct
 
@@ -33,16 +31,9 @@ STEP_RAD = 0.02  # the finite-difference turn (1.1 deg)
 
 def distal_row_moment(model, d, driver, result) -> np.ndarray:
     """The net moment (N·mm, RCS, about the capitate's centre of mass) of contacts, ligaments and the
-    driver's lines on the distal row at the run's first frame: what the driver holds."""
-    p = sim.prepare(model, None, driver.mode)
-    poses = result.poses[0]
-    R, x = pose_state(poses, model.com)
-    nodes = np.ascontiguousarray(result.membrane_nodes[0])
-    state = kernel.State(R, x, np.zeros_like(x), np.zeros_like(x), nodes, np.zeros_like(nodes))
-    work = kernel.new_work(p.grids, nodes)
-    st = sim.stiffness(p, d)
-    kernel.net_forces(state, work, p.system, st, driver.kernel_load(0), True, True, p.settings.smooth_normals)
-    return work.T[CAPITATE].copy()
+    driver's lines on the distal row at the run's first frame: what the driver holds
+    (`outputs.driven_body_load`)."""
+    return driven_body_load(model, d, driver, result.poses[0], result.membrane_nodes[0])[1]
 
 
 def run(model, d, rotvec, direction):

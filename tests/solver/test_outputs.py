@@ -173,3 +173,41 @@ def test_articulations_split_each_pair_by_the_bone_under_its_samples(p1, sweep):
         assert set(np.unique(sample_parts(p1, pair))) <= named, pair
     assert split["scaphocapitate"] > 0 and split["lunocapitate"] > 0
     assert split["ulnocarpal"] > 0.0  # the TFCC: the lunate body bears on the ulnar head (issue 33)
+
+
+def test_the_driven_bodys_load_adds_a_line_on_it_as_r_cross_f(p1):
+    """`driven_body_load` at a turned and shifted capitate: one line of tension t at capitate point p
+    along u adds t·u to the force and (R(p − c0)) × t·u to the moment about the capitate's centre of
+    mass, the closed form of a force on a rigid body; a line on another body (the radial column) adds
+    nothing to either."""
+    from dataclasses import replace
+
+    from scipy.spatial.transform import Rotation
+
+    from wrist_env.model import CAPITATE, TRAPEZIUM
+    from wrist_env.solver.drivers import Loads, loaded
+    from wrist_env.solver.outputs import driven_body_load
+
+    rng = np.random.default_rng(1)
+    poses = np.tile(np.eye(4), (N_BODIES, 1, 1))
+    poses[CAPITATE, :3, :3] = Rotation.from_rotvec([0.05, -0.1, 0.15]).as_matrix()
+    poses[CAPITATE, :3, 3] = (0.2, 0.3, -0.1)
+    nodes = p1.membrane_nodes
+    point = p1.com[CAPITATE] + rng.normal(0.0, 6.0, 3)
+    u = np.array([0.3, 0.9, -0.2])
+    u /= np.linalg.norm(u)
+    base = loaded(p1, [np.eye(3)], 0.0)
+
+    def load(body, tension):
+        line = Loads(np.array([body]), point[None], u[None], np.ones(1))
+        return driven_body_load(
+            p1, design.population(), replace(base, loads=line, load_n=np.array([tension])), poses, nodes
+        )
+
+    F0, M0 = load(CAPITATE, 0.0)
+    F1, M1 = load(CAPITATE, 7.5)
+    arm = poses[CAPITATE, :3, :3] @ (point - p1.com[CAPITATE])
+    assert np.allclose(F1 - F0, 7.5 * u, atol=1e-12)
+    assert np.allclose(M1 - M0, np.cross(arm, 7.5 * u), atol=1e-9)
+    F2, M2 = load(TRAPEZIUM, 7.5)
+    assert np.allclose(F2, F0, atol=1e-12) and np.allclose(M2, M0, atol=1e-9)

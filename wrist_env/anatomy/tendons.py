@@ -228,17 +228,24 @@ def carpal_loads(tendons: Tendons, total_n: float, about=None) -> dict:
 _LINES: dict = {}
 
 
+def carry_point(model, carpal: str, site: np.ndarray) -> tuple[int, np.ndarray]:
+    """A template point (3,) mm on or near `carpal` (one of `PARTS`) carried onto a participant model:
+    (its body's index into `BONES`, the point in the model's neutral pose), moved by the shift of the
+    carpal's centre of mass and the cube root of its volume ratio (both in the RCS at neutral)."""
+    owner = next(b for b in BONES if carpal in BODY_PARTS[b])
+    mine = trimesh.Trimesh(*model.part_mesh(carpal), process=False)
+    theirs = load_template().parts[carpal].trimesh(solid_only=True)
+    scale = (mine.volume / theirs.volume) ** (1.0 / 3.0)
+    return BONES.index(owner), mine.center_mass + scale * (np.asarray(site, dtype=np.float64) - theirs.center_mass)
+
+
 def _lines(rig: str, model) -> tuple:
     tendons = load_tendons(rig)
-    template = load_template()
     body, point = [], []
     for carpal, site in zip(tendons.carpal, tendons.point):
-        owner = next(b for b in BONES if carpal in BODY_PARTS[b])
-        mine = trimesh.Trimesh(*model.part_mesh(carpal), process=False)
-        theirs = template.parts[carpal].trimesh(solid_only=True)
-        scale = (mine.volume / theirs.volume) ** (1.0 / 3.0)
-        body.append(BONES.index(owner))
-        point.append(mine.center_mass + scale * (site - theirs.center_mass))
+        b, p = carry_point(model, carpal, site)
+        body.append(b)
+        point.append(p)
     share = tendons.tension / tendons.tension.sum()
     arrays = (np.array(body, np.int64), np.array(point), tendons.direction.copy(), share)
     for a in arrays:
@@ -249,8 +256,7 @@ def _lines(rig: str, model) -> tuple:
 def model_lines(model, rig: str = "erhart2020") -> tuple:
     """The `rig`'s tendons as lines of action on a participant model: (body (n,) index into `BONES`,
     point (n, 3) mm in the model's neutral pose, direction (n, 3) unit pull, share (n,) of the total
-    tension). Each template site moves with the carpal it loads (`carpal`): by the shift of that
-    bone's centroid and the cube root of its volume ratio (both in the RCS at neutral)."""
+    tension). Each template site moves with the carpal it loads (`carpal`, `carry_point`)."""
     if rig not in RIGS:
         raise ValueError(f"unknown tendon rig {rig!r}; known: {sorted(RIGS)}")
     key = (model.name, model.source_hash, rig)

@@ -85,6 +85,29 @@ def articulation_forces(model: Model, pose_frame: ArrayLike) -> dict[str, float]
     return out
 
 
+def driven_body_load(
+    model: Model, design, driver, pose_frame: ArrayLike, membrane_nodes: ArrayLike, frame: int = 0
+) -> tuple[np.ndarray, np.ndarray]:
+    """The net force (3,) N and moment (3,) N·mm, RCS, of every force on the driven capitate body at one
+    frame's poses (6, 4, 4) and RSC membrane nodes (M, 3) (a `Result`'s `poses[f]`, `membrane_nodes[f]`):
+    its contacts, ligaments, the membrane and `driver`'s lines at `frame` (`Driver.kernel_load`), summed
+    by the solver's own force kernel (`kernel.net_forces`), the moment about the capitate's centre of
+    mass where the poses put it. The driver holds the opposite: at a loaded driver's equilibrium the
+    force is ~0 (its translations are free) and the moment is what the prescribed rotation absorbs
+    (about z flexion +, x ulnar deviation +, y pronation +: `cardan_deg`'s senses for a right wrist)."""
+    from wrist_env.model import CAPITATE
+    from wrist_env.solver import kernel, simulate
+
+    p = simulate.prepare(model, None, driver.mode)
+    R, x = _state(model, pose_frame)
+    nodes = np.array(membrane_nodes, dtype=np.float64)
+    state = kernel.State(R, x, np.zeros_like(x), np.zeros_like(x), nodes, np.zeros_like(nodes))
+    work = kernel.new_work(p.grids, nodes)
+    load = driver.kernel_load(frame)
+    kernel.net_forces(state, work, p.system, simulate.stiffness(p, design), load, True, True, p.settings.smooth_normals)
+    return work.F[CAPITATE].copy(), work.T[CAPITATE].copy()
+
+
 def cardan_deg(poses: ArrayLike) -> np.ndarray:
     """Cardan Z-X-Y angles (deg, `wrist_env.frames.cardan_angles`) of poses (..., 4, 4) or rotations
     (..., 3, 3): Flex/Ext (about z, flexion +), UlnD/RadD (ulnar +), Pro/Sup; NaN where a pose is not finite."""
