@@ -49,6 +49,11 @@ MAX_FOSSA_SWEEP_DEG = 90.0
 """Half-range, deg, of each axis of the row's sweep that shapes the radius fossae (`--fossa-sweep`,
 `BuildParams.fossa_sweep_deg`; default 20 and 10): the row turns ~0.7x the capitate's +-40, so a right
 angle is past any wrist's reach; a half-range is at least 0 (0 0 moulds the fossae to the neutral row)."""
+MAX_ULNAR_VARIANCE_MM = 5.0
+"""|Ulnar variance|, mm, a build may seat the ulna at (`BuildParams.ulnar_variance_mm`, participant.toml's
+`ulnar_variance_mm`; + ulna plus, by `anatomy.ulnar_variance`'s corner rule): adults measure about −4 to
++5 mm (mean +0.26 mm, Yoshioka 2007); beyond that the ulnar head leaves the sigmoid notch or enters the
+lunate."""
 MIN_SENSITIVITY_N = 2
 """Least Morris trajectories or Sobol base size (`sensitivity --n`): Morris's sigma is the spread of a
 material's effects over the trajectories (one gives NaN); the smallest Sobol base is 2 (a power of 2)."""

@@ -17,7 +17,7 @@ section per `--only` key:
   (the rig's lines on the column, on the capitate, on the hamate: `tendons.CARPAL_OF`), each group's
   lines scaled to the same 100 N, and the trapeziocapitate contact and TZC ligament forces against the
   column's input (its lines' tension and the resultant's proximal component).
-- `b` (0b): the ulnar variance (mm, + ulna plus) by `ulnocarpal_space`'s corner rule, on the model's
+- `b` (0b): the ulnar variance (mm, + ulna plus) by the corner rule (`anatomy.ulnar_variance`), on the model's
   rebuilt radius (the radius cap, `anatomy.radius_cap`) and on myo-sim's original radius carried into
   the participant (the template's RCS, the participant's warp).
 - `c` (0c): the shares with the capitate + hamate body shifted ±`SEAT_SHIFT_MM` along the capitate's
@@ -28,9 +28,14 @@ section per `--only` key:
   line on the capitate's centre of mass) and the hand loaded axially as in the Tencer/Viegas jig
   (`cmc_lines`: 100 N along the radius' axis split among the distal carpals by their CMC articular
   areas measured on myo-sim's metacarpals, each part through its facets' centroid).
+- `variance` (issue 54, step 1): the shares at neutral with the ulna seated at each of `VARIANCES_MM`
+  (`BuildParams.ulnar_variance_mm`: the participant rebuilt with its ulna moved along the radius' long
+  axis, each model cached by its own hash) and as built, with the TFCC layer each build made
+  (`pipeline.tfcc_thickness`) and the lunate's bone distance to the ulna; then the ulnar share's slope
+  on each side of 0 mm beside Werner 1986's (`WERNER_1986`).
 
-Run: `python experiments/research/load_paths.py P1 [P2 ...] [--only paths,a,b,c,d] [--load-direction erhart2020]`
-(`--load-direction`: the load of `paths`, `a` and `c`: `settings.LOAD_DIRECTIONS`).
+Run: `python experiments/research/load_paths.py P1 [P2 ...] [--only paths,a,b,c,d,variance] [--load-direction erhart2020]`
+(`--load-direction`: the load of `paths`, `a`, `c` and `variance`: `settings.LOAD_DIRECTIONS`).
 """
 
 from __future__ import annotations
@@ -47,8 +52,11 @@ from wrist_env.anatomy import tendons
 from wrist_env.anatomy.midcarpal import read_seat
 from wrist_env.anatomy.myosim import CHAIN_XML, _body_transform
 from wrist_env.anatomy.template import load_template, oriented_parts
+from wrist_env.anatomy.ulnar_variance import ulnar_variance
+from wrist_env.builder.params import BuildParams
 from wrist_env.builder.warp import Warp
 from wrist_env.design import ALL_LIGAMENT_NAMES
+from wrist_env.errors import BuildError
 from wrist_env.model import BODY_PARTS, BONES, CAPITATE, MIDCARPAL, PAIR_BONES, PAIRS, Model
 from wrist_env.participants import builtin, registry
 from wrist_env.participants.registry import load_model
@@ -97,20 +105,6 @@ def part_gaps(name: str, model, poses) -> list[dict]:
     return rows
 
 
-HEAD_WIDTH_MM = 8.0  # the ulnar head beside the sigmoid notch: up to this far ulnar of the radius' ulnar corner
-
-
-def ulnar_variance(radius_v: np.ndarray, ulna_v: np.ndarray) -> tuple[float, float, float]:
-    """The corner rule (mm, RCS; + ulna plus): the radius' ulnar corner (its most ulnar vertex within 6 mm
-    of the RCS origin along y, i.e. y < 6) minus the most distal point of the ulnar head (ulna vertices up
-    to `HEAD_WIDTH_MM` ulnar of that corner, which leaves out the styloid), along y. Returns (variance,
-    the corner's y, the head's y)."""
-    rim = radius_v[radius_v[:, 1] < 6.0]
-    corner = rim[np.argmin(rim[:, 2])]
-    head = ulna_v[(ulna_v[:, 2] <= corner[2]) & (ulna_v[:, 2] >= corner[2] - HEAD_WIDTH_MM)]
-    return float(corner[1] - head[:, 1].min()), float(corner[1]), float(head[:, 1].min())
-
-
 def _body(model, b):
     lo, hi = model.vertex_offsets[b], model.vertex_offsets[b + 1]
     faces = model.faces[model.face_offsets[b] : model.face_offsets[b + 1]]
@@ -119,7 +113,8 @@ def _body(model, b):
 
 def ulnocarpal_space(model) -> dict:
     """Where a TFCC would sit, at neutral: the closest approach (mm) of the lunate and of the triquetrum
-    to the ulna's surface, and the ulnar variance (mm, + ulna plus) by `ulnar_variance`'s corner rule."""
+    to the ulna's surface, and the ulnar variance (mm, + ulna plus) by the corner rule
+    (`anatomy.ulnar_variance.ulnar_variance`)."""
     radius_v, _, _ = _body(model, BONES.index("radius"))
     ulna_v, ulna_f, _ = _body(model, BONES.index("ulna"))
     lunate_v, _, part = _body(model, BONES.index("lunate"))
@@ -286,7 +281,6 @@ def shifted_model(name: str, shift_mm: float, axis: np.ndarray) -> Model:
     """The participant rebuilt with its capitate body (capitate + hamate) moved `shift_mm` along `axis`
     (the other bones where they were), cached by its inputs' hash as `registry.load_model` caches."""
     from wrist_env.builder.digest import source_hash
-    from wrist_env.builder.params import BuildParams
     from wrist_env.builder.pipeline import build_model
 
     params = BuildParams()
@@ -513,7 +507,92 @@ def print_d(name, model, facets) -> None:
         print(f"| {r['mode']} | {share_cells(r)} | {h[2]:+.3f} / {h[0]:+.3f} / {h[1]:+.3f} |")
 
 
-SECTIONS = ("paths", "a", "b", "c", "d")
+# --- variance (issue 54, step 1): the shares against the ulnar variance -----------------------------
+
+VARIANCES_MM = (-2.5, -1.25, 0.0, 1.25, 2.5)
+WERNER_1986 = {"neutral_pct": 18.4, "shortening_per_mm": 5.6, "lengthening_per_mm": 9.4}
+"""Werner 1986 (cadavers, the disc intact), as the load-path study (§6, step 1) quotes it: the ulnar share
+18.4 % at neutral variance, falling about 5.6 points per mm of ulnar shortening and rising about 9.4 per
+mm of lengthening (4.3 % at −2.5 mm, 41.9 % at +2.5 mm)."""
+
+
+def werner_share(variance_mm: float) -> float:
+    """The ulnar share (%) Werner 1986's slopes give at `variance_mm` (`WERNER_1986`)."""
+    w = WERNER_1986
+    slope = w["shortening_per_mm"] if variance_mm < 0 else w["lengthening_per_mm"]
+    return w["neutral_pct"] + slope * variance_mm
+
+
+def variance_model(name: str, variance_mm: float | None) -> Model:
+    """The participant built with its ulna seated at `variance_mm` (None: as built), cached by its hash."""
+    return load_model(name, BuildParams(ulnar_variance_mm=variance_mm))
+
+
+def variance_sweep(name: str, rig: str) -> list[dict]:
+    """Per variance (as built, then `VARIANCES_MM`): the variance seated, the ulna's shift, the TFCC
+    layer's thickness (mm: min / mean / max), the lunate's bone distance to the ulna (mm), the shares."""
+    rows = []
+    for v in (None, *VARIANCES_MM):
+        row = {"asked": v}
+        try:
+            model = variance_model(name, v)
+        except BuildError as e:
+            rows.append(row | {"error": str(e)})
+            continue
+        seated = model.report.get("ulnar_variance_mm") or {}
+        space = ulnocarpal_space(model)
+        row |= {
+            "seated": space["ulnar_variance_mm"],
+            "shift": seated.get("shift_mm", 0.0),
+            "tfcc": model.report["tfcc_thickness_mm"],
+            "lunate_gap": space["lunate_to_ulna_mm"],
+        }
+        try:
+            result = neutral(model, drivers.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=rig))
+        except RuntimeError as e:
+            rows.append(row | {"error": str(e)})
+            continue
+        rows.append(row | shares(model, result))
+    return rows
+
+
+def print_variance(name, rig) -> None:
+    print(
+        f"\n{name} (variance): the ulna seated at each ulnar variance (`BuildParams.ulnar_variance_mm`, the corner "
+        f"rule on the model's rebuilt radius), population design, neutral, {NEUTRAL_LOAD_N:g} N on the {rig} lines"
+    )
+    print(
+        f"| variance asked (mm) | read (mm) | ulna moved (mm, + proximal) | TFCC layer min / mean / max (mm) "
+        f"| lunate to ulna, bone (mm) | {SHARE_HEAD} | Werner 1986 ulnar (%) |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|"
+    )
+    rows = variance_sweep(name, rig)
+    for r in rows:
+        asked = "as built" if r["asked"] is None else f"{r['asked']:+.2f}"
+        if "error" in r and "seated" not in r:
+            print(f"| {asked} | build refused: {r['error']} |")
+            continue
+        t = r["tfcc"]
+        head = f"| {asked} | {r['seated']:+.2f} | {r['shift']:+.2f} | {t['min']:.2f} / {t['mean']:.2f} / {t['max']:.2f} | {r['lunate_gap']:.2f} |"
+        if "error" in r:
+            print(f"{head} simulation failed: {r['error']} |")
+            continue
+        werner = "" if r["asked"] is None else f"{werner_share(r['asked']):.1f}"
+        print(f"{head} {share_cells(r)} | {werner} |")
+    by = {r["asked"]: r["ulnar"] for r in rows if "ulnar" in r}
+    lo, mid, hi = VARIANCES_MM[0], 0.0, VARIANCES_MM[-1]
+    if {lo, mid, hi} <= set(by):
+        short, long = (by[mid] - by[lo]) / (mid - lo), (by[hi] - by[mid]) / (hi - mid)
+        print(
+            f"ulnar share's slope: {short:+.2f} points/mm from {lo:+g} to 0 mm (Werner 1986: "
+            f"{WERNER_1986['shortening_per_mm']:+.1f}), {long:+.2f} points/mm from 0 to {hi:+g} mm "
+            f"(Werner: {WERNER_1986['lengthening_per_mm']:+.1f}); at 0 mm {by[mid]:.1f} % (Werner: "
+            f"{WERNER_1986['neutral_pct']:.1f} %). The TFCC layer fills whatever space the variance leaves "
+            "(`pipeline.tfcc_thickness`), so the share is expected to move little (the study's §6, step 1)."
+        )
+
+
+SECTIONS = ("paths", "a", "b", "c", "d", "variance")
 
 
 def main(names, load_direction: str = DEFAULT_LOADS, only=SECTIONS) -> None:
@@ -537,6 +616,8 @@ def main(names, load_direction: str = DEFAULT_LOADS, only=SECTIONS) -> None:
             print_c(name, model, load_direction)
         if "d" in only:
             print_d(name, model, facets)
+        if "variance" in only:
+            print_variance(name, load_direction)
 
 
 def _sections(text: str) -> tuple:

@@ -27,3 +27,28 @@ def test_a_fossa_sweep_out_of_range_is_refused(sweep, says):
 def test_the_default_and_the_moulded_sweeps_are_taken():
     assert BuildParams().anatomy[0] == (20.0, 10.0)
     assert check_fossa_sweep([0, 0]) == (0.0, 0.0)
+
+
+@pytest.mark.parametrize("value", [math.nan, math.inf, -5.01, 7.0, "1", True])
+def test_an_ulnar_variance_out_of_range_is_refused(value):
+    with pytest.raises(InputError, match=r"ulnar_variance_mm must be a finite number in \[-5, 5\] \(mm, \+ ulna plus"):
+        BuildParams(ulnar_variance_mm=value)
+
+
+def test_an_ulnar_variance_is_kept_as_a_float():
+    assert BuildParams(ulnar_variance_mm=2).ulnar_variance_mm == 2.0
+    assert isinstance(BuildParams(ulnar_variance_mm=-5).ulnar_variance_mm, float)
+    assert BuildParams().ulnar_variance_mm is None
+
+
+def test_a_variance_left_none_is_left_out_of_the_hash_and_a_value_is_in_it():
+    """The default parameters hash as before the field existed (the shipped models' keys); each variance
+    is a model of its own."""
+    from wrist_env.builder.digest import source_hash
+    from wrist_env.participants import registry
+
+    bones = registry.bones("P1")
+    default = source_hash("P1", bones, BuildParams())
+    seated = {v: source_hash("P1", bones, BuildParams(ulnar_variance_mm=v)) for v in (-2.5, 0.0, 2.5)}
+    assert len({default, *seated.values()}) == 4
+    assert source_hash("P1", bones, BuildParams(ulnar_variance_mm=0)) == seated[0.0]

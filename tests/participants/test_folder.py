@@ -194,6 +194,30 @@ BAD_TOML = [
         r"\[trials.unresisted\] role must be one of.*'train'",
     ),
     ("frames", "frames = 15", "frames = 12", TrialError, "trials/unresisted.csv", "n_frames=12 frames, but has 15"),
+    (
+        "ulnar variance",
+        "age = 41",
+        "age = 41\nulnar_variance_mm = 7.5",
+        ParticipantError,
+        TOML,
+        r"ulnar_variance_mm must be a finite number in \[-5, 5\] \(mm, \+ ulna plus.*but got 7.5",
+    ),
+    (
+        "ulnar variance nan",
+        "age = 41",
+        "age = 41\nulnar_variance_mm = nan",
+        ParticipantError,
+        TOML,
+        r"ulnar_variance_mm must be a finite number.*but got nan",
+    ),
+    (
+        "ulnar variance string",
+        "age = 41",
+        'age = 41\nulnar_variance_mm = "+1"',
+        ParticipantError,
+        TOML,
+        r"ulnar_variance_mm must be a finite number.*but got '\+1'",
+    ),
 ]
 MISSING_FILES = [
     # (file removed, error, file named, message)
@@ -771,3 +795,19 @@ def test_frames_in_participant_toml_are_bounded(folder):
     edit_toml(folder, "frames = 15", "frames = 1000000000000")
     with raises(ParticipantError, folder / TOML, r"frames must be an integer in \[2, 1,000\].*1000000000000"):
         load_participant_folder(folder)
+
+
+def test_a_stated_ulnar_variance_is_the_builds_unless_the_parameters_give_one(folder):
+    """participant.toml's `ulnar_variance_mm` reaches `BuildParams` (`registry.build_params`, which
+    `load_model` builds with); a variance in the parameters wins; it round-trips through a folder."""
+    edit_toml(folder, "age = 41", "age = 41\nulnar_variance_mm = 1")
+    assert load_participant_folder(folder).meta["ulnar_variance_mm"] == 1.0
+    name = registry.add_folder(folder)
+    assert registry.build_params(name).ulnar_variance_mm == 1.0
+    assert registry.build_params(name, BuildParams(distal_row=False)) == BuildParams(
+        distal_row=False, ulnar_variance_mm=1.0
+    )
+    assert registry.build_params(name, BuildParams(ulnar_variance_mm=-2)).ulnar_variance_mm == -2.0
+    copy = write_participant_folder(load_participant_folder(folder), folder.parent / "copy")
+    assert load_participant_folder(copy).meta["ulnar_variance_mm"] == 1.0
+    assert registry.build_params("P1") == BuildParams()

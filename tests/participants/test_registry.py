@@ -146,3 +146,16 @@ def test_the_shipped_model_is_what_a_build_gives(tmp_path, monkeypatch):
             assert close.mean() >= 0.995 and same.mean() >= 0.9, (
                 f"{f.name}: {int((~same).sum())} of {same.size} differ, by up to {np.nanmax(np.abs(a - b)):.3g}"
             )
+
+
+def test_the_builtin_source_hashes_are_those_of_the_shipped_models():
+    """Adding `BuildParams.ulnar_variance_mm` (None: left out of the hash) keeps the default parameters'
+    key: P1–P3 hash to their shipped models' (`builtin.shipped_source_hash`), as on 2026-12-07."""
+    from wrist_env.builder.digest import source_hash
+    from wrist_env.builder.params import BuildParams
+    from wrist_env.participants import builtin
+
+    today = {"P1": "98d2d1a549b1e5ba", "P2": "c166c95b8bf75512", "P3": "8855a8066c52eac0"}
+    for name in builtin.BUILTIN:
+        digest = source_hash(name, registry.bones(name), BuildParams())
+        assert digest == builtin.shipped_source_hash(name) == today[name], name

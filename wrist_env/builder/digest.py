@@ -17,9 +17,12 @@ BUILDER_VERSION = 6  # 6: the TFCC (the ulna's head closed and gridded, the ulno
 
 
 def source_hash(name: str, bones: dict, params: BuildParams) -> str:
-    """Hash of everything a build depends on: bones, parameters, builder and annotation versions."""
+    """Hash of everything a build depends on: bones, parameters, builder and annotation versions. A
+    parameter left None (`BuildParams.ulnar_variance_mm`: the bones as given) is left out, so that adding
+    an optional parameter keeps the keys of the models built without it (the shipped ones among them)."""
     h = hashlib.sha256()
-    h.update(json.dumps({"name": name, "params": asdict(params), "builder": BUILDER_VERSION}, sort_keys=True).encode())
+    hashed = {k: v for k, v in asdict(params).items() if v is not None}
+    h.update(json.dumps({"name": name, "params": hashed, "builder": BUILDER_VERSION}, sort_keys=True).encode())
 
     h.update(json.dumps(read_annotation_data(), sort_keys=True).encode())
     for bone in BONES:

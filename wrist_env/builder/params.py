@@ -7,12 +7,19 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from wrist_env.errors import InputError
-from wrist_env.limits import MAX_FOSSA_SWEEP_DEG, bounded_float, check_float
+from wrist_env.limits import MAX_FOSSA_SWEEP_DEG, MAX_ULNAR_VARIANCE_MM, bounded_float, check_float
 
 if TYPE_CHECKING:
     import argparse
 
 SWEEP_WHY = "deg; 0 0 moulds the fossae to the neutral row"
+VARIANCE_WHY = "mm, + ulna plus; adults measure about -4 to +5"
+
+
+def check_ulnar_variance(variance_mm: object, name: str = "ulnar_variance_mm") -> float:
+    """The ulnar variance (mm) as a float if it is finite and within ±`MAX_ULNAR_VARIANCE_MM`; `InputError`
+    naming the value."""
+    return check_float(name, variance_mm, -MAX_ULNAR_VARIANCE_MM, MAX_ULNAR_VARIANCE_MM, VARIANCE_WHY)
 
 
 def check_fossa_sweep(sweep_deg: Sequence[float]) -> tuple[float, float]:
@@ -55,9 +62,18 @@ class BuildParams:
     fixed_ligaments: bool = True
     """Build the fixed TC and TH with the distal row (False: the lunate body is tied to the
     distal row by contact alone; for studying what they do)."""
+    ulnar_variance_mm: float | None = None
+    """The ulnar variance (mm, + ulna plus) to seat the ulna at: the ulna moved along the radius' long axis
+    until `anatomy.ulnar_variance`'s corner rule gives it, before anything of the build is made from it
+    (`anatomy.ulnar_variance.seat_ulna`). None: where the participant's bones put it (a participant
+    folder may state it: participant.toml's `ulnar_variance_mm`, `registry.build_params`). Within
+    ±`limits.MAX_ULNAR_VARIANCE_MM`; left out of `builder.digest.source_hash` when None, so the default
+    parameters keep their models' keys."""
 
     def __post_init__(self):
         check_fossa_sweep(self.fossa_sweep_deg)  # refused before anything is built or cached from it
+        if self.ulnar_variance_mm is not None:
+            object.__setattr__(self, "ulnar_variance_mm", check_ulnar_variance(self.ulnar_variance_mm))
 
     @property
     def anatomy(self) -> tuple:

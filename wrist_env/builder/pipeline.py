@@ -17,6 +17,7 @@ from tqdm import tqdm
 
 from wrist_env.anatomy.annotations import read_annotation_data, template_annotations
 from wrist_env.anatomy.template import closed, load_template
+from wrist_env.anatomy.ulnar_variance import seat_ulna, ulnar_variance
 from wrist_env.builder import cartilage, contact_law, fibres, mass, morph, sdf
 from wrist_env.builder.contact_samples import _contact_samples, _seat_samples
 from wrist_env.builder.digest import source_hash
@@ -161,6 +162,22 @@ def tfcc_thickness(bones: dict, thickness: dict, coverage: tuple, bandwidth_mm: 
     return out, report | {"rays_hit": int(len(ray_ids)), "vertices": int(ulna.sum())}
 
 
+def _seat_ulna(name: str, bones: dict, variance_mm: float | None) -> tuple[dict, dict | None]:
+    """The bones with the ulna seated at `variance_mm` (`BuildParams.ulnar_variance_mm`; None: where the
+    bones put it), before its morph, TFCC layer, grid and ligament sites are made from it, and the
+    variance as given and seated (None where the corner rule finds no corner or head: a folder's meshes
+    cut otherwise; then a variance asked is a `BuildError`)."""
+    try:
+        if variance_mm is not None:
+            return seat_ulna(bones, variance_mm)
+        v = round(ulnar_variance(bones["radius"].vertices, bones["ulna"].vertices).variance_mm, 4)
+        return bones, {"given": v, "seated": v, "shift_mm": 0.0}
+    except ValueError as e:
+        if variance_mm is None:
+            return bones, None
+        raise BuildError(f"participant {name!r}: ulnar variance {variance_mm:g} mm cannot be seated: {e}") from None
+
+
 def build_model(
     name: str,
     bones: dict,
@@ -196,6 +213,7 @@ def build_model(
 
     bones = {**bones, "ulna": closed(bones["ulna"])}  # an open ulna's head, closed for its grid (the TFCC)
     check_side(name, load_template(*params.anatomy).bones, bones, params.seed)  # before the minute of morphing
+    bones, variance = _seat_ulna(name, bones, params.ulnar_variance_mm)
     morphs, morph_report = _morph_all(bones, params, workers)
     lap("morph")
     coverage, sites, relocated = _transfer(morphs, bones, params)
@@ -260,6 +278,7 @@ def build_model(
         "contact_seating_mm": round(seated, 4),
         **cart_report,
         "tfcc_thickness_mm": tfcc_report,
+        "ulnar_variance_mm": variance,
     }
     return Model(
         name=name,

@@ -26,7 +26,8 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from wrist_env.errors import MeshError, ParticipantError
+from wrist_env.builder.params import check_ulnar_variance
+from wrist_env.errors import InputError, MeshError, ParticipantError
 from wrist_env.io import sha256_file
 from wrist_env.limits import MAX_TRIAL_FRAMES
 from wrist_env.model import SUPPLIED
@@ -35,7 +36,7 @@ from wrist_env.trial import ROLES, Trial, mirror_trial, read_trial_csv, write_tr
 
 PARTICIPANT_FILE = "participant.toml"
 REQUIRED_KEYS = ("name", "side", "units", "bones", "trials")
-OPTIONAL_KEYS = ("sex", "age", "facet_type", "task", "frames", "drop_islands")
+OPTIONAL_KEYS = ("sex", "age", "facet_type", "task", "frames", "drop_islands", "ulnar_variance_mm")
 SIDES = ("right", "left")
 NAME_PATTERN = r"[A-Za-z0-9_]{1,64}"
 TRIAL_NAME_PATTERN = r"[A-Za-z0-9_-]{1,64}"
@@ -46,7 +47,8 @@ TRIAL_NAME_PATTERN = r"[A-Za-z0-9_-]{1,64}"
 class ParticipantSource:
     """A participant as given by the user, mirrored to a right wrist.
 
-    meta: the optional fields of participant.toml (sex, age, facet_type, task, frames, drop_islands) plus
+    meta: the optional fields of participant.toml (sex, age, facet_type, task, frames, drop_islands,
+        ulnar_variance_mm) plus
         side, the side of the files (the arrays here are always a right wrist).
     bones: {bone: (vertices of shape (n, 3) float64 mm, faces of shape (m, 3) int64)}, SUPPLIED order, RCS.
     trials: {name: Trial}. folder: where it was loaded from.
@@ -270,6 +272,11 @@ def _check_meta(config: dict, toml_path: Path) -> dict:
                 f"{toml_path}: drop_islands must be true or false, but got {config['drop_islands']!r}."
             )
         meta["drop_islands"] = config["drop_islands"]
+    if "ulnar_variance_mm" in config:  # the build seats the ulna there (BuildParams.ulnar_variance_mm)
+        try:
+            meta["ulnar_variance_mm"] = check_ulnar_variance(config["ulnar_variance_mm"])
+        except InputError as exc:
+            raise ParticipantError(f"{toml_path}: {exc}.") from None
     return meta
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import warnings
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -98,6 +99,17 @@ def bones(name: str, params: BuildParams | None = None) -> dict:
     return carry_parts(principal, load_template(), params.distal_row)
 
 
+def build_params(name: str, params: BuildParams | None = None) -> BuildParams:
+    """`params` (default `BuildParams()`) with what the participant's folder states: its participant.toml's
+    `ulnar_variance_mm` where `params` leave the variance None (a value in `params` wins)."""
+    params = params or BuildParams()
+    if name in builtin.BUILTIN or params.ulnar_variance_mm is not None:
+        return params
+    require(name)
+    stated = _SOURCES[name].meta.get("ulnar_variance_mm")
+    return params if stated is None else replace(params, ulnar_variance_mm=stated)
+
+
 def trials(name: str) -> dict:
     """The participant's trials {name: Trial}; at least one has role "calibrate"."""
     if name in builtin.BUILTIN:
@@ -119,8 +131,9 @@ def trial(name: str, role: str) -> Trial:
 
 def load_model(name: str, params: BuildParams | None = None, *, cache: bool = True) -> Model:
     """The participant's model, built on first use and cached by the hash of its inputs (a built-in
-    participant's shipped model is used when its hash is that of the inputs: `builtin.SHIPPED_MODEL`)."""
-    params = params or BuildParams()
+    participant's shipped model is used when its hash is that of the inputs: `builtin.SHIPPED_MODEL`).
+    A participant folder's stated ulnar variance applies where `params` leave it None (`build_params`)."""
+    params = build_params(name, params)
     b = bones(name, params)
     digest = source_hash(name, b, params)
     path = cache_dir() / f"{name}-{digest}"
@@ -177,6 +190,7 @@ __all__ = [
     "add_folder",
     "ensure_folder",
     "bones",
+    "build_params",
     "cache_dir",
     "folder",
     "load_model",
