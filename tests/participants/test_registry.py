@@ -159,3 +159,34 @@ def test_the_builtin_source_hashes_are_those_of_the_shipped_models():
     for name in builtin.BUILTIN:
         digest = source_hash(name, registry.bones(name), BuildParams())
         assert digest == builtin.shipped_source_hash(name) == today[name], name
+
+
+def test_processes_that_need_one_uncached_model_at_once_build_it_once(tmp_path, monkeypatch):
+    """A study's workers (or a test session's) asking for the same uncached folder model at once: one
+    builds it under the model's lock, the others wait and load what it cached (each used to build it)."""
+    import threading
+    import time
+    from dataclasses import replace
+
+    import wrist_env.builder.pipeline as pipeline
+    from wrist_env.model import Model
+    from wrist_env.participants import builtin
+
+    monkeypatch.setenv("WRIST_ENV_CACHE", str(tmp_path / "cache"))
+    registry.add_folder(warped_template_folder(tmp_path / "u3", name="U3"))
+    builds = []
+
+    def slow_build(name, bones, params, digest):  # a stand-in build: P1's shipped model under U3's key
+        builds.append(name)
+        time.sleep(0.5)
+        return replace(Model.load(builtin.shipped_model_path("P1")), name=name, source_hash=digest)
+
+    monkeypatch.setattr(pipeline, "build_model", slow_build)
+    got = []
+    threads = [threading.Thread(target=lambda: got.append(registry.load_model("U3"))) for _ in range(3)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert builds == ["U3"] and len(got) == 3 and {m.name for m in got} == {"U3"}
+    assert len({m.source_hash for m in got}) == 1

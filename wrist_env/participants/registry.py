@@ -7,8 +7,11 @@ the annotations and the builder version.
 
 from __future__ import annotations
 
+import fcntl
 import os
 import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -137,37 +140,69 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
     b = bones(name, params)
     digest = source_hash(name, b, params)
     path = cache_dir() / f"{name}-{digest}"
-    if cache and path.with_suffix(".json").exists():
-        try:
-            model = Model.load(path)
-            if model.name != name or model.source_hash != digest:
-                raise StoreError(
-                    f"{path.with_suffix('.json')} holds {model.name!r} {model.source_hash}, not {name!r} {digest}"
-                )
-            return model
-        except StoreError as e:
-            warnings.warn(f"rebuilding a damaged cached model: {e}", stacklevel=2)
+    model = _cached(path, name, digest) if cache else None
+    if model is not None:
+        return model
     if cache and builtin.shipped_source_hash(name) == digest:
         try:
             return Model.load(builtin.shipped_model_path(name))
         except StoreError as e:
             warnings.warn(f"building instead of reading a damaged shipped model: {e}", stacklevel=2)
-    if cache:
-        check_cache(path)  # before a build of minutes, not after
+    if not cache:
+        return _build(name, b, params, digest)
+    check_cache(path)  # before a build of minutes, not after
+    with _build_lock(path):  # another process building this model: wait for it, then load what it saved
+        model = _cached(path, name, digest, quiet=True)
+        if model is None:
+            model = _build(name, b, params, digest)
+            try:
+                model.save(path)
+            except OSError as e:  # the build is not lost: the model is used uncached
+                warnings.warn(f"{path}: the built model could not be cached ({type(e).__name__}: {e})", stacklevel=2)
+    return model
+
+
+def _cached(path: Path, name: str, digest: str, *, quiet: bool = False) -> Model | None:
+    """The model cached at `path` if it is there whole and is `name`'s of source hash `digest`; else None
+    (damage warned about, naming the file, unless `quiet`)."""
+    if not path.with_suffix(".json").exists():
+        return None
+    try:
+        model = Model.load(path)
+        if model.name != name or model.source_hash != digest:
+            raise StoreError(
+                f"{path.with_suffix('.json')} holds {model.name!r} {model.source_hash}, not {name!r} {digest}"
+            )
+        return model
+    except StoreError as e:
+        if not quiet:
+            warnings.warn(f"rebuilding a damaged cached model: {e}", stacklevel=2)
+        return None
+
+
+def _build(name: str, b: dict, params: BuildParams, digest: str) -> Model:
     from wrist_env.builder.pipeline import build_model  # the builder (scikit-learn, libigl) only on a cache miss
 
     try:
-        model = build_model(name, b, params, digest=digest)
+        return build_model(name, b, params, digest=digest)
     except BuildError as e:
         if name in _FOLDERS:  # name the folder's file
             raise BuildError(f"{_FOLDERS[name] / 'participant.toml'}: {e}") from e
         raise
-    if cache:
+
+
+@contextmanager
+def _build_lock(path: Path) -> Iterator[None]:
+    """Hold an flock on `.<model>.lock` beside the cached model while building it: processes that need the
+    same uncached model at once (a study's workers, a test session's) build it once; the others wait and
+    load it. Released when the process dies, even by SIGKILL."""
+    lock = path.parent / f".{path.name}.lock"
+    with open(lock, "a+") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
         try:
-            model.save(path)
-        except OSError as e:  # the build is not lost: the model is used uncached
-            warnings.warn(f"{path}: the built model could not be cached ({type(e).__name__}: {e})", stacklevel=2)
-    return model
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
 
 
 def check_cache(path: Path) -> None:
