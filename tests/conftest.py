@@ -32,8 +32,14 @@ def pytest_configure(config):
 
 @pytest.fixture(scope="session", autouse=True)
 def model_cache(tmp_path_factory):
-    """Every test session builds into its own cache (so the build itself is tested)."""
-    path = tmp_path_factory.mktemp("wrist_env_cache")
+    """Every test session builds into its own cache (so the build itself is tested), one for all its
+    pytest-xdist workers (beside their own temporary folders): a model two workers need is built once, under
+    the registry's build lock, and loaded by the other."""
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        path = tmp_path_factory.getbasetemp().parent / "wrist_env_cache"
+        path.mkdir(exist_ok=True)
+    else:
+        path = tmp_path_factory.mktemp("wrist_env_cache")
     old = os.environ.get("WRIST_ENV_CACHE")
     os.environ["WRIST_ENV_CACHE"] = str(path)
     yield path
