@@ -17,9 +17,10 @@ section per `--only` key:
   (the rig's lines on the column, on the capitate, on the hamate: `tendons.CARPAL_OF`), each group's
   lines scaled to the same 100 N, and the trapeziocapitate contact and TZC ligament forces against the
   column's input (its lines' tension and the resultant's proximal component).
-- `b` (0b): the ulnar variance (mm, + ulna plus) by the corner rule (`anatomy.ulnar_variance`), on the model's
-  rebuilt radius (the radius cap, `anatomy.radius_cap`) and on myo-sim's original radius carried into
-  the participant (the template's RCS, the participant's warp).
+- `b` (0b): the ulnar variance (mm, + ulna plus) by the corner rule (`anatomy.ulnar_variance`) against the
+  model's ulna, on myo-sim's original radius carried into the participant (the template's RCS, the
+  participant's warp: the reading the build seats the ulna by) and on the model's whole radius, its
+  rebuilt fossae (`anatomy.radius_cap`) included (what step 0 read).
 - `c` (0c): the shares with the capitate + hamate body shifted ±`SEAT_SHIFT_MM` along the capitate's
   long axis (`capitate_axis`), two ways: the loaded driver's target moved (a check: its translations
   are free, so only the start moves), and the participant rebuilt with the body's bones moved (the
@@ -28,13 +29,15 @@ section per `--only` key:
   line on the capitate's centre of mass) and the hand loaded axially as in the Tencer/Viegas jig
   (`cmc_lines`: 100 N along the radius' axis split among the distal carpals by their CMC articular
   areas measured on myo-sim's metacarpals, each part through its facets' centroid).
-- `variance` (issue 54, step 1): the shares at neutral with the ulna seated at each of `VARIANCES_MM`
-  (`BuildParams.ulnar_variance_mm`: the participant rebuilt with its ulna moved along the radius' long
-  axis, each model cached by its own hash) and as built, with the TFCC layer each build made
-  (`pipeline.tfcc_thickness`) and the lunate's bone distance to the ulna; then the ulnar share's slope
-  on each side of 0 mm beside Werner 1986's (`WERNER_1986`).
+- `variance` (issue 54, step 1): the shares at neutral after an ulnar osteotomy of each of `OSTEOTOMIES_MM`
+  (`BuildParams.ulnar_osteotomy_mm`: the participant rebuilt with its ulna moved along the radius' long
+  axis after its TFCC layer is made at the participant's seat, as Werner 1986 shortened and lengthened
+  the ulna of cadaver wrists; each model cached by its own hash), with the TFCC layer and the lunate's
+  bone distance to the ulna; then the ulnar share's slope on each side beside Werner 1986's
+  (`WERNER_1986`). `--tfc` rebuilds with other TFCC properties (`TFC_VARIANTS`): the filling layer at
+  cartilage's stiffness, a disc of measured thickness.
 
-Run: `python experiments/research/load_paths.py P1 [P2 ...] [--only paths,a,b,c,d,variance] [--load-direction erhart2020]`
+Run: `python experiments/research/load_paths.py P1 [P2 ...] [--only paths,a,b,c,d,variance] [--load-direction erhart2020] [--tfc default|cartilage|disc]`
 (`--load-direction`: the load of `paths`, `a`, `c` and `variance`: `settings.LOAD_DIRECTIONS`).
 """
 
@@ -42,6 +45,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import math
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -113,14 +117,21 @@ def _body(model, b):
 
 def ulnocarpal_space(model) -> dict:
     """Where a TFCC would sit, at neutral: the closest approach (mm) of the lunate and of the triquetrum
-    to the ulna's surface, and the ulnar variance (mm, + ulna plus) by the corner rule
-    (`anatomy.ulnar_variance.ulnar_variance`)."""
+    to the ulna's surface, and the ulnar variance (mm, + ulna plus) the build seated the ulna at, its
+    osteotomy included (`recorded_variance`)."""
     radius_v, _, _ = _body(model, BONES.index("radius"))
     ulna_v, ulna_f, _ = _body(model, BONES.index("ulna"))
     lunate_v, _, part = _body(model, BONES.index("lunate"))
     _, distance, _ = trimesh.proximity.closest_point(trimesh.Trimesh(ulna_v, ulna_f, process=False), lunate_v)
     out = {f"{p}_to_ulna_mm": float(distance[part == q].min()) for q, p in enumerate(BODY_PARTS["lunate"])}
-    return out | {"ulnar_variance_mm": ulnar_variance(radius_v, ulna_v)[0]}
+    return out | {"ulnar_variance_mm": recorded_variance(model)}
+
+
+def recorded_variance(model) -> float:
+    """The ulnar variance (mm) the build seated the ulna at plus its osteotomy (`Model.report`); NaN where
+    the corner rule found no corner or head."""
+    r = model.report.get("ulnar_variance_mm")
+    return math.nan if r is None else r["seated"] + r.get("osteotomy_mm", 0.0)
 
 
 # --- shared: one neutral run and its shares ---------------------------------------------------------
@@ -244,8 +255,9 @@ def group_rows(model, rig: str) -> list[dict]:
 
 
 def variance_rows(name: str, model) -> list[dict]:
-    """The corner rule (`ulnar_variance`) on the model's rebuilt radius and on myo-sim's original radius
-    (the template's RCS, then the built-in participant's warp), both against the model's ulna."""
+    """The corner rule (`ulnar_variance`) on myo-sim's original radius (the template's RCS, then the
+    built-in participant's warp) and on the model's whole radius (its rebuilt fossae included), both
+    against the model's ulna."""
     ulna_v = _body(model, BONES.index("ulna"))[0]
     rebuilt = ulnar_variance(_body(model, BONES.index("radius"))[0], ulna_v)
     parts, _ = oriented_parts()
@@ -255,7 +267,7 @@ def variance_rows(name: str, model) -> list[dict]:
     mine = ulnar_variance(original, ulna_v)
     return [
         {
-            "radius": "rebuilt (the model's radius cap)",
+            "radius": "the model's, its rebuilt fossae included",
             "variance": rebuilt[0],
             "corner_y": rebuilt[1],
             "head_y": rebuilt[2],
@@ -483,7 +495,7 @@ def print_b(name, model) -> None:
     rows = variance_rows(name, model)
     for r in rows:
         print(f"| {r['radius']} | {r['variance']:+.2f} | {r['corner_y']:+.2f} | {r['head_y']:+.2f} |")
-    print(f"the rebuild's part: {rows[0]['variance'] - rows[1]['variance']:+.2f} mm")
+    print(f"read on the rebuilt fossae, the variance would be {rows[0]['variance'] - rows[1]['variance']:+.2f} mm off")
 
 
 def print_c(name, model, rig) -> None:
@@ -509,44 +521,51 @@ def print_d(name, model, facets) -> None:
 
 # --- variance (issue 54, step 1): the shares against the ulnar variance -----------------------------
 
-VARIANCES_MM = (-2.5, -1.25, 0.0, 1.25, 2.5)
+OSTEOTOMIES_MM = (-2.5, -1.25, 0.0, 1.25, 2.5)
 WERNER_1986 = {"neutral_pct": 18.4, "shortening_per_mm": 5.6, "lengthening_per_mm": 9.4}
 """Werner 1986 (cadavers, the disc intact), as the load-path study (§6, step 1) quotes it: the ulnar share
 18.4 % at neutral variance, falling about 5.6 points per mm of ulnar shortening and rising about 9.4 per
 mm of lengthening (4.3 % at −2.5 mm, 41.9 % at +2.5 mm)."""
+TFC_DISC_MM = 1.4
+"""A TFC disc's measured thickness: the median 1.4 mm of 24 wrists on MRI at a median variance of −0.7 mm
+(J Hand Surg Eur 2022;47:722; the load-path study's 1.4–2 mm)."""
+TFC_VARIANTS = {
+    "default": {},
+    "cartilage": {"tfc_modulus_ratio": 1.0},
+    "disc": {"tfc_disc_mm": TFC_DISC_MM},
+}
+"""TFCC properties `--tfc` may rebuild with (`BuildParams` fields): the default (the layer filling the
+ulnocarpal space at fibrocartilage's stiffness), the layer at cartilage's stiffness, a disc of measured
+thickness (`TFC_DISC_MM`) at fibrocartilage's."""
 
 
-def werner_share(variance_mm: float) -> float:
-    """The ulnar share (%) Werner 1986's slopes give at `variance_mm` (`WERNER_1986`)."""
+def werner_share(osteotomy_mm: float) -> float:
+    """The ulnar share (%) Werner 1986's slopes give `osteotomy_mm` from neutral variance (`WERNER_1986`)."""
     w = WERNER_1986
-    slope = w["shortening_per_mm"] if variance_mm < 0 else w["lengthening_per_mm"]
-    return w["neutral_pct"] + slope * variance_mm
+    slope = w["shortening_per_mm"] if osteotomy_mm < 0 else w["lengthening_per_mm"]
+    return w["neutral_pct"] + slope * osteotomy_mm
 
 
-def variance_model(name: str, variance_mm: float | None) -> Model:
-    """The participant built with its ulna seated at `variance_mm` (None: as built), cached by its hash."""
-    return load_model(name, BuildParams(ulnar_variance_mm=variance_mm))
+def variance_model(name: str, osteotomy_mm: float, tfc: str = "default") -> Model:
+    """The participant built with `TFC_VARIANTS[tfc]` and an ulnar osteotomy of `osteotomy_mm`, cached by
+    its hash."""
+    return load_model(name, BuildParams(ulnar_osteotomy_mm=osteotomy_mm, **TFC_VARIANTS[tfc]))
 
 
-def variance_sweep(name: str, rig: str) -> list[dict]:
-    """Per variance (as built, then `VARIANCES_MM`): the variance seated, the ulna's shift, the TFCC
-    layer's thickness (mm: min / mean / max), the lunate's bone distance to the ulna (mm), the shares."""
+def variance_sweep(name: str, rig: str, tfc: str = "default") -> list[dict]:
+    """Per osteotomy (`OSTEOTOMIES_MM`): the variance then, the TFCC layer's thickness (mm: min / mean /
+    max), the lunate's bone distance to the ulna (mm), the shares."""
     rows = []
-    for v in (None, *VARIANCES_MM):
-        row = {"asked": v}
+    for o in OSTEOTOMIES_MM:
+        row = {"osteotomy": o}
         try:
-            model = variance_model(name, v)
+            model = variance_model(name, o, tfc)
         except BuildError as e:
             rows.append(row | {"error": str(e)})
             continue
-        seated = model.report.get("ulnar_variance_mm") or {}
         space = ulnocarpal_space(model)
-        row |= {
-            "seated": space["ulnar_variance_mm"],
-            "shift": seated.get("shift_mm", 0.0),
-            "tfcc": model.report["tfcc_thickness_mm"],
-            "lunate_gap": space["lunate_to_ulna_mm"],
-        }
+        row |= {"variance": space["ulnar_variance_mm"], "tfcc": model.report["tfcc_thickness_mm"]}
+        row["lunate_gap"] = space["lunate_to_ulna_mm"]
         try:
             result = neutral(model, drivers.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=rig))
         except RuntimeError as e:
@@ -556,46 +575,45 @@ def variance_sweep(name: str, rig: str) -> list[dict]:
     return rows
 
 
-def print_variance(name, rig) -> None:
+def print_variance(name, rig, tfc: str = "default") -> None:
     print(
-        f"\n{name} (variance): the ulna seated at each ulnar variance (`BuildParams.ulnar_variance_mm`, the corner "
-        f"rule on the model's rebuilt radius), population design, neutral, {NEUTRAL_LOAD_N:g} N on the {rig} lines"
+        f"\n{name} (variance, TFCC {tfc}: {TFC_VARIANTS[tfc] or 'as built'}): an ulnar osteotomy from the "
+        f"participant's seat (`BuildParams.ulnar_osteotomy_mm`), population design, neutral, {NEUTRAL_LOAD_N:g} N "
+        f"on the {rig} lines"
     )
     print(
-        f"| variance asked (mm) | read (mm) | ulna moved (mm, + proximal) | TFCC layer min / mean / max (mm) "
+        f"| osteotomy (mm, + lengthening) | variance (mm) | TFCC layer min / mean / max (mm) "
         f"| lunate to ulna, bone (mm) | {SHARE_HEAD} | Werner 1986 ulnar (%) |\n"
-        "|---|---|---|---|---|---|---|---|---|---|---|---|"
+        "|---|---|---|---|---|---|---|---|---|---|---|"
     )
-    rows = variance_sweep(name, rig)
+    rows = variance_sweep(name, rig, tfc)
     for r in rows:
-        asked = "as built" if r["asked"] is None else f"{r['asked']:+.2f}"
-        if "error" in r and "seated" not in r:
+        asked = f"{r['osteotomy']:+.2f}"
+        if "variance" not in r:
             print(f"| {asked} | build refused: {r['error']} |")
             continue
         t = r["tfcc"]
-        head = f"| {asked} | {r['seated']:+.2f} | {r['shift']:+.2f} | {t['min']:.2f} / {t['mean']:.2f} / {t['max']:.2f} | {r['lunate_gap']:.2f} |"
+        head = f"| {asked} | {r['variance']:+.2f} | {t['min']:.2f} / {t['mean']:.2f} / {t['max']:.2f} | {r['lunate_gap']:.2f} |"
         if "error" in r:
             print(f"{head} simulation failed: {r['error']} |")
             continue
-        werner = "" if r["asked"] is None else f"{werner_share(r['asked']):.1f}"
-        print(f"{head} {share_cells(r)} | {werner} |")
-    by = {r["asked"]: r["ulnar"] for r in rows if "ulnar" in r}
-    lo, mid, hi = VARIANCES_MM[0], 0.0, VARIANCES_MM[-1]
+        print(f"{head} {share_cells(r)} | {werner_share(r['osteotomy']):.1f} |")
+    by = {r["osteotomy"]: r["ulnar"] for r in rows if "ulnar" in r}
+    lo, mid, hi = OSTEOTOMIES_MM[0], 0.0, OSTEOTOMIES_MM[-1]
     if {lo, mid, hi} <= set(by):
         short, long = (by[mid] - by[lo]) / (mid - lo), (by[hi] - by[mid]) / (hi - mid)
         print(
-            f"ulnar share's slope: {short:+.2f} points/mm from {lo:+g} to 0 mm (Werner 1986: "
-            f"{WERNER_1986['shortening_per_mm']:+.1f}), {long:+.2f} points/mm from 0 to {hi:+g} mm "
-            f"(Werner: {WERNER_1986['lengthening_per_mm']:+.1f}); at 0 mm {by[mid]:.1f} % (Werner: "
-            f"{WERNER_1986['neutral_pct']:.1f} %). The TFCC layer fills whatever space the variance leaves "
-            "(`pipeline.tfcc_thickness`), so the share is expected to move little (the study's §6, step 1)."
+            f"ulnar share's slope: {short:+.2f} points/mm of shortening to {lo:+g} mm (Werner 1986: "
+            f"{WERNER_1986['shortening_per_mm']:+.1f}), {long:+.2f} points/mm of lengthening to {hi:+g} mm "
+            f"(Werner: {WERNER_1986['lengthening_per_mm']:+.1f}); at the seat {by[mid]:.1f} % (Werner at neutral: "
+            f"{WERNER_1986['neutral_pct']:.1f} %)."
         )
 
 
 SECTIONS = ("paths", "a", "b", "c", "d", "variance")
 
 
-def main(names, load_direction: str = DEFAULT_LOADS, only=SECTIONS) -> None:
+def main(names, load_direction: str = DEFAULT_LOADS, only=SECTIONS, tfc: str = "default") -> None:
     facets = None
     if "d" in only:
         facets = cmc_facets()
@@ -617,7 +635,7 @@ def main(names, load_direction: str = DEFAULT_LOADS, only=SECTIONS) -> None:
         if "d" in only:
             print_d(name, model, facets)
         if "variance" in only:
-            print_variance(name, load_direction)
+            print_variance(name, load_direction, tfc)
 
 
 def _sections(text: str) -> tuple:
@@ -635,5 +653,8 @@ if __name__ == "__main__":
     parser.add_argument(
         "--only", type=_sections, default=SECTIONS, help=f"sections to print, comma-separated: {','.join(SECTIONS)}"
     )
+    parser.add_argument(
+        "--tfc", choices=tuple(TFC_VARIANTS), default="default", help="the TFCC properties of `variance`'s builds"
+    )
     args = parser.parse_args()
-    main(args.participants, args.load_direction, args.only)
+    main(args.participants, args.load_direction, args.only, args.tfc)

@@ -100,3 +100,15 @@ def test_a_template_is_not_swept_through_angles_out_of_range(sweep):
 
     with pytest.raises(InputError, match=r"fossa_sweep_deg \w+ must be a finite number in \[0, 90\]"):
         load_template(sweep, True)
+
+
+def test_the_rebuilt_fossae_end_at_the_radius_ulnar_border():
+    """The rebuilt articular solid reaches the ulnar border of myo-sim's radius (the corner rule's, on the
+    template's distal radius kept beside it) and stops there, within a grid spacing (0.4 mm): the lunate's
+    ulnar part lies over the ulnocarpal space, on the TFCC, not on a fossa the radius lacks (issue 54)."""
+    from wrist_env.anatomy.ulnar_variance import radius_bone, ulnar_corner
+
+    radius = load_template((20.0, 10.0), True).bones["radius"]
+    border = ulnar_corner(radius_bone(radius))[2]
+    cap_z = radius.vertices[radius.solid][:, 2]
+    assert border - 0.4 - 1e-9 <= cap_z.min() <= border + 1.0, (cap_z.min(), border)

@@ -42,8 +42,8 @@ def test_an_ulnar_variance_is_kept_as_a_float():
 
 
 def test_a_variance_left_none_is_left_out_of_the_hash_and_a_value_is_in_it():
-    """The default parameters hash as before the field existed (the shipped models' keys); each variance
-    is a model of its own."""
+    """A variance left None is left out of the hash (adding the field kept the keys of the models built
+    before it); each variance is a model of its own."""
     from wrist_env.builder.digest import source_hash
     from wrist_env.participants import registry
 
@@ -52,3 +52,17 @@ def test_a_variance_left_none_is_left_out_of_the_hash_and_a_value_is_in_it():
     seated = {v: source_hash("P1", bones, BuildParams(ulnar_variance_mm=v)) for v in (-2.5, 0.0, 2.5)}
     assert len({default, *seated.values()}) == 4
     assert source_hash("P1", bones, BuildParams(ulnar_variance_mm=0)) == seated[0.0]
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "message"),
+    [
+        ("tfc_disc_mm", 0.0, r"tfc_disc_mm must be a finite number in \[0.1, 10\]"),
+        ("tfc_disc_mm", float("nan"), "tfc_disc_mm must be a finite number"),
+        ("tfc_modulus_ratio", 0.0, r"tfc_modulus_ratio must be a finite number in \[0.01, 10\]"),
+        ("ulnar_osteotomy_mm", 6.0, r"ulnar_osteotomy_mm must be a finite number in \[-5, 5\]"),
+    ],
+)
+def test_tfcc_and_osteotomy_parameters_out_of_range_are_refused(field, value, message):
+    with pytest.raises(InputError, match=message):
+        BuildParams(**{field: value})

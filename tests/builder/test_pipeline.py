@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from wrist_env.anatomy.annotations import read_annotation_data
+from wrist_env.builder.params import BuildParams
 from wrist_env.builder.pipeline import TFCC
 from wrist_env.builder.sdf import DistanceGrid, trilinear
 from wrist_env.design import ALL_LIGAMENTS
@@ -52,18 +53,82 @@ def test_no_cartilage_overclosure_remains_in_the_neutral_pose(built, name):
 
 @pytest.mark.parametrize("name", PARTICIPANTS)
 def test_the_tfcc_fills_the_ulnocarpal_space(built, name):
-    """The disc is a layer on the ulnar head as thick as the space to the lunate body: at least the
-    ulnar variance of the built-ins (4.9-6.2 mm, the head short of the lunate fossa) and at most the
-    triquetrum's distance (8.8-10.1 mm) plus the dome's slope (the rays' reach, the coverage's 10.5 mm,
-    and the smoothing); the lunate body's contact samples touch it at neutral and none lies inside."""
+    """The TFCC is a layer on the ulnar head as thick as the space to the lunate body's cartilage: at least
+    the lunate's bone distance to the ulna less the lunate's cartilage (at most `max_thickness_mm`), at
+    most the coverage's reach (10.5 mm) plus the smoothing; the lunate body's contact samples touch it at
+    neutral and none lies inside."""
+    import trimesh
+
     model = built(name)
     layer = model.report["tfcc_thickness_mm"]
-    assert 4.5 <= layer["min"] <= layer["mean"] <= layer["max"] <= 12.0, layer
+    i, j = BONES.index("ulna"), BONES.index("lunate")
+    faces = model.faces[model.face_offsets[i] : model.face_offsets[i + 1]]
+    ulna = trimesh.Trimesh(model.vertices[model.vertex_offsets[i] : model.vertex_offsets[i + 1]], faces, process=False)
+    lunate = model.vertices[model.vertex_offsets[j] : model.vertex_offsets[j + 1]]
+    bone_gap = float(trimesh.proximity.closest_point(ulna, lunate)[1].min())
+    assert bone_gap - BuildParams().max_thickness_mm <= layer["min"] <= layer["mean"] <= layer["max"] <= 12.0, layer
     p = PAIRS.index(TFCC)
-    i = BONES.index("ulna")
     grid = DistanceGrid(model.grid_origin[i], float(model.grid_spacing[i]), model.grid("ulna"))
     distance, _ = trilinear(grid, model.sample_points[model.sample_offsets[p] : model.sample_offsets[p + 1]])
     assert -0.05 < distance.min() < 0.05, distance.min()
+
+
+def _slab(y0: float, y1: float):
+    """A 20 × 20 mm slab between y0 and y1 (mm), subdivided to ~1 mm edges."""
+    import trimesh
+
+    box = trimesh.creation.box(extents=(20.0, y1 - y0, 20.0))
+    box.apply_translation((0.0, (y0 + y1) / 2, 0.0))
+    for _ in range(4):
+        box = box.subdivide()
+    return box
+
+
+@pytest.mark.parametrize(("disc_mm", "expected"), [(None, 3.0), (1.4, 1.4), (5.0, 3.0)])
+def test_the_tfcc_layer_fills_the_space_up_to_the_discs_thickness(disc_mm, expected):
+    """An ulnar head 3 mm proximal of a lunate (flat faces, no cartilage): the layer is the 3 mm gap, or the
+    disc's thickness where the disc is thinner (`BuildParams.tfc_disc_mm`)."""
+    from wrist_env.anatomy.template import BoneSurface
+    from wrist_env.builder.pipeline import tfcc_thickness
+
+    head, lunate = _slab(3.0, 20.0), _slab(-10.0, 0.0)
+    bones = {
+        "ulna": BoneSurface("ulna", head.vertices, head.faces, np.ones(len(head.vertices), bool)),
+        "lunate": BoneSurface("lunate", lunate.vertices, lunate.faces, np.ones(len(lunate.vertices), bool)),
+    }
+    facing = np.abs(head.vertices[:, [0, 2]]).max(axis=1) < 6.0
+    cover_head = facing & (head.vertices[:, 1] < 3.0 + 1e-9)
+    cover_lunate = lunate.vertices[:, 1] > -1e-9
+    thickness = {"lunate": np.zeros(len(lunate.vertices))}
+    layer, report = tfcc_thickness(bones, thickness, ("ulna", "lunate", cover_head, cover_lunate), 1.0, disc_mm)
+    assert report["min"] == pytest.approx(expected, abs=1e-6) and report["max"] == pytest.approx(expected, abs=1e-6)
+    assert (layer[~cover_head] == 0).all()
+
+
+def test_an_osteotomy_moves_the_ulna_alone_along_the_radius_axis():
+    """`BuildParams.ulnar_osteotomy_mm` + lengthens: the ulna moves distally (−y); the other bones stay."""
+    from wrist_env.anatomy.template import BoneSurface
+    from wrist_env.builder.pipeline import _osteotomy
+
+    v = np.arange(9.0).reshape(3, 3)
+    bones = {b: BoneSurface(b, v, np.zeros((0, 3), np.int64), np.ones(3, bool)) for b in ("radius", "ulna")}
+    assert _osteotomy(bones, 0.0) is bones
+    moved = _osteotomy(bones, 1.25)
+    np.testing.assert_array_equal(moved["ulna"].vertices, v - [0.0, 1.25, 0.0])
+    assert moved["radius"] is bones["radius"]
+
+
+def test_the_tfcc_counts_at_its_cartilage_equivalent_thickness():
+    """Layers in series: the TFCC, `tfc_modulus_ratio` as stiff as cartilage, strains like a cartilage layer
+    1/ratio as thick (the contact law's total thickness); cartilage counts as it is."""
+    from wrist_env.builder.contact_samples import _compliant
+    from wrist_env.builder.params import TFC_MODULUS_RATIO
+
+    t = np.array([0.5, 2.0])
+    np.testing.assert_allclose(_compliant("ulna", t, BuildParams()), t / TFC_MODULUS_RATIO)
+    assert TFC_MODULUS_RATIO == pytest.approx(0.25 / 0.64)
+    np.testing.assert_array_equal(_compliant("lunate", t, BuildParams()), t)
+    np.testing.assert_array_equal(_compliant("ulna", t, BuildParams(tfc_modulus_ratio=1.0)), t)
 
 
 @pytest.mark.parametrize("name", PARTICIPANTS)

@@ -26,7 +26,7 @@ def test_a_cache_that_is_a_file_is_named_before_the_build(must_build, monkeypatc
 
 def test_a_cached_json_that_is_a_folder_is_named_before_the_build(must_build, monkeypatch, tmp_path):
     monkeypatch.setenv("WRIST_ENV_CACHE", str(tmp_path))
-    digest = registry.source_hash("P1", registry.bones("P1"), registry.BuildParams())
+    digest = registry.source_hash("P1", registry.bones("P1"), registry.build_params("P1"))
     (tmp_path / f"P1-{digest}.json").mkdir()
     with pytest.warns(UserWarning, match="rebuilding"), pytest.raises(StoreError, match=r"\.json: a folder where"):
         registry.load_model("P1")

@@ -149,15 +149,17 @@ def test_the_shipped_model_is_what_a_build_gives(tmp_path, monkeypatch):
 
 
 def test_the_builtin_source_hashes_are_those_of_the_shipped_models():
-    """Adding `BuildParams.ulnar_variance_mm` (None: left out of the hash) keeps the default parameters'
-    key: P1–P3 hash to their shipped models' (`builtin.shipped_source_hash`), as on 2026-12-07."""
+    """P1–P3 hash, with their parameters (`registry.build_params`: the ulna seated at
+    `builtin.ULNAR_VARIANCE_MM`), to their shipped models' (`builtin.shipped_source_hash`), as shipped on
+    2026-12-07 (builder version 7): a change of the build's inputs is a new model, shipped on purpose."""
     from wrist_env.builder.digest import source_hash
-    from wrist_env.builder.params import BuildParams
     from wrist_env.participants import builtin
 
-    today = {"P1": "98d2d1a549b1e5ba", "P2": "c166c95b8bf75512", "P3": "8855a8066c52eac0"}
+    today = {"P1": "PIN_P1", "P2": "PIN_P2", "P3": "PIN_P3"}
     for name in builtin.BUILTIN:
-        digest = source_hash(name, registry.bones(name), BuildParams())
+        params = registry.build_params(name)
+        assert params.ulnar_variance_mm == builtin.ULNAR_VARIANCE_MM == 0.26
+        digest = source_hash(name, registry.bones(name), params)
         assert digest == builtin.shipped_source_hash(name) == today[name], name
 
 

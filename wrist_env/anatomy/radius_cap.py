@@ -209,12 +209,16 @@ def build_radius_cap(
     sample_mm: float = 0.15,
     sweep_deg: tuple[float, float] = (0.0, 0.0),
     swept_sample_mm: float = 0.25,
+    ulnar_border_z: float | None = None,
 ) -> tuple[trimesh.Trimesh, np.ndarray]:
     """The rebuilt distal radius articular solid and its articular (top) vertex mask.
 
     row_meshes: the scaphoid and lunate. sweep_deg: (flexion, deviation) half-ranges of the
     swept envelope, deg; (0, 0) moulds the fossae to the neutral row. sample_mm, swept_sample_mm:
-    surface sampling of the row, mm (coarser when swept: every sample is repeated per pose). Returns (mesh, articular)
+    surface sampling of the row, mm (coarser when swept: every sample is repeated per pose). ulnar_border_z:
+    the radius' ulnar border (z, mm, in the row's frame; None: no border): the fossae end there, as the
+    radius they rebuild does (the envelope of the row reaches past it, over the ulnocarpal space, where the
+    lunate's ulnar part rests on the TFCC, not on the radius). Returns (mesh, articular)
     where articular is a bool array over mesh vertices.
     """
     footprint = fossa_points(row_meshes, radius_mesh)
@@ -232,6 +236,8 @@ def build_radius_cap(
     xs, zs, height = offset_heightfield(
         footprint, np.concatenate(row_points), joint_space_mm=joint_space_mm, spacing_mm=spacing_mm
     )
+    if ulnar_border_z is not None:
+        height[:, zs < ulnar_border_z] = np.nan
     mesh = extrude_heightfield(xs, zs, height, depth_mm=depth_mm)
     articular = mesh.vertices[:, 1] < mesh.vertices[:, 1].max() - 1e-6
     return mesh, articular

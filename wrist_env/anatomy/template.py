@@ -29,6 +29,7 @@ from numpy.typing import ArrayLike
 from wrist_env.anatomy.midcarpal import DISTAL_ROW, read_seat
 from wrist_env.anatomy.myosim import load_myosim_anatomy
 from wrist_env.anatomy.radius_cap import build_radius_cap
+from wrist_env.anatomy.ulnar_variance import ulnar_corner
 from wrist_env.builder.params import check_fossa_sweep
 from wrist_env.model import BODY_PARTS, BONES, CARPALS, CARRIED_WITH, PARTS, SUPPLIED
 
@@ -220,17 +221,21 @@ def load_template(fossa_sweep_deg: tuple = (0.0, 0.0), distal_row: bool = False)
     seat = read_seat()
     m |= {b: _transform(m[b], seat) for b in DISTAL_ROW}
     cap, articular = build_radius_cap([m[b] for b in ROW], m["radius"], joint_space_mm=JOINT_SPACE_MM)
-    top = cap.vertices[articular]  # the origin comes from the moulded surface, whatever the variant
+    top = cap.vertices[articular]  # the origin comes from the moulded envelope, whatever the variant
     origin = top[np.argmin(np.linalg.norm(top[:, [0, 2]] - top[:, [0, 2]].mean(axis=0), axis=1))]
     to_rcs = np.eye(4)
     to_rcs[:3, 3] = -origin
-    if tuple(fossa_sweep_deg) != (0.0, 0.0):
-        cap, _ = build_radius_cap(
-            [m[b] for b in ROW],
-            m["radius"],
-            joint_space_mm=JOINT_SPACE_MM,
-            sweep_deg=tuple(float(a) for a in fossa_sweep_deg),
-        )
+    # The fossae end at myo-sim's radius' ulnar border (issue 54): unbounded, the row's envelope ran on
+    # ulnar over the ulnocarpal space (docs/history.md, issue 54 step 1). The origin stays the unbounded
+    # envelope's: the RCS the annotations are placed in.
+    border_z = ulnar_corner(m["radius"].vertices - origin)[2] + origin[2]
+    cap, _ = build_radius_cap(
+        [m[b] for b in ROW],
+        m["radius"],
+        joint_space_mm=JOINT_SPACE_MM,
+        sweep_deg=tuple(float(a) for a in fossa_sweep_deg),
+        ulnar_border_z=border_z,
+    )
     rcs_from_myosim = to_rcs @ oriented
     m = {b: _transform(mesh, to_rcs) for b, mesh in m.items()}
     cap = _transform(cap, to_rcs)

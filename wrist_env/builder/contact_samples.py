@@ -2,7 +2,7 @@
 
 Per sample: a point (mm) on its pair's sample bone's bone-plus-cartilage surface, ~1 mm apart
 (`BuildParams.contact_spacing_mm`), its unit normal, its area (mm²) and the total cartilage thickness of
-both layers there (mm).
+both layers there (mm; the TFCC's counted at its cartilage-equivalent thickness, `_compliant`).
 """
 
 from __future__ import annotations
@@ -37,6 +37,13 @@ def _thin(points, spacing_mm) -> np.ndarray:
     return order[first], order, np.cumsum(first) - 1
 
 
+def _compliant(bone: str, thickness: np.ndarray, params) -> np.ndarray:
+    """A layer's thickness (mm) as the contact law counts it: the ulna's TFCC layer at its thickness over
+    its stiffness relative to cartilage (`BuildParams.tfc_modulus_ratio`; layers in series: a layer k times
+    softer strains like one k times thicker), cartilage as it is."""
+    return thickness / params.tfc_modulus_ratio if bone == "ulna" else thickness
+
+
 def _contact_samples(bones, thickness, coverage, params):
     """Pair-sorted contact samples on each pair's sample bone (see `Model`)."""
     pts, nrm, area, h, sizes = [], [], [], [], []
@@ -57,7 +64,7 @@ def _contact_samples(bones, thickness, coverage, params):
         chosen = idx[keep]
         partner = np.flatnonzero(cb)
         _, nearest = cKDTree(displaced[b][partner]).query(displaced[a][chosen])
-        total = thickness[a][chosen] + thickness[b][partner[nearest]]
+        total = _compliant(a, thickness[a][chosen], params) + _compliant(b, thickness[b][partner[nearest]], params)
         pts.append(displaced[a][chosen])
         nrm.append(mesh.vertex_normals[chosen])
         area.append(sample_area)

@@ -38,6 +38,12 @@ def check_fossa_sweep(sweep_deg: Sequence[float]) -> tuple[float, float]:
     )
 
 
+TFC_MODULUS_RATIO = 0.25 / 0.64
+"""The TFCC's stiffness relative to articular cartilage: the aggregate moduli of meniscal fibrocartilage
+and of articular cartilage (0.25 and 0.64 MPa, Danso et al. 2018), for no modulus of the TFC disc is
+published (it was indentation-tested, PMC4755783, without a value in the text)."""
+
+
 @dataclass(frozen=True)
 class BuildParams:
     """Build parameters (all lengths mm)."""
@@ -68,12 +74,36 @@ class BuildParams:
     (`anatomy.ulnar_variance.seat_ulna`). None: where the participant's bones put it (a participant
     folder may state it: participant.toml's `ulnar_variance_mm`, `registry.build_params`). Within
     ±`limits.MAX_ULNAR_VARIANCE_MM`; left out of `builder.digest.source_hash` when None, so the default
-    parameters keep their models' keys."""
+    parameters keep their models' keys. A built-in participant is seated at the adult mean
+    (`participants.builtin.ULNAR_VARIANCE_MM`)."""
+    tfc_disc_mm: float | None = None
+    """The TFCC's thickness on the ulnar head (mm): the layer fills the ulnocarpal space up to this and no
+    further (None: it fills it all). See `builder.pipeline.tfcc_thickness`."""
+    tfc_modulus_ratio: float = TFC_MODULUS_RATIO
+    """The TFCC layer's stiffness as a fraction of the radiocarpal cartilage's (the contact law's): it
+    counts in the ulnocarpal pair's total thickness as its thickness / this ratio, two layers in series
+    (`builder.contact_samples`). 1: cartilage; the default, fibrocartilage's (`TFC_MODULUS_RATIO`)."""
+    ulnar_osteotomy_mm: float = 0.0
+    """An ulnar osteotomy (mm, + lengthening, − shortening): the ulna moved along the radius' long axis after
+    its TFCC layer is made at its seat, the disc unchanged, as Werner et al. 1986 changed the variance of
+    cadaver wrists. Within ±`limits.MAX_ULNAR_VARIANCE_MM`."""
 
     def __post_init__(self):
         check_fossa_sweep(self.fossa_sweep_deg)  # refused before anything is built or cached from it
         if self.ulnar_variance_mm is not None:
             object.__setattr__(self, "ulnar_variance_mm", check_ulnar_variance(self.ulnar_variance_mm))
+        object.__setattr__(
+            self, "ulnar_osteotomy_mm", check_ulnar_variance(self.ulnar_osteotomy_mm, "ulnar_osteotomy_mm")
+        )
+        if self.tfc_disc_mm is not None:
+            object.__setattr__(
+                self, "tfc_disc_mm", check_float("tfc_disc_mm", self.tfc_disc_mm, 0.1, 10.0, "mm, the TFCC's thickness")
+            )
+        object.__setattr__(
+            self,
+            "tfc_modulus_ratio",
+            check_float("tfc_modulus_ratio", self.tfc_modulus_ratio, 0.01, 10.0, "the TFCC's stiffness / cartilage's"),
+        )
 
     @property
     def anatomy(self) -> tuple:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import time
+from dataclasses import replace
 
 import numpy as np
 import trimesh
@@ -17,7 +18,7 @@ from tqdm import tqdm
 
 from wrist_env.anatomy.annotations import read_annotation_data, template_annotations
 from wrist_env.anatomy.template import closed, load_template
-from wrist_env.anatomy.ulnar_variance import seat_ulna, ulnar_variance
+from wrist_env.anatomy.ulnar_variance import AXIS, radius_bone, seat_ulna, ulnar_variance
 from wrist_env.builder import cartilage, contact_law, fibres, mass, morph, sdf
 from wrist_env.builder.contact_samples import _contact_samples, _seat_samples
 from wrist_env.builder.digest import source_hash
@@ -137,12 +138,14 @@ def _ligaments(bones: dict, sites: dict, params: BuildParams):
     return bundles, membrane
 
 
-def tfcc_thickness(bones: dict, thickness: dict, coverage: tuple, bandwidth_mm: float) -> tuple[np.ndarray, dict]:
+def tfcc_thickness(
+    bones: dict, thickness: dict, coverage: tuple, bandwidth_mm: float, disc_mm: float | None = None
+) -> tuple[np.ndarray, dict]:
     """The TFCC as a layer on the ulnar head (`TFCC`): per ulna vertex (mm, zero off its coverage) the
     distance along its extrusion direction (`surface.extrusion_directions`) to the lunate body's
     cartilage surface (the closest distance where that ray misses or runs beyond the coverage's
-    max_gap_mm), smoothed over the patch
-    (`surface.grnn_smooth`); and its min/mean/max."""
+    max_gap_mm), smoothed over the patch (`surface.grnn_smooth`), and no thicker than `disc_mm` (None:
+    the space filled); and its min/mean/max."""
     a, _, mask_a, mask_b = coverage
     ulna, carpal = (mask_a, mask_b) if a == "ulna" else (mask_b, mask_a)
     head, lunate = bones["ulna"], bones["lunate"]
@@ -157,9 +160,21 @@ def tfcc_thickness(bones: dict, thickness: dict, coverage: tuple, bandwidth_mm: 
     gap[ray_ids] = np.where((along > 0) & (along <= reach), along, gap[ray_ids])
     out = np.zeros(len(head.vertices))
     out[ulna] = grnn_smooth(origins, gap, bandwidth_mm)
+    if disc_mm is not None:
+        out[ulna] = np.minimum(out[ulna], disc_mm)
     layer = out[ulna]
     report = {k: round(float(f(layer)), 4) for k, f in (("min", np.min), ("mean", np.mean), ("max", np.max))}
     return out, report | {"rays_hit": int(len(ray_ids)), "vertices": int(ulna.sum())}
+
+
+def _osteotomy(bones: dict, lengthening_mm: float) -> dict:
+    """`bones` with the ulna moved `lengthening_mm` distally along the radius' long axis
+    (`BuildParams.ulnar_osteotomy_mm`); its vertex masks, cartilage and TFCC layer move with it."""
+    if lengthening_mm == 0.0:
+        return bones
+    v = np.asarray(bones["ulna"].vertices, float) - lengthening_mm * AXIS
+    v.setflags(write=False)
+    return {**bones, "ulna": replace(bones["ulna"], vertices=v)}
 
 
 def _seat_ulna(name: str, bones: dict, variance_mm: float | None) -> tuple[dict, dict | None]:
@@ -170,7 +185,7 @@ def _seat_ulna(name: str, bones: dict, variance_mm: float | None) -> tuple[dict,
     try:
         if variance_mm is not None:
             return seat_ulna(bones, variance_mm)
-        v = round(ulnar_variance(bones["radius"].vertices, bones["ulna"].vertices).variance_mm, 4)
+        v = round(ulnar_variance(radius_bone(bones["radius"]), bones["ulna"].vertices).variance_mm, 4)
         return bones, {"given": v, "seated": v, "shift_mm": 0.0}
     except ValueError as e:
         if variance_mm is None:
@@ -224,7 +239,10 @@ def build_model(
         verts, faces, articulations, bandwidth_mm=params.grnn_bandwidth_mm, max_thickness_mm=params.max_thickness_mm
     )
     thickness = {b: thickness.get(b, np.zeros(len(verts[b]))) for b in BONES}
-    thickness["ulna"], tfcc_report = tfcc_thickness(bones, thickness, coverage[TFCC], params.grnn_bandwidth_mm)
+    thickness["ulna"], tfcc_report = tfcc_thickness(
+        bones, thickness, coverage[TFCC], params.grnn_bandwidth_mm, params.tfc_disc_mm
+    )
+    bones = _osteotomy(bones, params.ulnar_osteotomy_mm)  # the ulna moved with its layer, after it is made
     summary = _articulation_summary(cart_report["cartilage"]["articulations"])
     _check_joint_spaces(name, summary["joint_space_mm"])
     lap("cartilage")
@@ -278,7 +296,7 @@ def build_model(
         "contact_seating_mm": round(seated, 4),
         **cart_report,
         "tfcc_thickness_mm": tfcc_report,
-        "ulnar_variance_mm": variance,
+        "ulnar_variance_mm": variance if variance is None else variance | {"osteotomy_mm": params.ulnar_osteotomy_mm},
     }
     return Model(
         name=name,

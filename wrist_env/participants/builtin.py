@@ -48,6 +48,13 @@ class BuiltinInfo:
     truth_seed: int
 
 
+ULNAR_VARIANCE_MM = 0.26
+"""The built-in participants' ulnar variance (mm, + ulna plus): the adult mean, Yoshioka et al. 2007
+(range −4.6 to +3.7 mm). Their bones are the template's under a warp, and myo-sim's wrist is ulna minus
+(about −3 mm by `anatomy.ulnar_variance`'s corner rule): the build seats the ulna at this
+(`registry.build_params`, `BuildParams.ulnar_variance_mm`)."""
+
+
 def _data(name: str, file: str) -> dict:
     if name not in BUILTIN:
         raise ParticipantError(f"unknown built-in participant {name!r}; the built-in ones are {list(BUILTIN)}")

@@ -103,11 +103,14 @@ def bones(name: str, params: BuildParams | None = None) -> dict:
 
 
 def build_params(name: str, params: BuildParams | None = None) -> BuildParams:
-    """`params` (default `BuildParams()`) with what the participant's folder states: its participant.toml's
-    `ulnar_variance_mm` where `params` leave the variance None (a value in `params` wins)."""
+    """`params` (default `BuildParams()`) with the participant's ulnar variance where `params` leave it None
+    (a value in `params` wins): a built-in's `builtin.ULNAR_VARIANCE_MM`, a folder's participant.toml's
+    `ulnar_variance_mm` if it states one."""
     params = params or BuildParams()
-    if name in builtin.BUILTIN or params.ulnar_variance_mm is not None:
+    if params.ulnar_variance_mm is not None:
         return params
+    if name in builtin.BUILTIN:
+        return replace(params, ulnar_variance_mm=builtin.ULNAR_VARIANCE_MM)
     require(name)
     stated = _SOURCES[name].meta.get("ulnar_variance_mm")
     return params if stated is None else replace(params, ulnar_variance_mm=stated)
