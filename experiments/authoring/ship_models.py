@@ -1,7 +1,7 @@
 """Build the built-in participants' models from scratch and ship them with the package.
 
 Writes `wrist_env/participants/data/<P>/model.npz` + `model.json` for P1–P3 (default build
-parameters), so that a fresh install skips the ~40 s build per participant:
+parameters, `registry.build_params`), so that a fresh install skips the ~40 s build per participant:
 `registry.load_model` reads a shipped model when its source hash is the one it would build
 (`builtin.SHIPPED_MODEL`), and builds otherwise. A slow test rebuilds P1 and compares. Run after
 any change to the builder, the template or the built-ins' data (`experiments/regenerate.py` does).
@@ -20,9 +20,8 @@ import time
 from pathlib import Path
 
 from wrist_env.builder.digest import source_hash
-from wrist_env.builder.params import BuildParams
 from wrist_env.participants import builtin
-from wrist_env.participants.registry import bones, load_model
+from wrist_env.participants.registry import bones, build_params, load_model
 
 DATA = Path(__file__).resolve().parents[2] / "wrist_env" / "participants" / "data"
 
@@ -33,7 +32,7 @@ def main() -> None:
     force = p.parse_args().force
     for name in builtin.BUILTIN:
         start = time.perf_counter()
-        wanted = source_hash(name, bones(name), BuildParams())
+        wanted = source_hash(name, bones(name), build_params(name))
         if not force and builtin.shipped_source_hash(name) == wanted:
             print(f"{name}: {wanted}, unchanged (kept; --force rebuilds it)", flush=True)
             continue

@@ -54,7 +54,7 @@ import trimesh
 from wrist_env import design
 from wrist_env.anatomy import tendons
 from wrist_env.anatomy.midcarpal import read_seat
-from wrist_env.anatomy.myosim import CHAIN_XML, _body_transform
+from wrist_env.anatomy.myosim import CHAIN_XML, radius_frame_transforms
 from wrist_env.anatomy.template import load_template, oriented_parts
 from wrist_env.anatomy.ulnar_variance import ulnar_variance
 from wrist_env.builder.params import BuildParams
@@ -358,23 +358,12 @@ def metacarpal_meshes() -> dict:
     import importlib.resources
 
     pkg = importlib.resources.files("myo_sim")
-    root = ET.parse(str(pkg / CHAIN_XML)).getroot()
-    bodies = {b.get("name"): b for b in root.iter("body")}
-    parent = {c.get("name"): b.get("name") for b in root.iter("body") for c in b.findall("body")}
-
-    def to_world(name):
-        T = np.eye(4)
-        while name in bodies:
-            T = _body_transform(bodies[name]) @ T
-            name = parent.get(name)
-        return T
-
-    radius_inv = np.linalg.inv(to_world("radius_r"))
+    in_radius = radius_frame_transforms(ET.parse(str(pkg / CHAIN_XML)).getroot())
     template, seat = load_template(), read_seat()
     out = {}
     for stl, body in CHAIN_MC.items():
         mesh = trimesh.load(str(pkg / "models" / "meshes" / stl), force="mesh", process=True)
-        v = (radius_inv @ to_world(body) @ np.c_[mesh.vertices, np.ones(len(mesh.vertices))].T).T[:, :3]
+        v = (in_radius[body] @ np.c_[mesh.vertices, np.ones(len(mesh.vertices))].T).T[:, :3]
         v = np.array([tendons._to_rcs(body, p, template.rcs_from_myosim, seat) for p in v])
         out[body] = trimesh.Trimesh(v, mesh.faces, process=False)
     return out

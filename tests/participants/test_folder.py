@@ -799,7 +799,8 @@ def test_frames_in_participant_toml_are_bounded(folder):
 
 def test_a_stated_ulnar_variance_is_the_builds_unless_the_parameters_give_one(folder):
     """participant.toml's `ulnar_variance_mm` reaches `BuildParams` (`registry.build_params`, which
-    `load_model` builds with); a variance in the parameters wins; it round-trips through a folder."""
+    `load_model` builds with); a variance in the parameters wins; it round-trips through a folder. A
+    built-in is seated at `builtin.ULNAR_VARIANCE_MM`."""
     edit_toml(folder, "age = 41", "age = 41\nulnar_variance_mm = 1")
     assert load_participant_folder(folder).meta["ulnar_variance_mm"] == 1.0
     name = registry.add_folder(folder)
@@ -810,4 +811,4 @@ def test_a_stated_ulnar_variance_is_the_builds_unless_the_parameters_give_one(fo
     assert registry.build_params(name, BuildParams(ulnar_variance_mm=-2)).ulnar_variance_mm == -2.0
     copy = write_participant_folder(load_participant_folder(folder), folder.parent / "copy")
     assert load_participant_folder(copy).meta["ulnar_variance_mm"] == 1.0
-    assert registry.build_params("P1") == BuildParams()
+    assert registry.build_params("P1") == BuildParams(ulnar_variance_mm=0.26)  # the built-ins' seat (Yoshioka 2007)

@@ -59,16 +59,11 @@ def _body_transform(body: ET.Element) -> np.ndarray:
     return T
 
 
-def _chain_transforms(root: ET.Element) -> tuple[dict, dict]:
-    """World-free transforms of each needed body in the radius body frame, and body elements."""
+def radius_frame_transforms(root: ET.Element) -> dict:
+    """Every body of a myo-sim chain (`root`: its parsed XML) in the radius body's frame: body name ->
+    4×4 (m), the body's frame composed up its parents to the world, then into `radius_r`'s."""
     bodies = {b.get("name"): b for b in root.iter("body")}
-    parent = {}
-    for b in root.iter("body"):
-        for child in b.findall("body"):
-            parent[child.get("name")] = b.get("name")
-    missing = [n for n in PARTS if f"{n}_r" not in bodies]
-    if missing:
-        raise BuildError(f"myo-sim chain {CHAIN_XML} lacks bodies {missing}")
+    parent = {c.get("name"): b.get("name") for b in root.iter("body") for c in b.findall("body")}
 
     def to_world(name: str) -> np.ndarray:
         T = np.eye(4)
@@ -78,7 +73,17 @@ def _chain_transforms(root: ET.Element) -> tuple[dict, dict]:
         return T
 
     radius_inv = np.linalg.inv(to_world("radius_r"))
-    return {n: radius_inv @ to_world(f"{n}_r") for n in PARTS}, bodies
+    return {name: radius_inv @ to_world(name) for name in bodies}
+
+
+def _chain_transforms(root: ET.Element) -> tuple[dict, dict]:
+    """World-free transforms of each needed body in the radius body frame, and body elements."""
+    bodies = {b.get("name"): b for b in root.iter("body")}
+    missing = [n for n in PARTS if f"{n}_r" not in bodies]
+    if missing:
+        raise BuildError(f"myo-sim chain {CHAIN_XML} lacks bodies {missing}")
+    in_radius = radius_frame_transforms(root)
+    return {n: in_radius[f"{n}_r"] for n in PARTS}, bodies
 
 
 def _sites(bodies: dict, body_T: dict, prefixes: tuple[str, ...]) -> np.ndarray:

@@ -38,7 +38,7 @@ import numpy as np
 import trimesh
 
 from wrist_env.anatomy.midcarpal import read_seat
-from wrist_env.anatomy.myosim import CHAIN_XML, _body_transform
+from wrist_env.anatomy.myosim import CHAIN_XML, radius_frame_transforms
 from wrist_env.anatomy.template import load_template
 from wrist_env.errors import BuildError
 from wrist_env.model import BODY_PARTS, BONES
@@ -124,22 +124,10 @@ def _parse(path) -> ET.Element:
 
 def _sites_in_radius_frame(root: ET.Element) -> dict:
     """site name -> (body name, position (3,) m in the myo-sim radius body frame)."""
-    bodies = {b.get("name"): b for b in root.iter("body")}
-    parent = {c.get("name"): b.get("name") for b in root.iter("body") for c in b.findall("body")}
-
-    def to_world(name):  # body frame -> world, composed root-first
-        chain = [name]
-        while chain[-1] in parent:
-            chain.append(parent[chain[-1]])
-        T = np.eye(4)
-        for n in reversed(chain):
-            T = T @ _body_transform(bodies[n])
-        return T
-
-    radius_inv = np.linalg.inv(to_world("radius_r"))
+    in_radius = radius_frame_transforms(root)
     sites = {}
-    for name, body in bodies.items():
-        T = radius_inv @ to_world(name)
+    for name, body in ((b.get("name"), b) for b in root.iter("body")):
+        T = in_radius[name]
         for s in body.findall("site"):
             pos = np.array([float(v) for v in (s.get("pos") or "0 0 0").split()])
             sites[s.get("name")] = (name, (T @ np.append(pos, 1.0))[:3])

@@ -217,6 +217,7 @@ def calibrate(
     storage: str | BaseStorage | None = None,
     options: dict | None = None,
     callback: Callable[[int, int], object] | None = None,
+    made_from: dict | None = None,
 ) -> CalibrationRun:
     """Calibrate the 22 materials of `participant` with the calibrator `optimizer_name`.
 
@@ -226,6 +227,8 @@ def calibrate(
         that take one; ignored by the others. Its study is rebuilt from the log on every start.
     options: extra options for the calibrator (`optimizers.make(..., **options)`).
     callback(n_new, nfev): called after every batch with the number of new evaluations.
+    made_from: the participant's `provenance.of_participant`, if the caller has it (else read here when
+        there is a log).
     """
 
     start_time = time.perf_counter()
@@ -244,8 +247,8 @@ def calibrate(
             pass
         options.update(storage=storage_obj, study_name=key.name)
     calibration = task(participant, "calibrate")
-    made_from = provenance.of_participant(participant) if run_log is not None else None
     if run_log is not None:
+        made_from = made_from or provenance.of_participant(participant)
         run_log.move_aside_stale(key, made_from)  # another model's evaluations are not replayed
 
     logged = run_log.read_cell(key) if run_log is not None else None

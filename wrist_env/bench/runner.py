@@ -115,7 +115,8 @@ def run_cell(
         registry.ensure_folder(folder)
     log = RunLog(out_dir)
     with log.lock(key):
-        log.move_aside_stale(key, provenance.of_participant(key.participant))
+        made_from = provenance.of_participant(key.participant)
+        log.move_aside_stale(key, made_from)
         summary = log.summary(key)
         if summary is not None:
             return {"status": "skipped", "summary": summary}
@@ -128,6 +129,7 @@ def run_cell(
             storage=cell_storage(storage, key),
             options=(options or {}).get(key.optimizer, (options or {}).get(split_prior(key.optimizer)[0])),
             callback=callback,
+            made_from=made_from,
         )
         return {"status": "ran", "summary": run.to_dict()}
 

@@ -36,6 +36,13 @@ def _failure(label, result) -> str | None:
     return None if result.ok else f"{label} run {result.message}"
 
 
+def _variance_said(model: Model) -> str:
+    """ ", ulnar variance +0.26 mm" as the build seated the ulna (its osteotomy included), or "" where the
+    corner rule found none: the ulnar share depends on it (Werner 1986)."""
+    r = model.report.get("ulnar_variance_mm")
+    return "" if not r else f", ulnar variance {r['seated'] + r.get('osteotomy_mm', 0.0):+.2f} mm"
+
+
 def validate(
     name: str,
     *,
@@ -133,7 +140,8 @@ def validate(
         ),
         _row(
             "ulnar_share_pct",
-            f"ulnocarpal share of the radiocarpal + ulnocarpal contact force, neutral, {NEUTRAL_LOAD_N:g} N",
+            f"ulnocarpal share of the radiocarpal + ulnocarpal contact force, neutral, {NEUTRAL_LOAD_N:g} N"
+            f"{_variance_said(model)}",
             shares["ulnocarpal"],
             ULNAR_SHARE_PCT,
             "%",
