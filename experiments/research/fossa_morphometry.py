@@ -17,7 +17,8 @@ radiologist or an anatomist would on a radius:
   z–y plane, a slab in x); and a least-squares sphere through the whole fossa (with its RMS
   residual). The capitate head's circles in the same planes (its proximal-facing vertices within
   `CAPITATE_HEAD_MM` of its most proximal one) give the capitate/lunate-fossa ratios Hawkins-Rivers
-  et al. measured on MRI.
+  et al. measured on MRI; the lunate's own proximal surface's circles (`LUNATE_SURFACE_MM`) show
+  what the lunate fossa's curvature comes from.
 - **the interfossal ridge**: in 1 mm sagittal bands (slabs in x) every `RIDGE_STEP_MM` across both
   fossae, the articular surface's profile y(z) (median y in `BIN_MM` bins of z); each fossa's floor
   is the profile's deepest (most proximal) point over that fossa's z-range in the band, the ridge the
@@ -35,7 +36,8 @@ radiologist or an anatomist would on a radius:
   (its rims are the lateral view's); and the same on myo-sim's radius' distal end (its vertices
   less than `ulnar_variance.RIM_Y_MM` proximal of the origin, a slab of ±`MYOSIM_SLAB_MM`).
 - **dimensions** (mm): the extents of the articular surface and of each fossa along x (dorsopalmar)
-  and z (radioulnar); and the styloid tip to ulnar corner distance along z.
+  and z (radioulnar); and the styloid tip to ulnar corner distance along z. And the scaphoid–lunate
+  bone gap along x (`row_gaps`), which shapes the ridge.
 
 Run: `python experiments/research/fossa_morphometry.py [P1 P2 P3] [--template]` (a few seconds each;
 reads the bones, builds no model). Prints Markdown tables; published values are in `PUBLISHED` and
@@ -65,6 +67,10 @@ MYOSIM_SLAB_MM = 1.5
 """Half the thickness of a section of myo-sim's radius (mm): its distal end is subdivided to 1.5 mm edges."""
 CAPITATE_HEAD_MM = 5.0
 """The capitate's head: its proximal-facing vertices within this of its most proximal one (mm, along y)."""
+LUNATE_SURFACE_MM = 4.0
+"""The lunate's radial articular surface: its proximal-facing vertices within this of its most proximal one (mm)."""
+SL_GAP_X_MM = (-8.0, -4.0, 0.0, 4.0, 8.0)
+"""Where along x (mm, + volar) the scaphoid–lunate bone gap is read (`row_gaps`)."""
 
 PUBLISHED = {
     "scaphoid/lunate area": "0.89 (47 % / 53 %; J Hand Surg Am 1996;21:567, 50 dry radii)",
@@ -236,18 +242,31 @@ def fossa_masks(bones: dict) -> tuple[np.ndarray, np.ndarray]:
     return s, lu
 
 
-def capitate_head_radii(bones: dict) -> dict:
-    """The capitate head's radii of curvature (mm) in the sagittal and coronal sections through its
-    centroid: its vertices facing proximal (normal·y > `FACING`) within `CAPITATE_HEAD_MM` of its most
-    proximal one."""
+def proximal_radii(bones: dict, bone: str, depth_mm: float) -> dict:
+    """A bone's proximal articular surface's radii of curvature (mm) in the sagittal and coronal sections
+    through its centroid: the principal bone's vertices facing proximal (normal·y > `FACING`) within
+    `depth_mm` of its most proximal one (the capitate's head; the lunate's radial surface)."""
     from wrist_env.model import BODY_PARTS
 
-    cap = bones["capitate"]
-    keep = cap.part == BODY_PARTS["capitate"].index("capitate")
-    v, f = cap.vertices, cap.faces[keep[cap.faces].all(axis=1)]
+    body = bones[bone]
+    keep = body.part == BODY_PARTS[bone].index(bone)
+    v, f = body.vertices, body.faces[keep[body.faces].all(axis=1)]
     n = vertex_normals(v, f)
-    head = keep & (n[:, 1] > FACING) & (v[:, 1] >= v[keep, 1].max() - CAPITATE_HEAD_MM)
+    head = keep & (n[:, 1] > FACING) & (v[:, 1] >= v[keep, 1].max() - depth_mm)
     return section_radii(v[head], v[head].mean(axis=0))
+
+
+def row_gaps(bones: dict, xs=SL_GAP_X_MM) -> list[float]:
+    """The scaphoid–lunate bone gap (mm) in 2 mm bands of x around each of `xs`: the least distance from
+    a scaphoid vertex in the band to the lunate's vertices (NaN where the band holds none)."""
+    from scipy.spatial import cKDTree
+
+    s, lu = bones["scaphoid"], bones["lunate"]
+    sv, lv = s.vertices[s.part == 0], lu.vertices[lu.part == 0]
+    d = cKDTree(lv).query(sv)[0]
+    return [
+        float(d[np.abs(sv[:, 0] - x) < 1.0].min()) if (np.abs(sv[:, 0] - x) < 1.0).any() else float("nan") for x in xs
+    ]
 
 
 def measure(bones: dict) -> dict:
@@ -277,7 +296,10 @@ def measure(bones: dict) -> dict:
         out[f"centroid_{name}"] = centroid
         out[f"dp_{name}"] = float(np.ptp(p[:, 0]))
         out[f"ru_{name}"] = float(np.ptp(p[:, 2]))
-    head = capitate_head_radii(bones)
+    head = proximal_radii(bones, "capitate", CAPITATE_HEAD_MM)
+    lunate = proximal_radii(bones, "lunate", LUNATE_SURFACE_MM)
+    out["R_lunate_bone_sagittal"], out["R_lunate_bone_coronal"] = lunate["sagittal"], lunate["coronal"]
+    out["sl_gaps"] = tuple(row_gaps(bones))
     out["capitate_lunate_coronal"] = head["coronal"] / out["R_lunate_coronal"]
     out["capitate_lunate_sagittal"] = head["sagittal"] / out["R_lunate_sagittal"]
     out["R_capitate_coronal"], out["R_capitate_sagittal"] = head["coronal"], head["sagittal"]
@@ -316,6 +338,12 @@ ROWS = (
     ("lunate fossa R sagittal (mm)", "R_lunate_sagittal", "{:.1f}", None),
     ("lunate fossa R coronal (mm)", "R_lunate_coronal", "{:.1f}", None),
     ("lunate fossa R sphere (rms) (mm)", ("R_lunate_sphere", "rms_lunate_sphere"), "{:.1f} ({:.2f})", None),
+    (
+        "lunate's proximal surface R sagittal / coronal (mm)",
+        ("R_lunate_bone_sagittal", "R_lunate_bone_coronal"),
+        "{:.1f} / {:.1f}",
+        None,
+    ),
     ("capitate head R sagittal / coronal (mm)", ("R_capitate_sagittal", "R_capitate_coronal"), "{:.1f} / {:.1f}", None),
     ("capitate/lunate fossa R, coronal", "capitate_lunate_coronal", "{:.2f}", "capitate/lunate fossa R, coronal"),
     ("capitate/lunate fossa R, sagittal", "capitate_lunate_sagittal", "{:.2f}", "capitate/lunate fossa R, sagittal"),
@@ -339,12 +367,19 @@ ROWS = (
         "lunate fossa dorsopalmar",
     ),
     ("styloid tip to ulnar corner, along z (mm)", "ru_styloid_corner", "{:.1f}", None),
+    (
+        "scaphoid–lunate bone gap at x = " + ", ".join(f"{x:+.0f}" for x in SL_GAP_X_MM) + " (mm)",
+        "sl_gaps",
+        " / ".join(["{:.1f}"] * len(SL_GAP_X_MM)),
+        None,
+    ),
 )
 
 
 def cell(result: dict, key, fmt: str) -> str:
     keys = key if isinstance(key, tuple) else (key,)
-    return fmt.format(*(result[k] for k in keys))
+    values = [v for k in keys for v in (result[k] if isinstance(result[k], tuple) else (result[k],))]
+    return fmt.format(*values)
 
 
 def table(results: dict) -> str:
