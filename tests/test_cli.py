@@ -242,23 +242,41 @@ def test_no_command_writes_into_the_committed_results_by_default():
 
 @pytest.mark.slow
 def test_export_build_evaluate_and_make_an_env_from_a_clean_folder(tmp_path, capsys):
+    """`export` writes a folder the folder loader reads back (P1's five bones and trials); `build`,
+    `evaluate` and `register_participant` run on a clean folder. The folder built is tests/envs'
+    "U1" (warped template bones, P1's unresisted trial), whose model the session builds once into its
+    cache (the cache key is its bones and name), not a second folder model (a minute of CI)."""
+    import importlib.util
+    from pathlib import Path
+
     import gymnasium as gym
 
     import wrist_env
+    from wrist_env.participants import registry
+    from wrist_env.participants.folder import load_participant_folder
 
     folder = tmp_path / "my_wrist"
     assert main(["export", "P1", str(folder)]) == 0
     assert (folder / "participant.toml").is_file() and len(list((folder / "bones").glob("*.stl"))) == 5
     assert main(["export", "P1", str(folder)]) == 2  # not over a folder already written
     assert "not empty" in capsys.readouterr().err
-    assert main(["build", "my_wrist", "--folder", str(folder)]) == 0
-    assert "my_wrist: built in" in capsys.readouterr().out
-    assert main(["evaluate", "my_wrist", "--folder", str(folder), "--json"]) == 0
+    exported = load_participant_folder(folder)
+    assert exported.name == "my_wrist" and set(exported.trials) == set(registry.trials("P1"))
+
+    spec = importlib.util.spec_from_file_location(
+        "_register_tests", Path(__file__).parent / "envs" / "test_register.py"
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    u1 = module.make_folder(tmp_path / "u1", "U1", validate=False)
+    assert main(["build", "U1", "--folder", str(u1)]) == 0
+    assert "U1: built in" in capsys.readouterr().out
+    assert main(["evaluate", "U1", "--folder", str(u1), "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["failed"] is False and 0 < out["cost"] < 100
-    ids = wrist_env.register_participant(folder)
-    assert "wrist_env/Calibrate-my_wrist-v0" in ids
-    env = gym.make("wrist_env/Calibrate-my_wrist-v0")
+    ids = wrist_env.register_participant(u1)
+    assert "wrist_env/Calibrate-U1-v0" in ids
+    env = gym.make("wrist_env/Calibrate-U1-v0")
     env.reset(seed=0)
     from wrist_env import design
 
