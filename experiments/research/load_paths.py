@@ -27,8 +27,9 @@ section per `--only` key:
   cartilage, contact grids and ligament lengths follow the new gaps; cached like any build).
 - `d` (0d): the shares under three load modes: the tendon rig (the default), the `axial` direction (one
   line on the capitate's centre of mass) and the hand loaded axially as in the Tencer/Viegas jig
-  (`cmc_lines`: 100 N along the radius' axis split among the distal carpals by their CMC articular
-  areas measured on myo-sim's metacarpals, each part through its facets' centroid).
+  (`anatomy.jig`, the load validate's neutral checks take: 100 N along the radius' axis split among the
+  distal carpals by their CMC articular areas measured on myo-sim's metacarpals, each part through its
+  facets' centroid).
 - `variance` (issue 54, step 1): the shares at neutral after an ulnar osteotomy of each of `OSTEOTOMIES_MM`
   (`BuildParams.ulnar_osteotomy_mm`: the participant rebuilt with its ulna moved along the radius' long
   axis after its TFCC layer is made at the participant's seat, as Werner 1986 shortened and lengthened
@@ -46,15 +47,12 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import math
-import xml.etree.ElementTree as ET
 
 import numpy as np
 import trimesh
 
 from wrist_env import design
-from wrist_env.anatomy import tendons
-from wrist_env.anatomy.midcarpal import read_seat
-from wrist_env.anatomy.myosim import CHAIN_XML, radius_frame_transforms
+from wrist_env.anatomy import jig, tendons
 from wrist_env.anatomy.template import load_template, oriented_parts
 from wrist_env.anatomy.ulnar_variance import ulnar_variance
 from wrist_env.builder.params import BuildParams
@@ -340,84 +338,16 @@ def seat_rows(name: str, model, rig: str) -> tuple[list[dict], np.ndarray]:
 
 # --- d: the load mode -------------------------------------------------------------------------------
 
-DISTAL_CARPALS = ("trapezium", "trapezoid", "capitate", "hamate")
-METACARPALS = {f"{k}mc_r": f"{k}mc.stl" for k in range(1, 6)}
-CMC_REACH_MM = 3.0  # a carpal faces a metacarpal where its closest approach is within this
-CMC_BAND_MM = 1.0  # the facet: the carpal's vertices within this beyond that closest approach
-CHAIN_MC = {
-    "1mc.stl": "firstmc_r",
-    "2mc.stl": "secondmc_r",
-    "3mc.stl": "thirdmc_r",
-    "4mc.stl": "fourthmc_r",
-    "5mc.stl": "fifthmc_r",
-}
-
-
-def metacarpal_meshes() -> dict:
-    """myo-sim's five metacarpals (name -> trimesh, mm) in the template's RCS, seated with the distal row."""
-    import importlib.resources
-
-    pkg = importlib.resources.files("myo_sim")
-    in_radius = radius_frame_transforms(ET.parse(str(pkg / CHAIN_XML)).getroot())
-    template, seat = load_template(), read_seat()
-    out = {}
-    for stl, body in CHAIN_MC.items():
-        mesh = trimesh.load(str(pkg / "models" / "meshes" / stl), force="mesh", process=True)
-        v = (in_radius[body] @ np.c_[mesh.vertices, np.ones(len(mesh.vertices))].T).T[:, :3]
-        v = np.array([tendons._to_rcs(body, p, template.rcs_from_myosim, seat) for p in v])
-        out[body] = trimesh.Trimesh(v, mesh.faces, process=False)
-    return out
-
-
-def cmc_facets() -> dict:
-    """Per distal carpal: its CMC articular area (mm²) and the facets' area-weighted centroid (RCS, the
-    template), from the carpal's surface within `CMC_BAND_MM` beyond its closest approach to each
-    metacarpal base that comes within `CMC_REACH_MM` of it (myo-sim's assembly, not built for contact)."""
-    parts = load_template().parts
-    mcs = metacarpal_meshes()
-    out = {}
-    for carpal in DISTAL_CARPALS:
-        mesh = parts[carpal].trimesh()
-        vertex_area = np.zeros(len(mesh.vertices))
-        np.add.at(vertex_area, mesh.faces.ravel(), np.repeat(mesh.area_faces / 3.0, 3))
-        facing = np.zeros(len(mesh.vertices), bool)
-        names = []
-        for body, mc in mcs.items():
-            d = np.abs(trimesh.proximity.signed_distance(mc, mesh.vertices))
-            if d.min() <= CMC_REACH_MM:
-                facing |= d <= d.min() + CMC_BAND_MM
-                names.append(body.replace("_r", ""))
-        area = vertex_area[facing]
-        out[carpal] = {
-            "area": float(area.sum()),
-            "centroid": (mesh.vertices[facing] * area[:, None]).sum(axis=0) / area.sum(),
-            "mcs": names,
-        }
-    return out
-
-
-def cmc_lines(model, facets: dict):
-    """The hand's axial load as lines (`drivers.Loads`): along the radius' axis (`drivers.AXIAL`) through
-    each distal carpal's CMC facets' centroid (`tendons.carry_point`), shared by their CMC areas."""
-    body, point = zip(*(tendons.carry_point(model, c, facets[c]["centroid"]) for c in DISTAL_CARPALS))
-    area = np.array([facets[c]["area"] for c in DISTAL_CARPALS])
-    return drivers.Loads(
-        np.array(body), np.array(point), np.tile(drivers.AXIAL, (len(area), 1)), area / area.sum(), "cmc_axial"
-    )
-
-
-def mode_rows(model, facets: dict) -> list[dict]:
+def mode_rows(model) -> list[dict]:
     """The shares and the held moment (N·m) under the tendon rig, one axial line on the capitate, and the
-    hand's axial load split by CMC area (`cmc_lines`)."""
+    hand loaded axially as in a jig (`anatomy.jig`: split by CMC area; validate's neutral load)."""
     rows = []
     for label, direction in (
         ("tendon rig (erhart2020)", "erhart2020"),
         ("axial: one line on the capitate's centre", "axial"),
-        ("hand axial, by CMC area", None),
+        ("jig: the hand axial, by CMC area (validate's)", "jig"),
     ):
-        driver = drivers.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=direction or "axial")
-        if direction is None:
-            driver = dataclasses.replace(driver, loads=cmc_lines(model, facets))
+        driver = drivers.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=direction)
         result = neutral(model, driver)
         rows.append({"mode": label} | shares(model, result) | {"held_nm": held_moment(model, driver, result) * NM})
     return rows
@@ -500,10 +430,10 @@ def print_c(name, model, rig) -> None:
         print(f"| {r['how']} | {r['shift']:+.2f} | {r['lc_gap']:+.3f} | {share_cells(r)} |")
 
 
-def print_d(name, model, facets) -> None:
+def print_d(name, model) -> None:
     print(f"\n{name} (0d): the load mode at neutral, {NEUTRAL_LOAD_N:g} N (population design)")
     print(f"| mode | {SHARE_HEAD} | held flex / uln. dev. / pron. (N·m) |\n|---|---|---|---|---|---|---|---|")
-    for r in mode_rows(model, facets):
+    for r in mode_rows(model):
         h = r["held_nm"]
         print(f"| {r['mode']} | {share_cells(r)} | {h[2]:+.3f} / {h[0]:+.3f} / {h[1]:+.3f} |")
 
@@ -603,14 +533,14 @@ SECTIONS = ("paths", "a", "b", "c", "d", "variance")
 
 
 def main(names, load_direction: str = DEFAULT_LOADS, only=SECTIONS, tfc: str = "default") -> None:
-    facets = None
     if "d" in only:
-        facets = cmc_facets()
+        facets = jig.cmc_facets()
         total = sum(f["area"] for f in facets.values())
-        print("CMC articular areas (template, myo-sim's metacarpals; the hand's axial load is split by them):")
+        print("CMC articular areas (template, myo-sim's metacarpals; the jig's axial load is split by them):")
         print("| carpal | facing | area (mm²) | share (%) |\n|---|---|---|---|")
         for c, f in facets.items():
-            print(f"| {c} | {', '.join(f['mcs'])} | {f['area']:.0f} | {100 * f['area'] / total:.1f} |")
+            mcs = ", ".join(m.replace("_r", "") for m in f["metacarpals"])
+            print(f"| {c} | {mcs} | {f['area']:.0f} | {100 * f['area'] / total:.1f} |")
     for name in names:
         model = load_model(name)
         if "paths" in only:
@@ -622,7 +552,7 @@ def main(names, load_direction: str = DEFAULT_LOADS, only=SECTIONS, tfc: str = "
         if "c" in only:
             print_c(name, model, load_direction)
         if "d" in only:
-            print_d(name, model, facets)
+            print_d(name, model)
         if "variance" in only:
             print_variance(name, load_direction, tfc)
 

@@ -30,12 +30,12 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "--load",
         type=bounded_float("load", 0.0, MAX_LOAD_N, "N, compressive"),
         help="compressive load on the capitate in the sweeps, N (default: the idealized "
-        "driver's; the load-share check always takes 100 N)",
+        "driver's; the load-share checks always take 100 N)",
     )
     load_direction_option(
         s,
-        "the loads' direction: along the radius (default), or the resultant at neutral of a tendon "
-        "rig's tensions along myo-sim's tendon paths (Erhart 2020; see anatomy/tendons.py)",
+        "the sweeps' loads (see simulate); the neutral load-share checks (RS/RL, midcarpal, ulnar) take "
+        "the hand loaded axially as in their experiments' jigs (jig; see anatomy/jig.py)",
     )
     add_solver_argument(s)
     s.set_defaults(run="figures:validate")

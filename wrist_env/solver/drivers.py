@@ -161,7 +161,11 @@ def loads(model: Model, direction: str | ArrayLike) -> Loads:
             raise ValueError(f"load_direction must be one of {LOAD_DIRECTIONS} or a (3,) vector, but got {direction!r}")
         if direction == "axial":
             return axial_load(model)
+        if direction == "jig":
+            from wrist_env.anatomy import jig  # myo-sim's metacarpals: read only for this load
 
+            body, point, pull, share = jig.model_lines(model)
+            return Loads(body, point, pull, share, direction)
         body, point, pull, share = model_lines(model, direction)
         return Loads(body, point, pull, share, direction)
     d = np.asarray(direction, dtype=np.float64)

@@ -139,9 +139,13 @@ def solver_settings(name: str) -> SolverSettings:
     return SolverSettings().diagonal() if name == "diagonal" else SolverSettings()
 
 
-LOAD_DIRECTIONS = ("axial", "erhart2020", "erhart2020_groups")
-"""Named loads: "axial", one compressive line on the capitate along the radius' long axis (`drivers.AXIAL`),
-or a tendon rig (`anatomy.tendons.RIGS`): each tendon on the body it loads, where it enters the hand."""
+LOAD_DIRECTIONS = ("axial", "erhart2020", "erhart2020_groups", "jig")
+"""Named loads: "axial", one compressive line on the capitate along the radius' long axis (`drivers.AXIAL`);
+a tendon rig (`anatomy.tendons.RIGS`): each tendon on the body it loads, where it enters the hand; or
+"jig", the hand loaded axially through its metacarpals as in Tencer 1988's and Viegas 1993's jigs: one
+line along the radius' axis on each distal carpal, shared by CMC facet area (`anatomy.jig`)."""
+JIG = "jig"
+"""The load mode of the checks measured in an axial jig (`validation`: the midcarpal shares, RS/RL)."""
 DEFAULT_LOADS = "erhart2020"
 """Every driver's loads unless told otherwise (`LOAD_DIRECTIONS`): the tendons where they enter the hand
 (issue 33: under the axial load the radial column carries nothing)."""

@@ -16,7 +16,7 @@ from wrist_env.solver import drivers
 from wrist_env.solver import simulate as sim
 from wrist_env.solver.drivers import IDEALIZED_LOAD_N
 from wrist_env.solver.outputs import cardan_deg
-from wrist_env.solver.settings import DEFAULT_LOADS
+from wrist_env.solver.settings import DEFAULT_LOADS, JIG
 from wrist_env.validation.bands import (
     EXTENSION_30_DEG,
     NEUTRAL_LOAD_N,
@@ -36,6 +36,11 @@ def _failure(label, result) -> str | None:
     return None if result.ok else f"{label} run {result.message}"
 
 
+def _mode(load: str) -> str:
+    """How a neutral check was loaded, in words."""
+    return "the hand loaded axially, as in a jig" if load == JIG else f"the {load} load"
+
+
 def _variance_said(model: Model) -> str:
     """ ", ulnar variance +0.26 mm" as the build seated the ulna (its osteotomy included), or "" where the
     corner rule found none: the ulnar share depends on it (Werner 1986)."""
@@ -52,13 +57,17 @@ def validate(
     params: BuildParams | None = None,
     load_n: float = IDEALIZED_LOAD_N,
     load_direction: str = DEFAULT_LOADS,
+    neutral_load: str = JIG,
     settings=None,
 ) -> Report:
     """Run the published-measurement checks on participant `name` (population design by default).
 
     params: build parameters (`BuildParams`; the anatomy variant), default the default build.
     load_n: the compressive load (N) of the sweeps; the neutral pose takes `NEUTRAL_LOAD_N`.
-    load_direction: the loads' direction in the sweeps and at neutral (`settings.LOAD_DIRECTIONS`).
+    load_direction: the loads' direction in the sweeps (`settings.LOAD_DIRECTIONS`).
+    neutral_load: the load at neutral, where RS/RL and the midcarpal and ulnar shares are measured: by
+        default their experiments' (`settings.JIG`: the hand loaded axially in a jig, as Palmer & Werner
+        1984, Tencer 1988, Hara 1992 and Viegas 1993 loaded it), not the tendons'.
     settings: the solver's (`settings.SolverSettings`), default its defaults.
     The load and the frames are checked before the model loads (a NaN load used to fail the whole run).
     """
@@ -74,7 +83,10 @@ def validate(
     sweep = drivers.idealized(model, n_frames=n_frames, load_n=load_n, direction=direction)
     intact, torn = sim.simulate_batch(model, [intact_design, torn_design], sweep, settings)
     neutral = sim.simulate(
-        model, intact_design, drivers.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=direction), settings
+        model,
+        intact_design,
+        drivers.loaded(model, [np.eye(3)], load_n=NEUTRAL_LOAD_N, direction=neutral_load),
+        settings,
     )
 
     b = {bone: BONES.index(bone) for bone in ("capitate", "scaphoid", "lunate")}
@@ -121,7 +133,8 @@ def validate(
         ),
         _row(
             "rs_rl_force_ratio",
-            f"radioscaphoid / radiolunate contact force, capitate held at neutral under {NEUTRAL_LOAD_N:g} N",
+            f"radioscaphoid / radiolunate contact force, capitate held at neutral under {NEUTRAL_LOAD_N:g} N"
+            f" ({_mode(neutral_load)})",
             rs_rl,
             (1.1, 2.0),
             "ratio",
@@ -130,7 +143,7 @@ def validate(
         *(
             _row(
                 f"midcarpal_{key}_share_pct",
-                f"{name}'s share of the midcarpal contact force, neutral, {NEUTRAL_LOAD_N:g} N",
+                f"{name}'s share of the midcarpal contact force, neutral, {NEUTRAL_LOAD_N:g} N ({_mode(neutral_load)})",
                 shares[name],
                 (pct - 10.0, pct + 10.0),
                 "%",
@@ -141,7 +154,7 @@ def validate(
         _row(
             "ulnar_share_pct",
             f"ulnocarpal share of the radiocarpal + ulnocarpal contact force, neutral, {NEUTRAL_LOAD_N:g} N"
-            f"{_variance_said(model)}",
+            f" ({_mode(neutral_load)}){_variance_said(model)}",
             shares["ulnocarpal"],
             ULNAR_SHARE_PCT,
             "%",
