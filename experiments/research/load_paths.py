@@ -338,6 +338,7 @@ def seat_rows(name: str, model, rig: str) -> tuple[list[dict], np.ndarray]:
 
 # --- d: the load mode -------------------------------------------------------------------------------
 
+
 def mode_rows(model) -> list[dict]:
     """The shares and the held moment (N·m) under the tendon rig, one axial line on the capitate, and the
     hand loaded axially as in a jig (`anatomy.jig`: split by CMC area; validate's neutral load)."""
