@@ -67,17 +67,18 @@ def test_lines_on_the_driven_capitate_act_as_their_resultant_and_the_columns_do_
     resultant on the capitate ends (their moments go to the driver), to 1e-3 mm and 1e-3 N: the same
     forces summed in another order change a hold's last steps, and a hold stops at a net force of
     0.01 N, which a soft direction (~10 N/mm) leaves 1e-3 mm from its balance; the radial column's lines (1st and 2nd rays) load a free body, so moving them to
-    the capitate as a resultant changes the answer (the STT joint's force by more than 1 N). Each run
+    the capitate as a resultant changes the answer (the STT joint's force by more than 1 N), and so do
+    the hamate's (4th and 5th rays, FCU through the pisiform: the triquetrohamate joint's force). Each run
     balances (every free body's net force under 0.05 N)."""
     from dataclasses import replace
 
-    from wrist_env.model import PAIRS, TRAPEZIUM
+    from wrist_env.model import HAMATE, PAIRS, TRAPEZIUM
     from wrist_env.solver.simulate import simulate
 
     rig = loaded(p1, [np.eye(3)], 100.0, direction="erhart2020")
-    assert set(rig.loads.body) == {BONES.index("capitate"), TRAPEZIUM}
-    stt = PAIRS.index("scaphotrapezial")
-    for body in (BONES.index("capitate"), TRAPEZIUM):
+    assert set(rig.loads.body) == {BONES.index("capitate"), TRAPEZIUM, HAMATE}
+    joint = {TRAPEZIUM: PAIRS.index("scaphotrapezial"), HAMATE: PAIRS.index("triquetrohamate")}
+    for body in (BONES.index("capitate"), TRAPEZIUM, HAMATE):
         keep = rig.loads.body == body
         share = rig.loads.share[keep] / rig.loads.share[keep].sum()
         part = replace(
@@ -94,8 +95,9 @@ def test_lines_on_the_driven_capitate_act_as_their_resultant_and_the_columns_do_
         resultant = loaded(p1, [np.eye(3)], float(np.linalg.norm(total)), direction=total)
         a, b = (simulate(p1, design.population(), d) for d in (part, resultant))
         assert a.ok and b.ok and a.settled.all() and a.residual[0, 0] < 0.05, (a.message, a.residual)
-        if body == TRAPEZIUM:
-            assert abs(a.contact[0, stt, 3] - b.contact[0, stt, 3]) > 1.0, (a.contact[0, stt], b.contact[0, stt])
+        if body in joint:
+            j = joint[body]
+            assert abs(a.contact[0, j, 3] - b.contact[0, j, 3]) > 1.0, (BONES[body], a.contact[0, j], b.contact[0, j])
         else:
             assert np.abs(a.poses - b.poses).max() < 1e-3
             assert np.abs(a.contact[..., 3] - b.contact[..., 3]).max() < 1e-3
