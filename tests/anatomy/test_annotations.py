@@ -11,9 +11,17 @@ def ann():
 
 
 def test_every_articulation_is_covered_on_both_bones(ann):
+    """Each articulation has cartilage on both bones; the triquetrohamate one only with the distal row (the
+    lunate body's triquetrum: the template's lunate, a type I lunate, comes no nearer the hamate than 3.8 mm)."""
+    with_row = template_annotations((20.0, 10.0), True)
     for art in ARTICULATIONS:
-        a, b, ma, mb = ann.coverage[art]
-        assert ma.sum() > 100 and mb.sum() > 100, art
+        for coverage in (ann.coverage, with_row.coverage):
+            a, b, ma, mb = coverage[art]
+            if art == "triquetrohamate" and coverage is ann.coverage:
+                assert ma.sum() == 0, art
+                continue
+            least = 30 if art == "triquetrohamate" else 100
+            assert ma.sum() > least and mb.sum() > least, (art, ma.sum(), mb.sum())
 
 
 def test_every_ligament_site_has_room_for_its_fibres(ann):
