@@ -83,25 +83,27 @@ CH_RIG_MOMENT_NMM = 500.0
 CH_ROTATION_DEG = 9.0
 """The capitohamate joint's dorsopalmar rotation (the capitate turning dorsally or palmarly on the hamate:
 about the joint's normal, the radioulnar axis) under `CH_RIG_MOMENT_NMM`, each way (Ritt 1996)."""
-CH_SHEAR_MM = (0.7, 0.6)
-"""The joint's translations in its own plane under `CH_RIG_FORCE_N` (mm; Ritt 1996): dorsopalmar, the
-mean of palmar 0.9 and dorsal 0.5 mm; proximodistal, the mean of 0.8 and 0.4 mm."""
+CH_SHEAR_MM = 0.65
+"""The joint's translation in its own plane under `CH_RIG_FORCE_N` (mm): the mean of Ritt 1996's four,
+dorsopalmar 0.9 (palmar) and 0.5 (dorsal), proximodistal 0.8 and 0.4 mm. One value for the plane: the
+two directions' means (0.7, 0.6 mm) differ by less than each direction's two ways, and a spring the same
+every way in the plane needs only the joint's normal, which the geometry gives in any frame."""
 CH_JOINT_STIFFNESS = (
-    CH_RIG_FORCE_N / CH_SHEAR_MM[0],
-    CH_RIG_FORCE_N / CH_SHEAR_MM[1],
+    CH_RIG_FORCE_N / CH_SHEAR_MM,
+    CH_RIG_FORCE_N / CH_SHEAR_MM,
     0.0,
     0.0,
     0.0,
     CH_RIG_MOMENT_NMM / float(np.radians(CH_ROTATION_DEG)),
 )
 """The capitohamate joint's in-plane constraint (`solver.forces.joint_forces`), in the joint's axes
-(dorsopalmar, proximodistal in its plane, then its normal, hamate to capitate): shifts (N/mm) then
-rotations (N·mm/rad). The three bands (`HAMATE_LIGAMENTS`) are tension-only fibres across the joint:
-they resist its distraction (and the rotations that open it) but, straight across a joint 2–3 mm wide,
-not a shear or a turn in its plane, to first order (a fibre's end moved sideways by δ stretches it by
-δ²/2L). What Ritt 1996 measured there, the ligaments' in-plane constraint, is this linear spring between
-the two bones at the joint's centre: 20 N over 0.7 and 0.6 mm (28.6 and 33.3 N/mm) in the plane, 0.5 N·m
-over 9 deg (3.18 N·m/rad) about the normal; nothing along the normal (the bands and the contact) nor
+(two in its plane, then its normal, hamate to capitate): shifts (N/mm) then rotations (N·mm/rad). The
+three bands (`HAMATE_LIGAMENTS`) are tension-only fibres across the joint: they resist its distraction
+(and the rotations that open it) but, straight across a joint 2–3 mm wide, not a shear or a turn in its
+plane, to first order (a fibre's end moved sideways by δ stretches it by δ²/2L). What Ritt 1996 measured
+there, the ligaments' in-plane constraint, is this linear spring between the two bones at the joint's
+centre: 20 N over 0.65 mm (30.8 N/mm) in the plane, 0.5 N·m over 9 deg (3.18 N·m/rad) about the normal;
+nothing along the normal (the bands and the contact) nor
 about the in-plane axes (they open the joint: the bands and the contact)."""
 FIXED_LIGAMENTS = (
     Ligament("TC", "palmar triquetrocapitate ligament", 3, 20.0, 6.0, False, "Garcia-Elias 2017; Weaver 1994"),
