@@ -138,6 +138,11 @@ def _ligaments(bones: dict, sites: dict, params: BuildParams):
     return bundles, membrane
 
 
+ABSENT_WITHOUT_DISTAL_ROW = ("triquetrohamate",)
+"""Articulations a model without the distal row (`BuildParams.distal_row`) has no cartilage of: the
+triquetrohamate pair is the lunate body's triquetrum on the hamate; its pair stays, without samples."""
+
+
 def tfcc_thickness(
     bones: dict, thickness: dict, coverage: tuple, bandwidth_mm: float, disc_mm: float | None = None
 ) -> tuple[np.ndarray, dict]:
@@ -232,6 +237,8 @@ def build_model(
     morphs, morph_report = _morph_all(bones, params, workers)
     lap("morph")
     coverage, sites, relocated = _transfer(morphs, bones, params)
+    if not params.distal_row:  # the lunate without its triquetrum reaches no hamate (a type I lunate)
+        coverage = {art: c for art, c in coverage.items() if art not in ABSENT_WITHOUT_DISTAL_ROW}
     articulations = {(a, b): (ma, mb) for art, (a, b, ma, mb) in coverage.items() if art != TFCC}
     verts = {b: bones[b].vertices for b in BONES}
     faces = {b: bones[b].faces for b in BONES}
