@@ -11,6 +11,23 @@ import tempfile
 import pytest
 
 WARM = "from wrist_env.solver.settings import solver_settings\nfrom wrist_env.solver.simulate import warm\nwarm(solver_settings({!r}))\n"
+PARTS_PROBE = (
+    "import json, sys\n"
+    "from wrist_env.solver import parts, precompile, simulate\n"
+    "from wrist_env.solver.settings import SolverSettings\n"
+    "precompile._start = lambda entry, smooth: None\n"
+    "parts.compile_parts(SolverSettings())\n"
+    "simulate.warm()\n"
+    "found = [d for d, _ in parts.part_signatures(SolverSettings())]\n"
+    "cold = not any(d.stats.cache_hits for d in found)\n"
+    "counts = [[d.py_func.__name__, len(d.signatures)] for d in found]\n"
+    "json.dump({'cold': cold, 'signatures': counts}, open(sys.argv[1], 'w'))\n"
+)
+"""The default solver's warming, as tests/solver/test_entry.py's parts check wants it: the second process's
+parts compiled first, then the entry point, the signature counts written to a file (`PARTS_PROBE_ENV`).
+From an empty cache (CI's) that is the check's own cold compile, which the test then reads instead of
+compiling everything again in a process of its own (a minute of CI)."""
+PARTS_PROBE_ENV = "WRIST_ENV_PARTS_PROBE"
 
 
 def pytest_configure(config):
@@ -22,9 +39,12 @@ def pytest_configure(config):
         return
     from wrist_env.solver.settings import SOLVERS
 
+    probe = os.path.join(tempfile.mkdtemp(prefix="wrist_env_parts_"), "parts.json")
+    os.environ[PARTS_PROBE_ENV] = probe  # the workers, started after this, read it
     with tempfile.TemporaryDirectory() as cache:
         env = dict(os.environ, WRIST_ENV_CACHE=cache)
-        warming = [subprocess.Popen([sys.executable, "-c", WARM.format(s)], env=env) for s in SOLVERS]
+        argv = {s: ["-c", PARTS_PROBE, probe] if s == "default" else ["-c", WARM.format(s)] for s in SOLVERS}
+        warming = [subprocess.Popen([sys.executable, *argv[s]], env=env) for s in SOLVERS]
         failed = [s for s, p in zip(SOLVERS, warming) if p.wait() != 0]
     if failed:
         raise pytest.UsageError(f"compiling the solver's entry points failed for {failed} (see above)")
