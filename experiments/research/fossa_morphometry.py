@@ -50,6 +50,8 @@ import sys
 
 import numpy as np
 
+from wrist_env.builder.surface import vertex_areas
+
 RIM_BAND_MM = 2.0
 """A rim: the surface's points within this of its least or greatest coordinate along the axis (mm)."""
 SLAB_MM = 0.5
@@ -82,19 +84,6 @@ PUBLISHED = {
 }
 
 
-def face_areas(v: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """Area (m,) mm² of each triangle of vertices `v` (n, 3) and faces `f` (m, 3)."""
-    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
-    return 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
-
-
-def vertex_areas(v: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """Area (n,) mm² owned by each vertex: a third of each face it is a corner of (they sum to the mesh's)."""
-    out = np.zeros(len(v))
-    np.add.at(out, f.ravel(), np.repeat(face_areas(v, f) / 3.0, 3))
-    return out
-
-
 def vertex_normals(v: np.ndarray, f: np.ndarray) -> np.ndarray:
     """Unit area-weighted vertex normals (n, 3) of a mesh whose faces wind outward."""
     a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
@@ -110,26 +99,26 @@ def patch_area(v: np.ndarray, f: np.ndarray, mask: np.ndarray) -> float:
     return float(vertex_areas(v, f)[mask].sum())
 
 
-def fit_circle(p: np.ndarray) -> tuple[np.ndarray, float, float]:
-    """Least-squares (Kåsa) circle through 2-D points `p` (n, 2): centre (2,), radius, RMS radial residual."""
+def _fit_ball(p: np.ndarray) -> tuple[np.ndarray, float, float]:
+    """Least-squares (Kåsa) circle or sphere through points `p` (n, d): centre (d,), radius, RMS radial
+    residual."""
     p = np.asarray(p, float)
     A = np.column_stack([2.0 * p, np.ones(len(p))])
     sol = np.linalg.lstsq(A, (p**2).sum(axis=1), rcond=None)[0]
-    centre = sol[:2]
-    radius = float(np.sqrt(sol[2] + centre @ centre))
+    centre = sol[:-1]
+    radius = float(np.sqrt(sol[-1] + centre @ centre))
     rms = float(np.sqrt(np.mean((np.linalg.norm(p - centre, axis=1) - radius) ** 2)))
     return centre, radius, rms
+
+
+def fit_circle(p: np.ndarray) -> tuple[np.ndarray, float, float]:
+    """Least-squares circle through 2-D points `p` (n, 2): centre (2,), radius, RMS radial residual."""
+    return _fit_ball(p)
 
 
 def fit_sphere(p: np.ndarray) -> tuple[np.ndarray, float, float]:
     """Least-squares sphere through points `p` (n, 3): centre (3,), radius, RMS radial residual."""
-    p = np.asarray(p, float)
-    A = np.column_stack([2.0 * p, np.ones(len(p))])
-    sol = np.linalg.lstsq(A, (p**2).sum(axis=1), rcond=None)[0]
-    centre = sol[:3]
-    radius = float(np.sqrt(sol[3] + centre @ centre))
-    rms = float(np.sqrt(np.mean((np.linalg.norm(p - centre, axis=1) - radius) ** 2)))
-    return centre, radius, rms
+    return _fit_ball(p)
 
 
 def section_radii(p: np.ndarray, through: np.ndarray, slab_mm: float = SLAB_MM) -> dict:

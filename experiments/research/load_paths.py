@@ -54,7 +54,7 @@ import trimesh
 from wrist_env import design
 from wrist_env.anatomy import jig, tendons
 from wrist_env.anatomy.template import load_template, oriented_parts
-from wrist_env.anatomy.ulnar_variance import ulnar_variance
+from wrist_env.anatomy.ulnar_variance import built_variance, ulnar_variance
 from wrist_env.builder.params import BuildParams
 from wrist_env.builder.warp import Warp
 from wrist_env.design import ALL_LIGAMENT_NAMES
@@ -117,7 +117,6 @@ def ulnocarpal_space(model) -> dict:
     """Where a TFCC would sit, at neutral: the closest approach (mm) of the lunate and of the triquetrum
     to the ulna's surface, and the ulnar variance (mm, + ulna plus) the build seated the ulna at, its
     osteotomy included (`recorded_variance`)."""
-    radius_v, _, _ = _body(model, BONES.index("radius"))
     ulna_v, ulna_f, _ = _body(model, BONES.index("ulna"))
     lunate_v, _, part = _body(model, BONES.index("lunate"))
     _, distance, _ = trimesh.proximity.closest_point(trimesh.Trimesh(ulna_v, ulna_f, process=False), lunate_v)
@@ -126,10 +125,10 @@ def ulnocarpal_space(model) -> dict:
 
 
 def recorded_variance(model) -> float:
-    """The ulnar variance (mm) the build seated the ulna at plus its osteotomy (`Model.report`); NaN where
-    the corner rule found no corner or head."""
-    r = model.report.get("ulnar_variance_mm")
-    return math.nan if r is None else r["seated"] + r.get("osteotomy_mm", 0.0)
+    """The ulnar variance (mm) the build seated the ulna at plus its osteotomy; NaN where the corner rule
+    found no corner or head (`ulnar_variance.built_variance`)."""
+    v = built_variance(model.report)
+    return math.nan if v is None else v
 
 
 # --- shared: one neutral run and its shares ---------------------------------------------------------

@@ -25,6 +25,7 @@ from wrist_env.anatomy import tendons
 from wrist_env.anatomy.midcarpal import read_seat
 from wrist_env.anatomy.myosim import CHAIN_XML, radius_frame_transforms
 from wrist_env.anatomy.template import load_template
+from wrist_env.builder.surface import vertex_areas
 
 DISTAL_CARPALS = ("trapezium", "trapezoid", "capitate", "hamate")
 """The carpals the metacarpals meet (`model.PARTS`)."""
@@ -61,8 +62,7 @@ def cmc_facets() -> dict:
     out = {}
     for carpal in DISTAL_CARPALS:
         mesh = parts[carpal].trimesh()
-        vertex_area = np.zeros(len(mesh.vertices))
-        np.add.at(vertex_area, mesh.faces.ravel(), np.repeat(mesh.area_faces / 3.0, 3))
+        vertex_area = vertex_areas(mesh.vertices, mesh.faces)
         facing = np.zeros(len(mesh.vertices), bool)
         names = []
         for body, mc in mcs.items():

@@ -88,6 +88,21 @@ def radius_bone(radius) -> np.ndarray:
     return v[~solid] if solid.any() and not solid.all() else v
 
 
+def moved_ulna(bones: dict, shift_mm: float) -> dict:
+    """`bones` with the ulna translated `shift_mm` along `AXIS` (+ proximal); its vertex masks, cartilage
+    and TFCC layer, per vertex, move with it."""
+    v = np.asarray(bones["ulna"].vertices, float) + shift_mm * AXIS
+    v.setflags(write=False)
+    return {**bones, "ulna": dataclasses.replace(bones["ulna"], vertices=v)}
+
+
+def built_variance(report: dict) -> float | None:
+    """The ulnar variance (mm) a built model's ulna sits at (`Model.report`): as seated, plus any osteotomy;
+    None where the corner rule found no corner or head."""
+    r = report.get("ulnar_variance_mm")
+    return None if not r else r["seated"] + r.get("osteotomy_mm", 0.0)
+
+
 def seat_ulna(bones: dict, variance_mm: float) -> tuple[dict, dict]:
     """`bones` (name -> `BoneSurface`, RCS mm) with the ulna moved along `AXIS` so that `ulnar_variance`
     gives `variance_mm` (a translation: the head's vertices stay the head's), and what was done: the
@@ -95,8 +110,6 @@ def seat_ulna(bones: dict, variance_mm: float) -> tuple[dict, dict]:
     ulna, radius = bones["ulna"], radius_bone(bones["radius"])
     given = ulnar_variance(radius, ulna.vertices).variance_mm
     shift = given - float(variance_mm)
-    v = np.asarray(ulna.vertices, float) + shift * AXIS
-    v.setflags(write=False)
-    moved = {**bones, "ulna": dataclasses.replace(ulna, vertices=v)}
-    seated = ulnar_variance(radius, v).variance_mm
+    moved = moved_ulna(bones, shift)
+    seated = ulnar_variance(radius, moved["ulna"].vertices).variance_mm
     return moved, {"given": round(given, 4), "seated": round(seated, 4), "shift_mm": round(shift, 4)}

@@ -12,18 +12,11 @@ import trimesh
 from scipy.spatial import cKDTree
 
 from wrist_env.builder import sdf
-from wrist_env.builder.surface import displaced_vertices
+from wrist_env.builder.surface import displaced_vertices, vertex_areas
 from wrist_env.errors import BuildError
 from wrist_env.model import BONES, PAIR_BONES, PAIRS, offsets
 
 SEAT_ITERATIONS = 6  # `_seat_samples`: the TFCC's domed layer needs more than the cartilage's 3
-
-
-def _vertex_areas(vertices, faces) -> np.ndarray:
-    area = trimesh.triangles.area(vertices[faces])
-    out = np.zeros(len(vertices))
-    np.add.at(out, faces.ravel(), np.repeat(area / 3.0, 3))
-    return out
 
 
 def _thin(points, spacing_mm) -> np.ndarray:
@@ -58,7 +51,7 @@ def _contact_samples(bones, thickness, coverage, params):
         if len(idx) == 0:
             raise BuildError(f"articulation {art} has no cartilage coverage on the {a}")
         mesh = trimesh.Trimesh(displaced[a], bones[a].faces, process=False)
-        vertex_area = _vertex_areas(displaced[a], bones[a].faces)[idx]
+        vertex_area = vertex_areas(displaced[a], bones[a].faces)[idx]
         keep, order, group = _thin(displaced[a][idx], params.contact_spacing_mm)
         sample_area = np.bincount(group, weights=vertex_area[order])
         chosen = idx[keep]

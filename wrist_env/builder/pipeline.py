@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import os
 import time
-from dataclasses import replace
 
 import numpy as np
 import trimesh
@@ -18,7 +17,7 @@ from tqdm import tqdm
 
 from wrist_env.anatomy.annotations import read_annotation_data, template_annotations
 from wrist_env.anatomy.template import closed, load_template
-from wrist_env.anatomy.ulnar_variance import AXIS, radius_bone, seat_ulna, ulnar_variance
+from wrist_env.anatomy.ulnar_variance import moved_ulna, radius_bone, seat_ulna, ulnar_variance
 from wrist_env.builder import cartilage, contact_law, fibres, mass, morph, sdf
 from wrist_env.builder.contact_samples import _contact_samples, _seat_samples
 from wrist_env.builder.digest import source_hash
@@ -170,11 +169,7 @@ def tfcc_thickness(
 def _osteotomy(bones: dict, lengthening_mm: float) -> dict:
     """`bones` with the ulna moved `lengthening_mm` distally along the radius' long axis
     (`BuildParams.ulnar_osteotomy_mm`); its vertex masks, cartilage and TFCC layer move with it."""
-    if lengthening_mm == 0.0:
-        return bones
-    v = np.asarray(bones["ulna"].vertices, float) - lengthening_mm * AXIS
-    v.setflags(write=False)
-    return {**bones, "ulna": replace(bones["ulna"], vertices=v)}
+    return bones if lengthening_mm == 0.0 else moved_ulna(bones, -lengthening_mm)
 
 
 def _seat_ulna(name: str, bones: dict, variance_mm: float | None) -> tuple[dict, dict | None]:

@@ -22,7 +22,7 @@ from wrist_env.errors import InputError
 from wrist_env.limits import MAX_FRAMES, MAX_SWEEP_DEG, check_float, check_int
 from wrist_env.model import CAPITATE, Model
 from wrist_env.solver import arrays, kernel
-from wrist_env.solver.settings import DEFAULT_LOADS, LOAD_DIRECTIONS
+from wrist_env.solver.settings import DEFAULT_LOADS, JIG, LOAD_DIRECTIONS
 
 if TYPE_CHECKING:
     from wrist_env.trial import Trial
@@ -161,7 +161,7 @@ def loads(model: Model, direction: str | ArrayLike) -> Loads:
             raise ValueError(f"load_direction must be one of {LOAD_DIRECTIONS} or a (3,) vector, but got {direction!r}")
         if direction == "axial":
             return axial_load(model)
-        if direction == "jig":
+        if direction == JIG:
             from wrist_env.anatomy import jig  # myo-sim's metacarpals: read only for this load
 
             body, point, pull, share = jig.model_lines(model)

@@ -145,7 +145,7 @@ a tendon rig (`anatomy.tendons.RIGS`): each tendon on the body it loads, where i
 "jig", the hand loaded axially through its metacarpals as in Tencer 1988's and Viegas 1993's jigs: one
 line along the radius' axis on each distal carpal, shared by CMC facet area (`anatomy.jig`)."""
 JIG = "jig"
-"""The load mode of the checks measured in an axial jig (`validation`: the midcarpal shares, RS/RL)."""
+"""The load mode of the checks measured in an axial jig (`validation`: RS/RL, the midcarpal and ulnar shares)."""
 DEFAULT_LOADS = "erhart2020"
 """Every driver's loads unless told otherwise (`LOAD_DIRECTIONS`): the tendons where they enter the hand
 (issue 33: under the axial load the radial column carries nothing)."""

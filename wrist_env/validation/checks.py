@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from wrist_env import design as design_mod
+from wrist_env.anatomy.ulnar_variance import built_variance
 from wrist_env.builder.params import BuildParams
 from wrist_env.limits import MAX_FRAMES, MAX_LOAD_N, check_float, check_int
 from wrist_env.model import BONES, MIDCARPAL, PAIRS, Model
@@ -44,8 +45,8 @@ def _mode(load: str) -> str:
 def _variance_said(model: Model) -> str:
     """ ", ulnar variance +0.26 mm" as the build seated the ulna (its osteotomy included), or "" where the
     corner rule found none: the ulnar share depends on it (Werner 1986)."""
-    r = model.report.get("ulnar_variance_mm")
-    return "" if not r else f", ulnar variance {r['seated'] + r.get('osteotomy_mm', 0.0):+.2f} mm"
+    v = built_variance(model.report)
+    return "" if v is None else f", ulnar variance {v:+.2f} mm"
 
 
 def validate(
