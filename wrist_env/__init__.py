@@ -3,12 +3,17 @@
 The Gymnasium ids of the built-in participants (`wrist_env/Calibrate-P1-v0`, …) are registered as soon as
 both this package and `gymnasium` are imported, in either order (a post-import hook: importing
 `wrist_env.design` or `wrist_env.cost` alone imports neither Gymnasium nor the model builder);
-`register_participant(folder)` adds a user's.
+`register_participant(folder)` adds a user's. Importing it points Numba's cache at the folder of the
+kernels' current sources (`kernel_cache`).
 """
 
 import wrapt
 
-from wrist_env.participants import BUILTIN
+from wrist_env import kernel_cache
+
+kernel_cache.configure()  # before any kernel is defined: Numba's cache folder follows the kernels' sources
+
+from wrist_env.participants import BUILTIN  # noqa: E402
 
 __all__ = ["register_participant", "registered_ids"]
 
