@@ -96,3 +96,21 @@ def test_an_empty_batch_of_actions_is_no_designs_but_a_wrong_width_is_named():
     assert design.from_actions(np.zeros((0, design.N_DESIGN))) == [] and design.from_actions([]) == []
     with pytest.raises(DesignError, match=r"shape \(n, 27\), but got \(0, 5\)"):
         design.from_actions(np.zeros((0, 5)))
+
+
+def test_the_capitohamate_bands_stiffness_is_ritt_1996s_distraction_shared_by_three():
+    """Each capitohamate interosseous band (fixed, outside the 27 variables): Ritt 1996's 20 N over the
+    joint's 0.3 mm distraction, shared equally by the deep, dorsal and palmar bands (66.7 N/mm for the
+    three in parallel, 22.2 N/mm each)."""
+    fixed = {lig.name: lig for lig in design.FIXED_LIGAMENTS}
+    assert design.HAMATE_LIGAMENTS == ("CH_deep", "CH_d", "CH_p")
+    assert design.STIFFNESS_CH == pytest.approx(20.0 / 0.3 / 3) == pytest.approx(22.22, abs=0.01)
+    for name in design.HAMATE_LIGAMENTS:
+        assert fixed[name].stiffness_mean == design.STIFFNESS_CH and not fixed[name].injurable
+        assert name not in design.LIGAMENT_NAMES and name in design.ALL_LIGAMENT_NAMES
+    assert sum(fixed[n].stiffness_mean for n in design.HAMATE_LIGAMENTS) * design.CH_DISTRACTION_MM == pytest.approx(
+        design.CH_RIG_FORCE_N
+    )
+    stiffness, strain, torn = design.ligament_arrays(design.population())
+    k = design.ALL_LIGAMENT_NAMES.index("CH_deep")
+    assert stiffness[k] == design.STIFFNESS_CH and strain[k] == 1.0 and not torn[k] and design.N_DESIGN == 27

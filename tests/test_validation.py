@@ -23,6 +23,7 @@ CHECK_IDS = (
     "midcarpal_th_share_pct",
     "ulnar_share_pct",
     "column_rotation_deg",
+    "hamate_rotation_deg",
     "sl_gap_growth_mm",
     "rs_mean_pressure_mpa",
     "slil_force_30ext_n",
@@ -98,7 +99,7 @@ def test_report_json_is_strict_and_round_trips():
     assert "FAIL" in validation.format_table(report)
 
 
-def test_cli_validate_json_has_the_thirteen_checks(capsys, built, tmp_path):
+def test_cli_validate_json_has_the_fourteen_checks(capsys, built, tmp_path):
     built("P1")
     code = main(["validate", "P1", "--json", "--out", str(tmp_path)])
     out = json.loads(capsys.readouterr().out)

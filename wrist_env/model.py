@@ -17,33 +17,43 @@ from numpy.typing import ArrayLike
 from wrist_env.errors import InputError
 from wrist_env.io import load_dataclass, save_dataclass
 
-BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate", "trapezium")
-"""The six rigid bodies, each named after its principal bone."""
-RADIUS, ULNA, SCAPHOID, LUNATE, CAPITATE, TRAPEZIUM = range(6)
+BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate", "trapezium", "hamate")
+"""The seven rigid bodies, each named after its principal bone."""
+RADIUS, ULNA, SCAPHOID, LUNATE, CAPITATE, TRAPEZIUM, HAMATE = range(7)
 N_BODIES = len(BONES)
-FREE = (SCAPHOID, LUNATE, TRAPEZIUM)
+FREE = (SCAPHOID, LUNATE, TRAPEZIUM, HAMATE)
 """The bodies free in 6 DOF under every driver (the capitate is driven; the radius and ulna fixed)."""
+CARRIED = (TRAPEZIUM, HAMATE)
+"""The free bodies of the distal row, which the driven capitate carries: their dislocation is measured
+from where the capitate carries them (`solver.stopping.displacement`)."""
 BODY_PARTS = {
     "radius": ("radius",),
     "ulna": ("ulna",),
     "scaphoid": ("scaphoid",),
     "lunate": ("lunate", "triquetrum"),
-    "capitate": ("capitate", "hamate"),
+    "capitate": ("capitate",),
     "trapezium": ("trapezium", "trapezoid"),
+    "hamate": ("hamate",),
 }
 """The bones of each rigid body, principal bone first: the triquetrum moves with the lunate
-(lunotriquetral motion is small beside scapholunate motion: Ruby 1988, Kobayashi 1997), the hamate
-with the capitate (the capitohamate joint is bound by its interosseous ligament and moves least of
-the distal row: Garcia-Elias 1989). The trapezium and trapezoid are the radial column, a body of its
-own: it loads the scaphoid's distal pole through the STT joint with the 1st and 2nd rays' loads
-(issue 33: with it on the driven capitate no load reached the STT joint), held to the capitate by
-the trapezocapitate ligaments and joint (`design.FIXED_LIGAMENTS`)."""
+(lunotriquetral motion is small beside scapholunate motion: Ruby 1988, Kobayashi 1997). The trapezium
+and trapezoid are the radial column, a body of its own: it loads the scaphoid's distal pole through the
+STT joint with the 1st and 2nd rays' loads (issue 33: with it on the driven capitate no load reached the
+STT joint), held to the capitate by the trapezocapitate ligaments and joint (`design.FIXED_LIGAMENTS`).
+The hamate is a body of its own too (issue 54, step 2), as in every full-carpus model that bears load
+(Fischli 2009, J Biomech 42:1363; Bajuri 2012, Proc IMechE H): on the driven capitate, the moment of
+its rays' loads (the 4th and 5th metacarpals and, through the pisiform, the FCU: 38 % of the tendon
+rig's tension) went to the driver and the capitate head took their load; free, it balances them on
+its own joints (capitohamate, triquetrohamate), held to the capitate by the three capitohamate
+interosseous ligaments of measured constraint (Ritt, Berger, Bishop & An 1996, J Hand Surg Br
+21:451; `design.HAMATE_LIGAMENTS`). The capitohamate joint still moves little (the distal row moves
+rigidly together, < 3 deg: Akhbari 2019, J Orthop Res 37:2661; `validation` checks it)."""
 SUPPLIED = ("radius", "ulna", "scaphoid", "lunate", "capitate")
-"""The bodies a participant folder supplies meshes of (the principal bones); the radial column and
-the other parts are carried from the template with the capitate (`anatomy.template.carry_parts`)."""
+"""The bodies a participant folder supplies meshes of (the principal bones); the radial column, the
+hamate and the other parts are carried from the template with the capitate (`anatomy.template.carry_parts`)."""
 CARPALS = ("scaphoid", "lunate", "capitate")
 """The carpals a participant supplies meshes of and a trial tracks (the forearm bones are the radius and ulna)."""
-CARRIED_WITH = {"trapezium": "capitate"}
+CARRIED_WITH = {"trapezium": "capitate", "hamate": "capitate"}
 """Bodies not in `SUPPLIED`, and the supplied body whose registration carries them."""
 PARTS = tuple(p for b in BONES for p in BODY_PARTS[b])
 """All nine bones of the model, body by body (`BODY_PARTS`)."""
@@ -56,6 +66,8 @@ PAIRS = (
     "scaphotrapezial",
     "trapeziocapitate",
     "ulnocarpal",
+    "capitohamate",
+    "triquetrohamate",
 )
 PAIR_BONES = np.array(
     [
@@ -67,13 +79,17 @@ PAIR_BONES = np.array(
         [TRAPEZIUM, SCAPHOID],
         [TRAPEZIUM, CAPITATE],
         [LUNATE, ULNA],
+        [HAMATE, CAPITATE],
+        [LUNATE, HAMATE],
     ]
 )
 """(sample bone, grid bone) of each contact pair: samples of the first are looked up in the second's grid.
 "scaphotrapezial" is the STT joint (the trapezium's and trapezoid's facets on the scaphoid's distal
 pole), "trapeziocapitate" the radial column against the capitate (chiefly the trapezoid–capitate joint),
 "ulnocarpal" the lunate and triquetrum on the ulnar head through the TFCC, a compliant layer on the ulna
-filling the ulnocarpal space (`builder.pipeline`): the ulnar load path (Palmer & Werner 1984)."""
+filling the ulnocarpal space (`builder.pipeline`): the ulnar load path (Palmer & Werner 1984).
+"capitohamate" is the hamate against the capitate, "triquetrohamate" the lunate body (the triquetrum,
+and the lunate where it reaches the hamate: a type II lunate's hamate facet, Viegas 1990) on the hamate."""
 ARTICULATIONS = {
     "radioscaphoid": ("radioscaphoid", ("scaphoid",)),
     "radiolunate": ("radiolunate", ("lunate", "triquetrum")),
@@ -81,14 +97,16 @@ ARTICULATIONS = {
     "scaphotrapeziotrapezoid": ("scaphotrapezial", ("trapezium", "trapezoid")),
     "scaphocapitate": ("scaphocapitate", ("capitate",)),
     "lunocapitate": ("lunocapitate", ("capitate",)),
-    "triquetrohamate": ("lunocapitate", ("hamate",)),
+    "triquetrohamate": ("triquetrohamate", ("triquetrum",)),
+    "lunohamate": ("triquetrohamate", ("lunate",)),
     "trapeziocapitate": ("trapeziocapitate", ("trapezium", "trapezoid")),
     "ulnolunate": ("ulnocarpal", ("lunate",)),
     "ulnotriquetral": ("ulnocarpal", ("triquetrum",)),
+    "capitohamate": ("capitohamate", ("hamate",)),
 }
 """Each articulation as (contact pair, the parts of the pair's sample body on its side): a pair whose
-sample body holds several bones (`BODY_PARTS`) spans several joints (the capitate body's samples
-against the lunate body are the lunocapitate joint on the capitate, the triquetrohamate on the hamate)."""
+sample body holds several bones (`BODY_PARTS`) spans several joints (the lunate body's samples on the
+hamate are the triquetrohamate joint on the triquetrum, the lunohamate on the lunate)."""
 MIDCARPAL = ("scaphotrapeziotrapezoid", "scaphocapitate", "lunocapitate", "triquetrohamate")
 """The midcarpal articulations whose load shares Viegas 1993 measured (STT, SC, LC, TH)."""
 
@@ -97,20 +115,20 @@ MIDCARPAL = ("scaphotrapeziotrapezoid", "scaphocapitate", "lunocapitate", "triqu
 class Model:
     """A participant model.
 
-    Bones (6, `BONES` order):
-        vertices (V, 3) mm, vertex_offsets (7,); faces (F, 3) local indices, face_offsets (7,);
+    Bones (7, `BONES` order):
+        vertices (V, 3) mm, vertex_offsets (8,); faces (F, 3) local indices, face_offsets (8,);
         vertex_part (V,) index into `BODY_PARTS[body]` of the bone each vertex belongs to;
         thickness (V,) mm, cartilage thickness per vertex (0 off cartilage);
-        mass (6,) t; com (6, 3) mm; inertia (6, 3, 3) t·mm² about the com, RCS axes;
-        centroid (6, 3) mm, volume centroid of each body's principal bone alone (the point
+        mass (7,) t; com (7, 3) mm; inertia (7, 3, 3) t·mm² about the com, RCS axes;
+        centroid (7, 3) mm, volume centroid of each body's principal bone alone (the point
         whose motion the kinematic cost tracks; the lunate's without the triquetrum).
     Contact grids (one per bone; empty for the radial column; the ulna's its head, closed, with the TFCC):
-        grid_origin (6, 3) mm; grid_spacing (6,) mm; grid_shape (6, 3);
-        grid_values (G,) float32 mm, C-order per bone, grid_offsets (7,).
-    Contact samples (pair-sorted, 7 pairs in `PAIRS` order, bones in `PAIR_BONES`):
+        grid_origin (7, 3) mm; grid_spacing (7,) mm; grid_shape (7, 3);
+        grid_values (G,) float32 mm, C-order per bone, grid_offsets (8,).
+    Contact samples (pair-sorted, 10 pairs in `PAIRS` order, bones in `PAIR_BONES`):
         sample_points (S, 3) mm on the sample bone's cartilage surface; sample_normals (S, 3);
         sample_area (S,) mm²; sample_thickness (S,) mm, total cartilage thickness of both layers;
-        sample_offsets (8,).
+        sample_offsets (11,).
     contact_law (5,): tri-linear pressure–strain law [e1, e2, k1, k2, k3] (strain, MPa).
     Ligament fibres (1D bundles, Table 2 order):
         fibre_ligament (N,) ligament index; fibre_bones (N, 2) origin, insertion bone;

@@ -5,7 +5,8 @@ z radial) by an anatomical rule quoted from the descriptions the preprint
 cites (Table 2): Berger 2001 (SLIL regions, RSC, LRL), Nagao 2005 (SRL, DRC,
 UL), Mizuseki 1989 (DRC), Ringler 2013 (RCL), Apergis 2013 (SCL), Moritomo
 2013 (UCL); Berger 2001 and Garcia-Elias 2017 for the fixed TC and TH; Garcia-Elias 1989,
-Nanno 2006 and Bettinger 1999 for the radial column's TZC_p, TZC_d and STT. A rule
+Nanno 2006 and Bettinger 1999 for the radial column's TZC_p, TZC_d and STT; Ritt 1996 for the
+hamate's capitohamate CH_deep, CH_d and CH_p. A rule
 picks the extreme vertex of a bone region along an anatomical direction; the patch is the bone surface within `radius_mm` of it.
 Cartilage coverage is the part of each bone facing its partner within a gap.
 
@@ -171,8 +172,7 @@ def main() -> None:
     ligaments["TH"] = {
         "origin": tri,
         "insertion": {
-            "bone": "capitate",
-            "part": "hamate",
+            "bone": "hamate",
             "radius_mm": 2.0,
             "centre_mm": np.round(extreme(V["hamate"], (1, 0.3, 0.3), hamate_body), 3).tolist(),
         },
@@ -197,6 +197,29 @@ def main() -> None:
                 "centre_mm": np.round(extreme(V["capitate"], direction, c_tz), 3).tolist(),
             },
         }
+    # The hamate (its own body, issue 54): bound to the capitate by the capitohamate interosseous
+    # ligament's three regions (Ritt, Berger, Bishop & An 1996, J Hand Surg Br 21:451): dorsal and
+    # palmar bands spanning the dorsal and palmar edges of the joint, and the deep band between the
+    # facing surfaces at the joint's distal end, midway dorsopalmarly. Each band runs across the
+    # joint: its capitate end is the capitate's extreme along the same direction within 2 mm of its
+    # hamate end proximodistally (and, for the deep band, dorsopalmarly).
+    h_c, c_h = near("hamate", "capitate", 2.5), near("capitate", "hamate", 2.5)
+    middle = np.abs(V["hamate"][:, 0] - V["hamate"][h_c, 0].mean()) < 2.0
+    for name, direction, hamate_end in (
+        ("CH_p", (1, 0, 0), extreme(V["hamate"], (1, 0, 0), h_c)),
+        ("CH_d", (-1, 0, 0), extreme(V["hamate"], (-1, 0, 0), h_c)),
+        ("CH_deep", (0, -1, 0), extreme(V["hamate"], (0, -1, 0), h_c & middle)),
+    ):
+        axes = [1] if name != "CH_deep" else [0, 1]
+        level = c_h & (np.abs(V["capitate"][:, axes] - hamate_end[axes]) < 2.0).all(axis=1)
+        ligaments[name] = {
+            "origin": {"bone": "hamate", "radius_mm": 2.0, "centre_mm": np.round(hamate_end, 3).tolist()},
+            "insertion": {
+                "bone": "capitate",
+                "radius_mm": 2.0,
+                "centre_mm": np.round(extreme(V["capitate"], direction, level), 3).tolist(),
+            },
+        }
     ligaments["STT"] = {
         "origin": {
             "bone": "scaphoid",
@@ -209,8 +232,7 @@ def main() -> None:
             "centre_mm": np.round(extreme(V["trapezium"], (1, 0.5, 0)), 3).tolist(),
         },
     }
-    # Articulations are between rigid bodies: the lunocapitate one includes the triquetrum
-    # against the hamate (Moritomo 2013: the helicoid triquetrohamate joint); the radial column
+    # Articulations are between rigid bodies; the radial column
     # meets the scaphoid's distal pole (the STT joint) and the capitate (the trapezoid–capitate
     # joint) as articulations of its own.
     cartilage = {
@@ -224,6 +246,10 @@ def main() -> None:
         # the TFCC fills the ulnocarpal space: the lunate lies 5.8-6.6 mm and the triquetrum 8.8-10.1 mm
         # from the template's ulnar head (issue 33); the disc covers the head's distal face
         "ulnocarpal": {"bones": ["ulna", "lunate"], "max_gap_mm": 10.5},
+        # the hamate, its own body (issue 54): against the capitate, and the lunate body on it (the
+        # triquetrum's helicoid facet; the lunate's, where a type II lunate reaches it)
+        "capitohamate": {"bones": ["hamate", "capitate"], "max_gap_mm": 2.5},
+        "triquetrohamate": {"bones": ["lunate", "hamate"], "max_gap_mm": 2.5},
     }
     data = {
         "about": "wrist-env template annotations in the template RCS (mm); written by experiments/authoring/make_annotations.py",

@@ -390,8 +390,8 @@ def test_too_few_faces(folder):
 
 def test_bad_trial_csv_names_its_file(folder):
     path = folder / "trials" / "resisted.csv"
-    path.write_text(path.read_text().replace(",lunate,", ",hamate,", 1))
-    with raises(TrialError, path, "line 5 has 'hamate'"):
+    path.write_text(path.read_text().replace(",lunate,", ",pisiform,", 1))  # no body of the model's
+    with raises(TrialError, path, "line 5 has 'pisiform'"):
         load_participant_folder(folder)
 
 

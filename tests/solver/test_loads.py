@@ -67,17 +67,18 @@ def test_lines_on_the_driven_capitate_act_as_their_resultant_and_the_columns_do_
     resultant on the capitate ends (their moments go to the driver), to 1e-3 mm and 1e-3 N: the same
     forces summed in another order change a hold's last steps, and a hold stops at a net force of
     0.01 N, which a soft direction (~10 N/mm) leaves 1e-3 mm from its balance; the radial column's lines (1st and 2nd rays) load a free body, so moving them to
-    the capitate as a resultant changes the answer (the STT joint's force by more than 1 N). Each run
+    the capitate as a resultant changes the answer (the STT joint's force by more than 1 N), and so do
+    the hamate's (4th and 5th rays, FCU through the pisiform: the triquetrohamate joint's force). Each run
     balances (every free body's net force under 0.05 N)."""
     from dataclasses import replace
 
-    from wrist_env.model import PAIRS, TRAPEZIUM
+    from wrist_env.model import HAMATE, PAIRS, TRAPEZIUM
     from wrist_env.solver.simulate import simulate
 
     rig = loaded(p1, [np.eye(3)], 100.0, direction="erhart2020")
-    assert set(rig.loads.body) == {BONES.index("capitate"), TRAPEZIUM}
-    stt = PAIRS.index("scaphotrapezial")
-    for body in (BONES.index("capitate"), TRAPEZIUM):
+    assert set(rig.loads.body) == {BONES.index("capitate"), TRAPEZIUM, HAMATE}
+    joint = {TRAPEZIUM: PAIRS.index("scaphotrapezial"), HAMATE: PAIRS.index("triquetrohamate")}
+    for body in (BONES.index("capitate"), TRAPEZIUM, HAMATE):
         keep = rig.loads.body == body
         share = rig.loads.share[keep] / rig.loads.share[keep].sum()
         part = replace(
@@ -94,8 +95,9 @@ def test_lines_on_the_driven_capitate_act_as_their_resultant_and_the_columns_do_
         resultant = loaded(p1, [np.eye(3)], float(np.linalg.norm(total)), direction=total)
         a, b = (simulate(p1, design.population(), d) for d in (part, resultant))
         assert a.ok and b.ok and a.settled.all() and a.residual[0, 0] < 0.05, (a.message, a.residual)
-        if body == TRAPEZIUM:
-            assert abs(a.contact[0, stt, 3] - b.contact[0, stt, 3]) > 1.0, (a.contact[0, stt], b.contact[0, stt])
+        if body in joint:
+            j = joint[body]
+            assert abs(a.contact[0, j, 3] - b.contact[0, j, 3]) > 1.0, (BONES[body], a.contact[0, j], b.contact[0, j])
         else:
             assert np.abs(a.poses - b.poses).max() < 1e-3
             assert np.abs(a.contact[..., 3] - b.contact[..., 3]).max() < 1e-3
@@ -106,3 +108,40 @@ def test_lines_need_a_known_rig(p1):
         loads(p1, "sideways")
     with pytest.raises(ValueError, match="rig"):
         model_lines(p1, "no_such_rig")
+
+
+def test_the_capitohamate_joint_resists_a_shift_and_a_turn_in_its_plane_by_ritts_constraint(p1):
+    """`forces.joint_forces` (the capitohamate joint's in-plane constraint, `design.CH_JOINT_STIFFNESS` from
+    Ritt 1996): the hamate moved by 0.5 mm along the joint's dorsopalmar axis, 0.3 mm proximodistally and
+    0.2 mm along the normal, and turned 5 deg about the normal, gets back 30.8 N/mm × 0.5 and × 0.3 mm in
+    the plane, nothing along the normal, and −3.18 N·m/rad × 5 deg about it plus the shift's lever; the
+    capitate gets the opposite force and moment (about its own centre point)."""
+    from scipy.spatial.transform import Rotation
+
+    from wrist_env.design import CH_JOINT_STIFFNESS
+    from wrist_env.model import CAPITATE, HAMATE
+    from wrist_env.solver.forces import joint_forces
+
+    p = prepare(p1, mode=1)
+    bod = p.bodies
+    centre, axes = bod.joint_centre, bod.joint_axes
+    assert np.allclose(axes @ axes.T, np.eye(3)) and axes[2, 2] > 0.8  # the normal is radioulnar
+    R = np.tile(np.eye(3), (len(BONES), 1, 1))
+    turn = np.radians(5.0)
+    R[HAMATE] = Rotation.from_rotvec(turn * axes[2]).as_matrix()
+    x = bod.com0.copy()
+    shift = 0.5 * axes[0] + 0.3 * axes[1] + 0.2 * axes[2]
+    # the hamate's centre point (its neutral place of the joint's centre) at centre + shift
+    x[HAMATE] = centre + shift - R[HAMATE] @ (centre - bod.com0[HAMATE])
+    F, T = np.zeros((len(BONES), 3)), np.zeros((len(BONES), 3))
+    energy = joint_forces(R, x, bod.com0, bod, F, T, True)
+    k = CH_JOINT_STIFFNESS
+    force = -(k[0] * 0.5 * axes[0] + k[1] * 0.3 * axes[1])
+    np.testing.assert_allclose(F[HAMATE], force, atol=1e-9)
+    np.testing.assert_allclose(F[CAPITATE], -force, atol=1e-9)
+    lever_h = centre + shift - x[HAMATE]
+    np.testing.assert_allclose(T[HAMATE], np.cross(lever_h, force) - k[5] * turn * axes[2], atol=1e-6)
+    np.testing.assert_allclose(T[CAPITATE], np.cross(centre - x[CAPITATE], -force) + k[5] * turn * axes[2], atol=1e-6)
+    assert energy == pytest.approx(0.5 * (k[0] * 0.25 + k[1] * 0.09 + k[5] * turn**2))
+    assert k[0] == k[1] == pytest.approx(20 / 0.65)
+    assert k[5] == pytest.approx(500 / np.radians(9.0)) and k[2] == k[3] == k[4] == 0.0

@@ -86,7 +86,9 @@ def test_substeps_relax_the_nodes_to_their_equilibrium(p1):
 def _rigid_path(t):
     """Rotations (n_bodies, 3, 3) and centres (n_bodies, 3) mm on a screw path: each body turns 0.05 rad
     per unit t about its own axis and moves 0.3 mm per unit t."""
-    axes = np.array([[0, 0, 1.0], [1.0, 0, 0], [0, 1.0, 0], [1.0, 1.0, 0], [0, 1.0, 1.0], [1.0, 0, 1.0]])[:N_BODIES]
+    axes = np.array(
+        [[0, 0, 1.0], [1.0, 0, 0], [0, 1.0, 0], [1.0, 1.0, 0], [0, 1.0, 1.0], [1.0, 0, 1.0], [1.0, 1.0, 1.0]]
+    )[:N_BODIES]
     R = np.stack([Rotation.from_rotvec(0.05 * t * a / np.linalg.norm(a)).as_matrix() for a in axes])
     x = np.arange(3.0 * N_BODIES).reshape(N_BODIES, 3) + 0.3 * t * axes
     return R, x

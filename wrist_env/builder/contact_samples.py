@@ -44,6 +44,9 @@ def _contact_samples(bones, thickness, coverage, params):
     displaced = {b: displaced_vertices(bones[b].vertices, bones[b].faces, thickness[b]) for b in paired}
     for p, art in enumerate(PAIRS):
         a, b = BONES[PAIR_BONES[p][0]], BONES[PAIR_BONES[p][1]]
+        if art not in coverage:  # an articulation this variant lacks (`pipeline.ABSENT_WITHOUT_DISTAL_ROW`)
+            sizes.append(0)
+            continue
         ca, cb = coverage[art][2], coverage[art][3]
         if coverage[art][0] != a:
             ca, cb = cb, ca

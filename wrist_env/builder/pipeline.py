@@ -24,12 +24,12 @@ from wrist_env.builder.digest import source_hash
 from wrist_env.builder.handedness import check_side
 from wrist_env.builder.params import BuildParams
 from wrist_env.builder.surface import displaced_vertices, extrusion_directions, gap_to, grnn_smooth
-from wrist_env.design import ALL_LIGAMENTS, COLUMN_LIGAMENTS, LIGAMENT_NAMES, LIGAMENTS, RSC_INDEX
+from wrist_env.design import ALL_LIGAMENTS, BODY_LIGAMENTS, LIGAMENT_NAMES, LIGAMENTS, RSC_INDEX
 from wrist_env.errors import BuildError
 from wrist_env.model import BONES, PAIRS, Model, offsets
 
 BUILD_STEPS = ("morph", "cartilage", "ligaments", "contact_law", "grids", "mass")  # timed in the report
-GRID_BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate")
+GRID_BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate", "hamate")
 TFCC = "ulnocarpal"
 """The pair through the TFCC: its articular disc and meniscus homologue fill the ulnocarpal space
 between the ulnar head and the lunate and triquetrum (Palmer & Werner 1981), so the disc is a layer
@@ -104,7 +104,7 @@ def _transfer(morphs: dict, bones: dict, params: BuildParams) -> tuple[dict, dic
 def _ligaments(bones: dict, sites: dict, params: BuildParams):
     bundles, membrane = [], None
     for k, lig in enumerate(ALL_LIGAMENTS):
-        optional = lig not in LIGAMENTS and lig.name not in COLUMN_LIGAMENTS
+        optional = lig not in LIGAMENTS and lig.name not in BODY_LIGAMENTS
         if lig.name not in sites or (optional and not params.fixed_ligaments):
             continue  # a fixed TC/TH, in a model without the distal row or without them
         (ob, om), (ib, im) = sites[lig.name]
@@ -135,6 +135,11 @@ def _ligaments(bones: dict, sites: dict, params: BuildParams):
             )
         )
     return bundles, membrane
+
+
+ABSENT_WITHOUT_DISTAL_ROW = ("triquetrohamate",)
+"""Articulations a model without the distal row (`BuildParams.distal_row`) has no cartilage of: the
+triquetrohamate pair is the lunate body's triquetrum on the hamate; its pair stays, without samples."""
 
 
 def tfcc_thickness(
@@ -227,6 +232,8 @@ def build_model(
     morphs, morph_report = _morph_all(bones, params, workers)
     lap("morph")
     coverage, sites, relocated = _transfer(morphs, bones, params)
+    if not params.distal_row:  # the lunate without its triquetrum reaches no hamate (a type I lunate)
+        coverage = {art: c for art, c in coverage.items() if art not in ABSENT_WITHOUT_DISTAL_ROW}
     articulations = {(a, b): (ma, mb) for art, (a, b, ma, mb) in coverage.items() if art != TFCC}
     verts = {b: bones[b].vertices for b in BONES}
     faces = {b: bones[b].faces for b in BONES}

@@ -28,13 +28,15 @@ BONE_COLOUR = {
     "lunate": "#e3d5bd",
     "capitate": "#eadfcf",
     "trapezium": "#e6d9c4",
+    "hamate": "#e1d3bf",
 }
 DISTAL_CROP_MM = 12.0  # radius and ulna are drawn by their distal end only (RCS y below this, mm)
 VIEWS = (("volar view", 0, 0), ("radial view", 0, 90), ("oblique", 25, 40))
 LIGAMENT_COLOURS = dict(
     zip(
         ALL_LIGAMENT_NAMES,
-        plt.get_cmap("tab10").colors + ("#000000", "#7a5195", "#ef5675", "#ffa600", "#003f5c", "#58508d"),
+        plt.get_cmap("tab10").colors
+        + ("#000000", "#7a5195", "#ef5675", "#ffa600", "#003f5c", "#58508d", "#bc5090", "#2f4b7c", "#a05195"),
     )
 )
 

@@ -11,12 +11,12 @@ from collections import namedtuple
 
 import numpy as np
 
-from wrist_env.design import RSC_INDEX, Design, ligament_arrays
-from wrist_env.model import BONES, PAIR_BONES, Model
+from wrist_env.design import CH_JOINT_STIFFNESS, RSC_INDEX, Design, ligament_arrays
+from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model
 from wrist_env.solver.contact import nodal_normals
 from wrist_env.solver.settings import SolverSettings
 
-Bodies = namedtuple("Bodies", "com0 inv_mass inv_inertia mass inertia")
+Bodies = namedtuple("Bodies", "com0 inv_mass inv_inertia mass inertia joint_centre joint_axes joint_stiffness")
 Grids = namedtuple(
     "Grids",
     "pair_bones sample_offsets points thickness area values offsets shape origin spacing normals pair_centre pair_reach",
@@ -46,7 +46,28 @@ def bodies(model: Model, s: SolverSettings) -> Bodies:
     inertia = model.inertia * (s.mass_scale * s.inertia_scale)
     inv_mass = np.where(mass > 0, 1.0 / np.where(mass > 0, mass, 1.0), 0.0)
     inv_inertia = np.array([np.linalg.inv(I) if m > 0 else np.zeros((3, 3)) for I, m in zip(inertia, mass)])
-    return Bodies(np.ascontiguousarray(model.com), inv_mass, inv_inertia, mass, inertia)
+    return Bodies(np.ascontiguousarray(model.com), inv_mass, inv_inertia, mass, inertia, *capitohamate_joint(model))
+
+
+def capitohamate_joint(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The capitohamate joint's in-plane constraint (`forces.joint_forces`): its centre (3,) mm, the
+    area-weighted mean of the hamate's contact samples on the capitate at neutral; its axes (3, 3), rows
+    in the RCS at neutral (carried by the capitate): dorsopalmar (the RCS volar axis x in the joint's
+    plane), proximodistal in the plane, and the normal (the samples' area-weighted mean normal, hamate to
+    capitate); and its stiffness (6,) along and about them (`design.CH_JOINT_STIFFNESS`). A model without
+    samples on that pair (a synthetic test model) gets zero stiffness."""
+    k = PAIRS.index("capitohamate")
+    lo, hi = model.sample_offsets[k], model.sample_offsets[k + 1]
+    area = np.asarray(model.sample_area[lo:hi], np.float64)
+    if hi <= lo or area.sum() <= 0:
+        return np.zeros(3), np.eye(3), np.zeros(6)
+    centre = area @ np.asarray(model.sample_points[lo:hi], np.float64) / area.sum()
+    normal = area @ np.asarray(model.sample_normals[lo:hi], np.float64)
+    normal /= np.linalg.norm(normal)
+    volar = np.array([1.0, 0.0, 0.0]) - normal[0] * normal
+    volar /= np.linalg.norm(volar)
+    axes = np.vstack([volar, np.cross(normal, volar), normal])
+    return centre, np.ascontiguousarray(axes), np.array(CH_JOINT_STIFFNESS, dtype=np.float64)
 
 
 _NORMALS: dict[int, tuple[weakref.ref, np.ndarray]] = {}

@@ -41,6 +41,7 @@ from wrist_env.solver.forces import (
     apply_force,
     contact_forces,
     fibre_forces,
+    joint_forces,
     to_world,
 )
 from wrist_env.solver.integrator import fire_step, kinetic_energy, move_blocks, move_diagonal
@@ -77,6 +78,7 @@ def net_forces(state, work, system, stiffness, load, rebuild, want_energy, smoot
     band = st.active_band_mm
     energy = contact_forces(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, want_energy, smooth)
     energy += fibre_forces(R, x, v, w, com0, fib, f_l0, f_K, st.fibre_damping_s, F, T, bundle, want_energy)
+    energy += joint_forces(R, x, com0, bod, F, T, want_energy)
     k_mem = st.membrane_contact_stiffness
     e_mem, rsc = membrane_forces(R, x, com0, mem, nodes, m_l0, m_K, k_mem, F, T, node_force, want_energy, smooth)
     energy += e_mem

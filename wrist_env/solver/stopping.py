@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from wrist_env.model import CAPITATE, TRAPEZIUM
+from wrist_env.model import CAPITATE, HAMATE, TRAPEZIUM
 from wrist_env.solver.arrays import EXPERIMENTAL
 from wrist_env.solver.preconditioner import SOLVED
 from wrist_env.solver.rigid import LEVER_MM
@@ -16,11 +16,12 @@ from wrist_env.solver.rigid import LEVER_MM
 @njit(cache=True, error_model="numpy")
 def displacement(R, x, com0, b):
     """How far (mm) free body b has moved from its place: the proximal row's (scaphoid, lunate) from its
-    neutral place on the radius; the radial column's from where the capitate carries it (the distal
-    row moves as one, Akhbari 2019; at ±40° the capitate carries the column's centre 15–18 mm)."""
+    neutral place on the radius; the radial column's and the hamate's (`model.CARRIED`) from where the
+    capitate carries them (the distal row moves as one, Akhbari 2019; at ±40° the capitate carries the
+    column's centre 15–18 mm)."""
     d2 = 0.0
     for i in range(3):
-        if b == TRAPEZIUM:
+        if b == TRAPEZIUM or b == HAMATE:
             carried = 0.0
             for j in range(3):
                 carried += R[CAPITATE, i, j] * (com0[b, j] - com0[CAPITATE, j])

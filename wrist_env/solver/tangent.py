@@ -4,7 +4,9 @@ reference (`equilibrium`) take.
 K is the Gauss–Newton tangent of the force kernels: each overclosed contact
 sample κ·JJᵀ with J = [n; r×n] and κ = p′(ε)·A/h; each taut fibre, and each RSC
 connector at its attached ends, dT/dl·uuᵀ + T/L·(I − uuᵀ) between its ends; the
-membrane's free nodes' contact with the scaphoid k·nnᵀ. No geometric terms of
+membrane's free nodes' contact with the scaphoid k·nnᵀ; the capitohamate joint's
+in-plane spring (`forces.joint_forces`) Σ kₖeₖeₖᵀ between its centre points and
+Σ k₃₊ₖeₖeₖᵀ on the hamate's rotations. No geometric terms of
 the moments. Coordinates per bone: shift (mm, world) then rotation (rad, world),
 as `equilibrium.tangent_stiffness`.
 """
@@ -14,8 +16,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from wrist_env.model import CAPITATE, HAMATE
 from wrist_env.solver.contact import law_slope, sdf_lookup_scalar
-from wrist_env.solver.forces import pair_transform, sample_lookup, sample_lookup_smooth, to_local, to_world
+from wrist_env.solver.forces import pair_transform, rotate, sample_lookup, sample_lookup_smooth, to_local, to_world
 from wrist_env.solver.ligaments import blankevoort_force, blankevoort_slope
 from wrist_env.solver.preconditioner import dof
 
@@ -196,6 +199,32 @@ def tangent(R, x, nodes, system, stiffness, active, n_active, m, smooth):
         pb = (nodes[j, 0], nodes[j, 1], nodes[j, 2])
         _element(K, st, m, a, pa, b, pb, x, stiffness.m_K[c], stiffness.m_l0[c], ra, rb)
     _membrane_contact(K, st, m, R, x, com0, mem, nodes, ra, rb)
+    _joint(K, st, m, R, x, com0, system.bodies, ra, rb)
+
+
+@njit(cache=True, error_model="numpy")
+def _joint(K, st, m, R, x, com0, bod, ra, rb):
+    """The capitohamate joint's spring (`forces.joint_forces`): its shift stiffness between the hamate's and
+    the capitate's centre points, its turn stiffness on the hamate's rotations (the capitate's rotations are
+    prescribed: no unknowns)."""
+    k = bod.joint_stiffness
+    c, E = bod.joint_centre, bod.joint_axes
+    k_shift = m.coupling
+    k_shift[:] = 0.0
+    i0, n = dof(st, HAMATE)
+    for a in range(3):
+        e = rotate(R, CAPITATE, E[a, 0], E[a, 1], E[a, 2])
+        for p in range(3):
+            for q in range(3):
+                k_shift[p, q] += k[a] * e[p] * e[q]
+                if i0 >= 0:
+                    K[i0 + 3 + p, i0 + 3 + q] += k[3 + a] * e[p] * e[q]
+    ph = to_world(R, x, com0, HAMATE, c[0], c[1], c[2])
+    pc = to_world(R, x, com0, CAPITATE, c[0], c[1], c[2])
+    for e in range(3):
+        ra[e] = ph[e] - x[HAMATE, e]
+        rb[e] = pc[e] - x[CAPITATE, e]
+    add_point(K, st, HAMATE, ra, CAPITATE, rb, m)
 
 
 @njit(cache=True, error_model="numpy")

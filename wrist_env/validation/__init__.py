@@ -24,6 +24,7 @@ from wrist_env.validation.checks import validate
 from wrist_env.validation.measures import (
     at_angle,
     column_rotation_deg,
+    hamate_rotation_deg,
     load_shares_pct,
     sl_gap_mm,
     slope,
@@ -35,5 +36,5 @@ from wrist_env.validation.report import Check, Report, _row, format_table
 __all__ = [
     "EXTENSION_30_DEG", "NEUTRAL_LOAD_N", "RAINBOW_LUNATE", "RAINBOW_SCAPHOID", "SL_DISSOCIATION_MM", "SLIL",
     "SOURCES", "ULNAR_SHARE_PCT", "VIEGAS_1993", "Check", "Report", "_row", "at_angle", "column_rotation_deg",
-    "format_table", "load_shares_pct", "sl_gap_mm", "slope", "surface_gap_mm", "validate", "with_tears",
+    "format_table", "hamate_rotation_deg", "load_shares_pct", "sl_gap_mm", "slope", "surface_gap_mm", "validate", "with_tears",
 ]  # fmt: skip

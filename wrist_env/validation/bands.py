@@ -52,6 +52,11 @@ SOURCES = {
         "Akhbari et al. 2019, J Orthop Res 37:2661-2670 (in-vivo CT, the distal row moves as one rigid "
         "body within 3 deg)"
     ),
+    "hamate_rotation_deg": (
+        "Akhbari et al. 2019, J Orthop Res 37:2661-2670 (in-vivo CT, the distal row moves as one rigid "
+        "body within 3 deg); the capitohamate joint rotates ~9 deg under 0.5 N m with its ligaments "
+        "intact (Ritt et al. 1996, J Hand Surg Br 21:451)"
+    ),
     "slil_force_30ext_n": (
         "Dimitris et al. 2015, J Hand Surg Am 40:1525-1533 (total SLIL force in active wrist "
         "motion ~20 N, 20.0 +- 3.3 N at 30 deg extension; the preprint's ref. 63)"

@@ -1,4 +1,4 @@
-"""`validate`: the population design's three runs and the thirteen checks against published bands."""
+"""`validate`: the population design's three runs and the fourteen checks against published bands."""
 
 from __future__ import annotations
 
@@ -26,7 +26,15 @@ from wrist_env.validation.bands import (
     ULNAR_SHARE_PCT,
     VIEGAS_1993,
 )
-from wrist_env.validation.measures import at_angle, column_rotation_deg, load_shares_pct, sl_gap_mm, slope, with_tears
+from wrist_env.validation.measures import (
+    at_angle,
+    column_rotation_deg,
+    hamate_rotation_deg,
+    load_shares_pct,
+    sl_gap_mm,
+    slope,
+    with_tears,
+)
 from wrist_env.validation.report import Report, _row
 
 if TYPE_CHECKING:
@@ -165,6 +173,14 @@ def validate(
             "column_rotation_deg",
             "largest rotation of the radial column (trapezium + trapezoid) relative to the capitate over the sweep",
             column_rotation_deg(intact.poses) if intact.ok else np.nan,
+            (0.0, 3.0),
+            "deg",
+            fail_i,
+        ),
+        _row(
+            "hamate_rotation_deg",
+            "largest rotation of the hamate relative to the capitate over the sweep",
+            hamate_rotation_deg(intact.poses) if intact.ok else np.nan,
             (0.0, 3.0),
             "deg",
             fail_i,

@@ -1,4 +1,4 @@
-"""What `validate` measures on a run: slopes, the SL gap, load shares, the radial column's turn."""
+"""What `validate` measures on a run: slopes, the SL gap, load shares, the radial column's and the hamate's turns."""
 
 from __future__ import annotations
 
@@ -10,15 +10,26 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from wrist_env import design as design_mod
-from wrist_env.model import BONES, CAPITATE, MIDCARPAL, TRAPEZIUM, Model
+from wrist_env.model import BONES, CAPITATE, HAMATE, MIDCARPAL, TRAPEZIUM, Model
 from wrist_env.solver.outputs import articulation_forces
 
 
-def column_rotation_deg(poses: np.ndarray) -> float:
-    """The radial column's largest rotation (deg) relative to the capitate over a run's poses (n, 6, 4, 4)."""
-    relative = np.einsum("fij,fkj->fik", poses[:, TRAPEZIUM, :3, :3], poses[:, CAPITATE, :3, :3])
+def rotation_from_capitate_deg(poses: np.ndarray, body: int) -> np.ndarray:
+    """The rotation (deg, per frame) of `body` relative to the capitate over a run's poses (n, 7, 4, 4)."""
+    relative = np.einsum("fij,fkj->fik", poses[:, body, :3, :3], poses[:, CAPITATE, :3, :3])
     cos = np.clip((np.trace(relative, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
-    return float(np.degrees(np.arccos(cos)).max())
+    return np.degrees(np.arccos(cos))
+
+
+def column_rotation_deg(poses: np.ndarray) -> float:
+    """The radial column's largest rotation (deg) relative to the capitate over a run's poses (n, 7, 4, 4)."""
+    return float(rotation_from_capitate_deg(poses, TRAPEZIUM).max())
+
+
+def hamate_rotation_deg(poses: np.ndarray) -> float:
+    """The hamate's largest rotation (deg) relative to the capitate over a run's poses (n, 7, 4, 4): the
+    distal row moves rigidly together, < 3 deg (Akhbari 2019, J Orthop Res 37:2661)."""
+    return float(rotation_from_capitate_deg(poses, HAMATE).max())
 
 
 def slope(x: ArrayLike, y: ArrayLike) -> float:
