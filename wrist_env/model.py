@@ -50,7 +50,11 @@ interosseous ligaments of measured constraint (Ritt, Berger, Bishop & An 1996, J
 rigidly together, < 3 deg: Akhbari 2019, J Orthop Res 37:2661; `validation` checks it)."""
 SUPPLIED = ("radius", "ulna", "scaphoid", "lunate", "capitate")
 """The bodies a participant folder supplies meshes of (the principal bones); the radial column, the
-hamate and the other parts are carried from the template with the capitate (`anatomy.template.carry_parts`)."""
+hamate and the other parts are carried from the template with the capitate (`anatomy.template.carry_parts`)
+unless the folder gives them too (`OPTIONAL_BONES`)."""
+OPTIONAL_BONES = ("triquetrum", "trapezium", "trapezoid", "hamate")
+"""The bones a participant folder may give besides `SUPPLIED` (a CT segmentation has them): each one given
+is used as it is, each one not given is carried from the template (`anatomy.template.carry_parts`)."""
 CARPALS = ("scaphoid", "lunate", "capitate")
 """The carpals a participant supplies meshes of and a trial tracks (the forearm bones are the radius and ulna)."""
 CARRIED_WITH = {"trapezium": "capitate", "hamate": "capitate"}

@@ -7,7 +7,8 @@ import trimesh
 
 from wrist_env.anatomy.annotations import template_annotations
 from wrist_env.anatomy.myosim import load_myosim_anatomy
-from wrist_env.anatomy.template import JOINT_SPACE_MM, BoneSurface, closed, load_template
+from wrist_env.anatomy.template import JOINT_SPACE_MM, BoneSurface, carry_parts, closed, load_template
+from wrist_env.model import SUPPLIED
 
 
 @pytest.fixture(scope="module")
@@ -112,3 +113,16 @@ def test_the_rebuilt_fossae_end_at_the_radius_ulnar_border():
     border = ulnar_corner(radius_bone(radius))[2]
     cap_z = radius.vertices[radius.solid][:, 2]
     assert border - 0.4 - 1e-9 <= cap_z.min() <= border + 1.0, (cap_z.min(), border)
+
+
+def test_a_given_bone_is_used_as_given_and_the_others_carried():
+    """A participant's own hamate (issue 54 step 8) replaces the template's; the radial column, not given,
+    is still the template's carried by the registration of its capitate (here onto itself: in place)."""
+    template = load_template()
+    hamate = template.parts["hamate"]
+    own = BoneSurface("hamate", hamate.vertices + [0.0, 0.0, -0.5], hamate.faces, hamate.solid)
+    bodies = carry_parts({b: template.parts[b] for b in SUPPLIED}, template, True, {"hamate": own})
+    assert np.array_equal(bodies["hamate"].vertices, own.vertices)
+    np.testing.assert_allclose(bodies["trapezium"].vertices, template.bones["trapezium"].vertices, atol=0.05)
+    with pytest.raises(ValueError, match="given bones must be among"):
+        carry_parts({b: template.parts[b] for b in SUPPLIED}, template, True, {"capitate": own})

@@ -653,6 +653,54 @@ def test_swapped_bones_are_named_before_the_build(folder, first, second, value):
         load_participant_folder(folder)
 
 
+# --- issue 54: a folder may give its own triquetrum, trapezium, trapezoid and hamate -------
+
+HAMATE = (7.0, 11.0, 6.0)
+"""An ellipsoid hamate's semi-axes (mm): placed ulnar of `CARPALS`' capitate, touching it."""
+
+
+def add_bone(folder, bone: str, centre) -> None:
+    """An ellipsoid `HAMATE`-sized mesh at `centre` (mm), listed in [bones] after the capitate."""
+    mesh = trimesh.creation.icosphere(subdivisions=2)
+    mesh.apply_scale(HAMATE)
+    mesh.apply_translation(centre)
+    mesh.export(folder / "bones" / f"{bone}.stl")
+    edit_toml(
+        folder, 'capitate = "bones/capitate.stl"', f'capitate = "bones/capitate.stl"\n{bone} = "bones/{bone}.stl"'
+    )
+
+
+def test_a_folder_may_give_its_own_hamate(tmp_path, folder):
+    add_bone(folder, "hamate", (0.0, -28.0, -10.0))
+    loaded = load_participant_folder(folder)
+    assert tuple(loaded.bones) == SUPPLIED + ("hamate",)
+    again = load_participant_folder(write_participant_folder(loaded, tmp_path / "again"))
+    assert tuple(again.bones) == tuple(loaded.bones)
+    assert_same_triangles(again.bones["hamate"], loaded.bones["hamate"], atol=1e-5)
+
+
+@pytest.mark.parametrize(
+    "centre, value",
+    [
+        ((0.0, -28.0, -40.0), r"bones.hamate \(hamate.stl\) comes no nearer than 30.0 mm to the capitate"),
+        ((0.0, -28.0, 16.0), r"bones.hamate \(hamate.stl\) has its centroid 13.0 mm radial of the capitate's"),
+    ],
+    ids=["far", "wrong side"],
+)
+def test_a_given_bone_out_of_place_is_named(folder, centre, value):
+    """A given bone in another frame or unit, or on the wrong side of the bone it articulates with, is
+    refused when the folder is read, naming the entry and its file."""
+    add_bone(folder, "hamate", centre)
+    with raises(ParticipantError, folder / "participant.toml", value):
+        load_participant_folder(folder)
+
+
+def test_a_bone_the_model_has_no_place_for_is_refused(folder):
+    add_bone(folder, "pisiform", (0.0, -28.0, -10.0))
+    with raises(ParticipantError, folder / "participant.toml", r"may list any of \('triquetrum'.*extra=\['pisiform'\]"):
+        load_participant_folder(folder)
+
+
 # --- issue 53: islands, one file for two bones, paths -------------------------------------
 
 

@@ -11,7 +11,7 @@ from wrist_env.builder.params import BuildParams
 from wrist_env.builder.warp import random_warp
 from wrist_env.design import ALL_LIGAMENTS
 from wrist_env.errors import BuildError, ParticipantError
-from wrist_env.model import SUPPLIED
+from wrist_env.model import HAMATE, SUPPLIED
 from wrist_env.participants import registry
 from wrist_env.participants.folder import ParticipantSource, write_participant_folder
 from wrist_env.trial import Trial
@@ -22,7 +22,8 @@ pytestmark = pytest.mark.slow  # builds models or runs simulations/studies (minu
 def warped_template_folder(path, name="U1", seed=7):
     """A folder made from the template under a warp, with closed forearm bones as a CT
     segmentation would give: the radius as its articular solid plus the hull of its
-    shaft, the ulna as the hull of its distal end."""
+    shaft, the ulna as the hull of its distal end; it gives its own hamate (`model.OPTIONAL_BONES`),
+    the other distal carpals and the triquetrum carried from the template."""
     warp = random_warp(seed, amplitude_mm=0.7, width_mm=15.0, extent_mm=25.0)
     bones = {}
     for bone in SUPPLIED:
@@ -34,6 +35,8 @@ def warped_template_folder(path, name="U1", seed=7):
         if bone == "ulna":
             mesh = mesh.convex_hull.subdivide_to_size(max_edge=2.0)
         bones[bone] = (warp.apply(mesh.vertices), np.asarray(mesh.faces))
+    hamate = load_template().parts["hamate"].trimesh()  # given, as CT segments it (the rest carried)
+    bones["hamate"] = (warp.apply(hamate.vertices), np.asarray(hamate.faces))
     transforms = np.tile(np.eye(4), (3, 2, 1, 1))
     trial = Trial("unresisted", "calibrate", ("scaphoid", "lunate", "capitate"), transforms)
     source = ParticipantSource(name, {"side": "right", "sex": "female", "age": 30}, bones, {"unresisted": trial}, path)
@@ -50,6 +53,10 @@ def test_a_registered_folder_builds_a_model(tmp_path):
     for art, gap in model.report["joint_space_mm"].items():
         assert 0.5 <= gap <= 3.0, art
     assert model.report["morph_error_mm"]["scaphoid"]["mean"] < 0.1
+    given = registry._SOURCES["U1"].bones["hamate"][0]  # the folder's own hamate is the model's
+    hamate = model.vertices[model.vertex_offsets[HAMATE] : model.vertex_offsets[HAMATE + 1]]
+    np.testing.assert_allclose(hamate, given, atol=1e-6)
+    assert model.report["morph_error_mm"]["hamate"]["mean"] < 0.1
 
 
 def test_a_folder_cannot_take_a_builtin_name(tmp_path):

@@ -31,7 +31,7 @@ from wrist_env.anatomy.myosim import load_myosim_anatomy
 from wrist_env.anatomy.radius_cap import build_radius_cap
 from wrist_env.anatomy.ulnar_variance import ulnar_corner
 from wrist_env.builder.params import check_fossa_sweep
-from wrist_env.model import BODY_PARTS, BONES, CARPALS, CARRIED_WITH, PARTS, SUPPLIED
+from wrist_env.model import BODY_PARTS, BONES, CARPALS, CARRIED_WITH, OPTIONAL_BONES, PARTS, SUPPLIED
 
 ROW = ("scaphoid", "lunate")  # the proximal row bones that articulate with the radius
 JOINT_SPACE_MM = 1.5  # radiocarpal bone-to-bone joint space of the rebuilt fossae
@@ -117,20 +117,27 @@ def _registration(source: "BoneSurface", target: "BoneSurface") -> np.ndarray:
     return T
 
 
-def carry_parts(bodies: dict, template: "Template", distal_row: bool = True) -> dict:
-    """All bodies for a participant who supplies the principal bones only (`SUPPLIED`: name ->
-    BoneSurface, RCS mm): each other bone of a supplied body (`BODY_PARTS`; with `distal_row`) and
-    each carried body (`CARRIED_WITH`) is the template's, carried by the similarity that registers
-    the template's principal bone of its supplied body onto the participant's."""
+def carry_parts(bodies: dict, template: "Template", distal_row: bool = True, given: dict | None = None) -> dict:
+    """All bodies for a participant who supplies the principal bones (`SUPPLIED`: name -> BoneSurface, RCS
+    mm) and perhaps some others (`given`: part name in `OPTIONAL_BONES` -> BoneSurface): each other bone of
+    a supplied body (`BODY_PARTS`; with `distal_row`) and each carried body (`CARRIED_WITH`) is the given
+    one, or else the template's, carried by the similarity that registers the template's principal bone of
+    its supplied body onto the participant's."""
+    given = given or {}
+    unknown = sorted(set(given) - set(OPTIONAL_BONES))
+    if unknown:
+        raise ValueError(f"given bones must be among {OPTIONAL_BONES}, but got {unknown}")
     parts = {b: bodies[b] for b in SUPPLIED}
     moved = {}
     for body in SUPPLIED:
         extra = list(BODY_PARTS[body][1:]) if distal_row else []
         extra += [p for c, host in CARRIED_WITH.items() if host == body for p in BODY_PARTS[c]]
-        if not extra:
+        moved |= {p: given[p] for p in extra if p in given}
+        carried = [p for p in extra if p not in given]
+        if not carried:
             continue
         T = _registration(template.parts[body], bodies[body])
-        for p in extra:
+        for p in carried:
             src = template.parts[p]
             moved[p] = BoneSurface(p, src.vertices @ T[:3, :3].T + T[:3, 3], src.faces.copy(), src.solid.copy())
     return compose(parts | moved, distal_row)

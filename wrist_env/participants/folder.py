@@ -3,6 +3,7 @@
     my_wrist/
       participant.toml
       bones/radius.stl ulna.stl scaphoid.stl lunate.stl capitate.stl   (any format trimesh reads)
+           [triquetrum.stl trapezium.stl trapezoid.stl hamate.stl]    (optional: else the template's)
       trials/unresisted.csv trials/resisted.csv                         (see wrist_env.trial)
 
 Meshes and trials are in the RCS, mm, static (neutral) pose. A left wrist
@@ -25,12 +26,13 @@ from pathlib import Path
 
 import numpy as np
 import trimesh
+from scipy.spatial import cKDTree
 
 from wrist_env.builder.params import check_ulnar_variance
 from wrist_env.errors import InputError, MeshError, ParticipantError
 from wrist_env.io import sha256_file
 from wrist_env.limits import MAX_TRIAL_FRAMES
-from wrist_env.model import SUPPLIED
+from wrist_env.model import OPTIONAL_BONES, SUPPLIED
 from wrist_env.participants.bone_mesh import read_bone_mesh
 from wrist_env.trial import ROLES, Trial, mirror_trial, read_trial_csv, write_trial_csv
 
@@ -50,7 +52,8 @@ class ParticipantSource:
     meta: the optional fields of participant.toml (sex, age, facet_type, task, frames, drop_islands,
         ulnar_variance_mm) plus
         side, the side of the files (the arrays here are always a right wrist).
-    bones: {bone: (vertices of shape (n, 3) float64 mm, faces of shape (m, 3) int64)}, SUPPLIED order, RCS.
+    bones: {bone: (vertices of shape (n, 3) float64 mm, faces of shape (m, 3) int64)}, RCS: the `SUPPLIED`
+        bones, then those of `OPTIONAL_BONES` the folder gives, in those orders.
     trials: {name: Trial}. folder: where it was loaded from.
     """
 
@@ -61,10 +64,14 @@ class ParticipantSource:
     folder: Path
 
     def __post_init__(self):
-        if sorted(self.bones) != sorted(SUPPLIED):
-            raise ParticipantError(f"participant {self.name!r}: bones must be {SUPPLIED}, but got {tuple(self.bones)}.")
+        order = SUPPLIED + tuple(b for b in OPTIONAL_BONES if b in self.bones)
+        if sorted(self.bones) != sorted(order):
+            raise ParticipantError(
+                f"participant {self.name!r}: bones must be {SUPPLIED}, and may be any of {OPTIONAL_BONES} too, "
+                f"but got {tuple(self.bones)}."
+            )
         bones = {}
-        for bone in SUPPLIED:
+        for bone in order:
             vertices = np.array(self.bones[bone][0], dtype=np.float64)
             faces = np.array(self.bones[bone][1], dtype=np.int64)
             if vertices.ndim != 2 or vertices.shape[1] != 3 or faces.ndim != 2 or faces.shape[1] != 3:
@@ -119,14 +126,19 @@ def load_participant_folder(path: str | Path) -> ParticipantSource:
 
     bone_table = _check_table(config, "bones", toml_path)
     absent = [b for b in SUPPLIED if b not in bone_table]
-    extra = [b for b in bone_table if b not in SUPPLIED]
+    extra = [b for b in bone_table if b not in SUPPLIED + OPTIONAL_BONES]
     if absent or extra:
-        raise ParticipantError(f"{toml_path}: [bones] must list exactly {SUPPLIED}, but {absent=} and {extra=}.")
-    files = {b: _listed_file(folder, bone_table[b], f"bones.{b}", toml_path) for b in SUPPLIED}
+        raise ParticipantError(
+            f"{toml_path}: [bones] must list {SUPPLIED} and may list any of {OPTIONAL_BONES}, "
+            f"but {absent=} and {extra=}."
+        )
+    listed = SUPPLIED + tuple(b for b in OPTIONAL_BONES if b in bone_table)
+    files = {b: _listed_file(folder, bone_table[b], f"bones.{b}", toml_path) for b in listed}
     _check_distinct_files(files, toml_path)
     drop = meta.get("drop_islands", False)
-    bones = {b: read_bone_mesh(files[b], b, drop_islands=drop) for b in SUPPLIED}
+    bones = {b: read_bone_mesh(files[b], b, drop_islands=drop) for b in listed}
     _check_arrangement(bones, toml_path)
+    _check_given(bones, files, toml_path)
 
     trial_table = _check_table(config, "trials", toml_path)
     trials = {}
@@ -243,6 +255,48 @@ def _check_arrangement(bones: dict, toml_path: Path) -> None:
             f"{toml_path}: bones.capitate and bones.lunate look swapped: the capitate's centroid is "
             f"{proximal:.1f} mm proximal of the lunate's (RCS +y), and a capitate lies distal of it; check [bones]."
         )
+
+
+GIVEN_NEIGHBOURS = {
+    "triquetrum": ("lunate", -1),
+    "hamate": ("capitate", -1),
+    "trapezium": ("scaphoid", +1),
+    "trapezoid": ("capitate", +1),
+}
+"""Each optional bone (`OPTIONAL_BONES`), a supplied bone it articulates with (the lunotriquetral,
+capitohamate, scaphotrapezial and trapezoid–capitate joints) and its side of that bone's centroid (+1
+radial, −1 ulnar; on the template 7–12 mm off that centroid's line, away from the neighbour)."""
+GIVEN_REACH_MM = 5.0
+"""How near (mm) an optional bone's mesh must come to its neighbour's (`GIVEN_NEIGHBOURS`). Articulating
+carpals are 1–3 mm apart (the build refuses neutral joint spaces outside 0.5–3.0 mm); 5 mm leaves room
+for coarse meshes and still refuses a bone in another frame or unit."""
+
+
+def _check_given(bones: dict, files: dict, toml_path: Path) -> None:
+    """ParticipantError naming the entry and its file if an optional bone does not sit where its anatomy
+    puts it: beyond `GIVEN_REACH_MM` of the bone it articulates with, or on the wrong side of it (the
+    radial direction from the radius and ulna as listed, as in `_check_arrangement`)."""
+    centre = {b: np.asarray(v, float).mean(axis=0) for b, (v, _) in bones.items()}
+    radial = centre["radius"] - centre["ulna"]
+    radial[1] = 0.0
+    radial /= max(float(np.linalg.norm(radial)), 1e-12)
+    for bone, (neighbour, side) in GIVEN_NEIGHBOURS.items():
+        if bone not in bones:
+            continue
+        gap = float(cKDTree(np.asarray(bones[neighbour][0], float)).query(np.asarray(bones[bone][0], float))[0].min())
+        if gap > GIVEN_REACH_MM:
+            raise ParticipantError(
+                f"{toml_path}: bones.{bone} ({files[bone].name}) comes no nearer than {gap:.1f} mm to the "
+                f"{neighbour}, with which a {bone} articulates (at most {GIVEN_REACH_MM:g} mm: "
+                "folder.GIVEN_REACH_MM); is it in the RCS, mm and static pose of the other bones?"
+            )
+        offset = float((centre[bone] - centre[neighbour]) @ radial) * side
+        if offset < 0.0:
+            where, should = ("ulnar", "radial") if side > 0 else ("radial", "ulnar")
+            raise ParticipantError(
+                f"{toml_path}: bones.{bone} ({files[bone].name}) has its centroid {-offset:.1f} mm {where} of "
+                f"the {neighbour}'s, and a {bone} lies {should} of it; check [bones]."
+            )
 
 
 def _check_meta(config: dict, toml_path: Path) -> dict:

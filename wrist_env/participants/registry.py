@@ -20,7 +20,7 @@ from wrist_env.anatomy.template import BoneSurface, carry_parts, load_template
 from wrist_env.builder.digest import source_hash
 from wrist_env.builder.params import BuildParams
 from wrist_env.errors import BuildError, ParticipantError, StoreError
-from wrist_env.model import BONES, Model
+from wrist_env.model import BONES, OPTIONAL_BONES, SUPPLIED, Model
 from wrist_env.participants import builtin
 from wrist_env.participants import folder as folder_module  # by module: tests count its reads
 from wrist_env.participants.bone_mesh import solid_mask
@@ -98,8 +98,10 @@ def bones(name: str, params: BuildParams | None = None) -> dict:
     require(name)
 
     source = _SOURCES[name]
-    principal = {b: BoneSurface(b, v, f, solid_mask(v, f)) for b, (v, f) in source.bones.items()}
-    return carry_parts(principal, load_template(), params.distal_row)
+    surfaces = {b: BoneSurface(b, v, f, solid_mask(v, f)) for b, (v, f) in source.bones.items()}
+    principal = {b: surfaces[b] for b in SUPPLIED}
+    given = {b: surfaces[b] for b in OPTIONAL_BONES if b in surfaces}
+    return carry_parts(principal, load_template(), params.distal_row, given)
 
 
 def build_params(name: str, params: BuildParams | None = None) -> BuildParams:
