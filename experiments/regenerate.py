@@ -5,7 +5,7 @@ Runs, from the repository root, each step as the README documents it and prints 
 the built-in models shipped with the package (`experiments/authoring/ship_models.py`), the figures (`wrist-bench figure ...`, `wrist-bench validate P1` … `P3`, whose JSON records the docs' validation page renders, the scaling benchmark `experiments/benchmarks/bench_scaling.py`), the full default benchmark
 and its leaderboard (3 participants × 11 calibrators × 5 seeds × 300 evaluations; Nevergrad's four
 need the `[nevergrad]` extra) with its IOHanalyzer files (`[ioh]`), and the full
-Monte Carlo study (P1 + P2, 2 × 12,500) with its report, what a trial identifies (Morris and Sobol
+Monte Carlo study (P1 + P2, 2 × 12,500) with its report and the probe of where each injury moves the load, what a trial identifies (Morris and Sobol
 sensitivity and the Fisher matrix at the hidden truth, P1–P3), the best calibrators with and without
 the prior (`leaderboards/prior/`) and the Bayesian calibrator's coverage on the trials and on the
 model's own trials (`leaderboards/posterior/`: emcee at 300 steps with the default 24 MAP starts
@@ -62,6 +62,10 @@ def steps(runs: Path, figures_only: bool) -> list[list[str]]:
         ["iohanalyzer", "--runs", str(runs / "benchmark"), "--out", "leaderboards/iohanalyzer"],
         ["montecarlo", "P1", "P2", "--n", "12500", "--seed", "0", "--out", str(runs / "montecarlo")],
         ["montecarlo-report", "--runs", str(runs / "montecarlo"), "--out", "leaderboards/montecarlo"],
+        [
+            *("python", "experiments/research/injury_load_paths.py", "P1", "P2"),
+            *("--out", "leaderboards/montecarlo/injury_load_paths.md"),
+        ],
         ["sensitivity", "P1", "P2", "P3", "--n", "10", "--out", "leaderboards/sensitivity"],
         [
             "sensitivity",

@@ -76,9 +76,11 @@ def prior() -> str:
 
 
 def montecarlo() -> str:
-    return embedded(
+    """The study's report, then the probe of where each injury moves the load (issue 54, step 9)."""
+    page = embedded(
         BOARDS / "montecarlo" / "report.md", "Monte Carlo injury study", "leaderboards/montecarlo/report.md"
     )
+    return page + "\n\n" + (BOARDS / "montecarlo" / "injury_load_paths.md").read_text()
 
 
 def sensitivity(top: int = 6) -> str:
