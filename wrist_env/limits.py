@@ -26,6 +26,9 @@ MAX_BUDGET = 1_000_000
 """Evaluations of one calibration (`--budget`)."""
 MAX_SEEDS = 10_000
 """Seeds per participant and calibrator (`--seeds`)."""
+MAX_INSTANCE = 10_000
+"""The largest problem instance of a participant (`participants.instances`; each one made is a few
+seconds of simulation and a few kB cached)."""
 MAX_BATCH = 4_096
 """Monte Carlo runs per batch, one vector-env step (`--batch`)."""
 MAX_WORKERS = 256

@@ -156,7 +156,7 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
     if not cache:
         return _build(name, b, params, digest)
     check_cache(path)  # before a build of minutes, not after
-    with _build_lock(path):  # another process building this model: wait for it, then load what it saved
+    with cache_lock(path):  # another process building this model: wait for it, then load what it saved
         model = _cached(path, name, digest, quiet=True)
         if model is None:
             model = _build(name, b, params, digest)
@@ -197,10 +197,10 @@ def _build(name: str, b: dict, params: BuildParams, digest: str) -> Model:
 
 
 @contextmanager
-def _build_lock(path: Path) -> Iterator[None]:
-    """Hold an flock on `.<model>.lock` beside the cached model while building it: processes that need the
-    same uncached model at once (a study's workers, a test session's) build it once; the others wait and
-    load it. Released when the process dies, even by SIGKILL."""
+def cache_lock(path: Path) -> Iterator[None]:
+    """Hold an flock on `.<name>.lock` beside a cached model (or instance) while making it: processes that
+    need the same uncached one at once (a study's workers, a test session's) make it once; the others wait
+    and load it. Released when the process dies, even by SIGKILL."""
     lock = path.parent / f".{path.name}.lock"
     with open(lock, "a+") as handle:
         fcntl.flock(handle, fcntl.LOCK_EX)
@@ -226,6 +226,7 @@ def check_cache(path: Path) -> None:
 
 
 __all__ = [
+    "cache_lock",
     "BONES",
     "add_folder",
     "ensure_folder",
