@@ -20,7 +20,7 @@ from wrist_env.design import ALL_LIGAMENT_NAMES, Design
 from wrist_env.errors import DesignError, ParticipantError
 from wrist_env.model import BONES, PAIRS, Model
 from wrist_env.motions import MOTIONS
-from wrist_env.participants import builtin, registry
+from wrist_env.participants import builtin, instances, registry
 from wrist_env.solver.drivers import Driver, idealized, trial_driver
 from wrist_env.solver.forces import CONTACT_FIELDS
 from wrist_env.solver.settings import DEFAULT_LOADS, LOAD_DIRECTIONS, SolverSettings
@@ -95,7 +95,10 @@ class Task:
     sweep for built-in participants, none for user participants → reward 0, and the
     info's `REFERENCE_KEYS` None).
     load_direction: the loads' lines (`settings.LOAD_DIRECTIONS`, default `settings.DEFAULT_LOADS`): the
-    sweep's, and in a trial the radial column's (the capitate is prescribed) at the trial's `load_n`."""
+    sweep's, and in a trial the radial column's (the capitate is prescribed) at the trial's `load_n`.
+    instance: the problem instance of a built-in participant (`participants.instances`; 0, the default,
+    its shipped truth and trials; k ≥ 1 a truth drawn from the prior and the trials made from it);
+    `truth` is the instance's hidden truth (None for a folder participant)."""
 
     def __init__(
         self,
@@ -105,6 +108,7 @@ class Task:
         settings: SolverSettings | None = None,
         weights: CostWeights | None = None,
         load_direction: str = DEFAULT_LOADS,
+        instance: int = 0,
     ):
         if motion not in MOTIONS:
             raise ValueError(f"motion must be one of {MOTIONS}, but got {motion!r}")
@@ -112,6 +116,12 @@ class Task:
             raise ValueError(f"load_direction must be one of {LOAD_DIRECTIONS}, but got {load_direction!r}")
         self.participant, self.motion, self.load_direction = participant, motion, load_direction
         self.settings, self.weights = settings, weights
+        self.instance = instance
+        if instance != 0 or participant in builtin.BUILTIN:
+            self.problem: instances.Instance | None = instances.instance(participant, instance)
+        else:
+            self.problem = None
+        self.truth: Design | None = None if self.problem is None else self.problem.truth
         self.model: Model = registry.load_model(participant)
         self.driver, self.reference = self._driver_and_reference()
         self.prepared = prepare(self.model, settings, self.driver.mode)
@@ -122,9 +132,10 @@ class Task:
             driver = idealized(self.model, direction=self.load_direction)
             if not has_reference(self.participant, self.motion):
                 return driver, None
-            truth = simulate(self.model, builtin.truth(self.participant), driver, self.settings)
+            truth = simulate(self.model, self.truth, driver, self.settings)
             return driver, cost_poses(truth.poses)
-        trial = registry.trial(self.participant, "calibrate" if self.motion == "calibrate" else "validate")
+        role = "calibrate" if self.motion == "calibrate" else "validate"
+        trial = registry.trial(self.participant, role) if self.problem is None else self.problem.trial(role)
         driver = trial_driver(self.model, trial, self.load_direction)
         return driver, np.stack([trial.pose(b) for b in COST_BONES])
 
@@ -213,7 +224,7 @@ def _zero_undefined(per_bone: dict) -> dict:
 
 
 @functools.lru_cache(maxsize=32)
-def task(participant: str, motion: str, load_direction: str = DEFAULT_LOADS) -> Task:
-    """A shared Task per participant, motion and load direction with default settings (models are big;
-    build once)."""
-    return Task(participant, motion, load_direction=load_direction)
+def task(participant: str, motion: str, load_direction: str = DEFAULT_LOADS, instance: int = 0) -> Task:
+    """A shared Task per participant, motion, load direction and instance with default settings (models are
+    big; build once)."""
+    return Task(participant, motion, load_direction=load_direction, instance=instance)

@@ -32,7 +32,9 @@ class WristEnv(gym.Env):
 
     participant: a registered participant name; motion: "calibrate",
     "validate" or "idealized"; load_direction: the idealized sweep's load
-    (`settings.LOAD_DIRECTIONS`, default `settings.DEFAULT_LOADS`). info: cost, per-DOF 75th-percentile errors and
+    (`settings.LOAD_DIRECTIONS`, default `settings.DEFAULT_LOADS`); instance: the problem instance of a
+    built-in participant (`participants.instances`: 0, the default, its shipped truth and trials; k ≥ 1 a
+    truth drawn from the prior, `gymnasium.make("wrist_env/Calibrate-P1-v0", instance=k)`). info: cost, per-DOF 75th-percentile errors and
     RMSE (mm, deg), per-frame contact (MPa, mm², N), bundle forces (N),
     energies (N·mm), poses, and `failed` — deterministic, NaN-free. Without reference kinematics (a folder
     participant's idealized sweep, reward 0) cost, error_p75, rmse and cost_terms are None
@@ -41,9 +43,11 @@ class WristEnv(gym.Env):
 
     metadata = {"render_modes": []}
 
-    def __init__(self, participant: str = "P1", motion: str = "calibrate", load_direction: str = DEFAULT_LOADS):
-        self.participant, self.motion = participant, motion
-        self.task = task(participant, motion, load_direction)
+    def __init__(
+        self, participant: str = "P1", motion: str = "calibrate", load_direction: str = DEFAULT_LOADS, instance: int = 0
+    ):
+        self.participant, self.motion, self.instance = participant, motion, instance
+        self.task = task(participant, motion, load_direction, instance)
         self.action_space, self.observation_space = _spaces()
 
     def reset(self, *, seed: int | None = None, options: dict | None = None) -> tuple[np.ndarray, dict]:
@@ -66,11 +70,12 @@ class WristVectorEnv(VectorEnv):
         participant: str = "P1",
         motion: str = "calibrate",
         load_direction: str = DEFAULT_LOADS,
+        instance: int = 0,
         **_,
     ):
         self.num_envs = check_int("num_envs", num_envs, 1, MAX_BATCH)
-        self.participant, self.motion = participant, motion
-        self.task = task(participant, motion, load_direction)
+        self.participant, self.motion, self.instance = participant, motion, instance
+        self.task = task(participant, motion, load_direction, instance)
         self.single_action_space, self.single_observation_space = _spaces()
         self.action_space = gym.vector.utils.batch_space(self.single_action_space, self.num_envs)
         self.observation_space = gym.vector.utils.batch_space(self.single_observation_space, self.num_envs)
