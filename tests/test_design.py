@@ -114,3 +114,24 @@ def test_the_capitohamate_bands_stiffness_is_ritt_1996s_distraction_shared_by_th
     stiffness, strain, torn = design.ligament_arrays(design.population())
     k = design.ALL_LIGAMENT_NAMES.index("CH_deep")
     assert stiffness[k] == design.STIFFNESS_CH and strain[k] == 1.0 and not torn[k] and design.N_DESIGN == 27
+
+
+def test_the_dorsal_intercarpal_ligament_takes_the_drcs_stiffness_split_between_its_two_components():
+    """The DIC (fixed, outside the 27 variables): Table 2's DRC mean, its partner in the dorsal "lateral V"
+    (Viegas 1999), split equally between the deep and superficial components from the triquetrum (Wessel
+    2021); the superficial one's continuation to the trapezium the same; SD 30 % as in Table 2; just taut at
+    neutral, never torn; built in every variant that has its bones."""
+    fixed = {lig.name: lig for lig in design.FIXED_LIGAMENTS}
+    drc = design.LIGAMENTS[design.LIGAMENT_NAMES.index("DRC")]
+    assert design.DIC_LIGAMENTS == ("DIC_s", "DIC_d", "DIC_tz")
+    assert design.DIC_LIGAMENT_STIFFNESS == drc.stiffness_mean == 75.0
+    assert fixed["DIC_s"].stiffness_mean + fixed["DIC_d"].stiffness_mean == pytest.approx(drc.stiffness_mean)
+    stiffness, strain, torn = design.ligament_arrays(design.population())
+    for name in design.DIC_LIGAMENTS:
+        lig = fixed[name]
+        assert lig.stiffness_mean == design.STIFFNESS_DIC == 37.5 and lig.stiffness_sd == pytest.approx(11.25)
+        assert lig.fibres == 3 and not lig.injurable and "Viegas 1999" in lig.source
+        assert name not in design.LIGAMENT_NAMES and name in design.BODY_LIGAMENTS
+        k = design.ALL_LIGAMENT_NAMES.index(name)
+        assert stiffness[k] == 37.5 and strain[k] == 1.0 and not torn[k]
+    assert design.N_DESIGN == 27

@@ -73,3 +73,33 @@ def test_a_built_model_gives_the_hamate_mass_a_grid_contacts_and_its_capitohamat
         expected = [HAMATE, CAPITATE] if name != "TH" else [LUNATE, HAMATE]
         assert mine.sum() == 3 and (p1.fibre_bones[mine] == expected).all(), name
         assert np.linalg.norm(p1.fibre_insertion[mine] - p1.fibre_origin[mine], axis=1).max() < 6.0 or name == "TH"
+
+
+def test_a_built_model_gives_the_dorsal_intercarpal_ligament_its_three_segments(built):
+    """P1 as built: the DIC's segments (3 fibres each) join the lunate body's triquetrum to the scaphoid (DIC_s)
+    and to the lunate (DIC_d: one rigid body, so it never stretches while the triquetrum rides on the lunate),
+    and the scaphoid to the radial column (DIC_tz). The superficial segment crosses the proximal row
+    dorsally: longer than the deep one, its chord passing within 2 mm of the lunate's dorsal surface (it
+    runs over the dorsal lunate, Viegas 1999) and crossing the scapholunate joint radially; each segment's
+    fibres 5-30 mm, the span of the bones it joins."""
+    from scipy.spatial import cKDTree
+
+    from wrist_env.design import ALL_LIGAMENT_NAMES, DIC_LIGAMENTS
+    from wrist_env.model import LUNATE, SCAPHOID, TRAPEZIUM
+
+    p1 = built("P1")
+    expected = {"DIC_s": [LUNATE, SCAPHOID], "DIC_d": [LUNATE, LUNATE], "DIC_tz": [SCAPHOID, TRAPEZIUM]}
+    length = {}
+    for name in DIC_LIGAMENTS:
+        mine = p1.fibre_ligament == ALL_LIGAMENT_NAMES.index(name)
+        assert mine.sum() == 3 and (p1.fibre_bones[mine] == expected[name]).all(), name
+        fibre = p1.fibre_insertion[mine] - p1.fibre_origin[mine]
+        length[name] = np.linalg.norm(fibre, axis=1)
+        assert (length[name] > 5.0).all() and (length[name] < 30.0).all(), (name, length[name])
+    assert length["DIC_s"].mean() > length["DIC_d"].mean()
+    lunate = p1.part_mesh("lunate")[0]
+    mine = p1.fibre_ligament == ALL_LIGAMENT_NAMES.index("DIC_s")
+    t = np.linspace(0.0, 1.0, 41)[:, None, None]
+    chords = p1.fibre_origin[mine] + t * (p1.fibre_insertion[mine] - p1.fibre_origin[mine])
+    assert cKDTree(lunate).query(chords.reshape(-1, 3))[0].min() < 2.0
+    assert (p1.fibre_origin[mine][:, 2] < lunate[:, 2].mean() < p1.fibre_insertion[mine][:, 2]).all()

@@ -105,6 +105,29 @@ there, the ligaments' in-plane constraint, is this linear spring between the two
 centre: 20 N over 0.65 mm (30.8 N/mm) in the plane, 0.5 N·m over 9 deg (3.18 N·m/rad) about the normal;
 nothing along the normal (the bands and the contact) nor
 about the in-plane axes (they open the joint: the bands and the contact)."""
+DIC_LIGAMENT_STIFFNESS = 75.0
+"""Stiffness (N/mm) of the dorsal intercarpal ligament (DIC) as a whole, from its triquetral origin: the
+mean of Table 2's DRC (Nagao 2005; Mizuseki 1989), the other arm of the dorsal "lateral V" that the two
+form (Viegas, Yamaguchi, Boyd & Patterson 1999, J Hand Surg Am 24:456), SD 30 % as in Table 2. Viegas
+1999 tested both ligaments mechanically, but its values are not in the abstract, the only text of it
+read; no measured DIC cross-section or stiffness was found either, so Savelberg et al.'s tangent moduli
+(1992, J Biomech 25:369) could not be turned into a stiffness (E·A / L). The DIC therefore takes a
+neighbour's property, as the model's other unmeasured ligaments do (`STIFFNESS_TZC`; Bajuri & Abdul
+Kadir 2013). Savelberg's moduli bound what this may overstate: the DRC's material (their dorsal
+radiotriquetral, about 93 MPa) was the stiffest of nine superficial ligaments, the other seven 25–50 MPa;
+a DIC of the DRC's section and length with such a modulus would be 0.27–0.54 times as stiff.
+
+In the Blankevoort law (`solver.ligaments`) a bundle's k (N/mm) is its linear-region slope, shared by its
+fibres (`solver.arrays.design_arrays`: K = (k / n)·l0 per fibre, N per unit strain), so k = E·A / L."""
+STIFFNESS_DIC = DIC_LIGAMENT_STIFFNESS / 2
+"""Stiffness (N/mm) of each of the DIC's segments (`DIC_LIGAMENTS`): the ligament's, split equally between
+its two components from the triquetrum, as the arcuate's is between its two insertions (TC, TH). Wessel et
+al. 2021 ("The dorsal ligament complex: a cadaveric, histology and imaging study", PMID 34294477, 17
+wrists) found two: a deep one
+inserting on the dorsal lunate (DIC_d) and a superficial one running on to the dorsal ridge of the scaphoid
+and then to the trapezium and trapezoid (DIC_s, and its continuation DIC_tz, the same fibres beyond their
+scaphoid attachment: the same stiffness)."""
+SOURCE_DIC = "Viegas 1999; Wessel 2021 (anatomy); Table 2's DRC (Nagao 2005), split between its two components"
 FIXED_LIGAMENTS = (
     Ligament("TC", "palmar triquetrocapitate ligament", 3, 20.0, 6.0, False, "Garcia-Elias 2017; Weaver 1994"),
     Ligament("TH", "palmar triquetrohamate ligament", 3, 20.0, 6.0, False, "Garcia-Elias 2017; Weaver 1994"),
@@ -120,9 +143,38 @@ FIXED_LIGAMENTS = (
     Ligament(
         "CH_p", "palmar capitohamate interosseous ligament", 3, STIFFNESS_CH, 0.3 * STIFFNESS_CH, False, SOURCE_CH
     ),
+    Ligament(
+        "DIC_s",
+        "dorsal intercarpal ligament, superficial: triquetrum to the scaphoid's dorsal ridge",
+        3,
+        STIFFNESS_DIC,
+        0.3 * STIFFNESS_DIC,
+        False,
+        SOURCE_DIC,
+    ),
+    Ligament(
+        "DIC_d",
+        "dorsal intercarpal ligament, deep: triquetrum to the dorsal lunate",
+        3,
+        STIFFNESS_DIC,
+        0.3 * STIFFNESS_DIC,
+        False,
+        SOURCE_DIC,
+    ),
+    Ligament(
+        "DIC_tz",
+        "dorsal intercarpal ligament, distal: the scaphoid's dorsal ridge to the trapezium",
+        3,
+        STIFFNESS_DIC,
+        0.3 * STIFFNESS_DIC,
+        False,
+        SOURCE_DIC,
+    ),
 )
 """Ligaments outside the design: the radial column's (TZC_p, TZC_d, STT: `COLUMN_LIGAMENTS`,
-stiffness above), the hamate's (CH_deep, CH_d, CH_p: `HAMATE_LIGAMENTS`, stiffness `STIFFNESS_CH`) and,
+stiffness above), the hamate's (CH_deep, CH_d, CH_p: `HAMATE_LIGAMENTS`, stiffness `STIFFNESS_CH`), the
+dorsal intercarpal ligament's three segments (DIC_s, DIC_d, DIC_tz: `DIC_LIGAMENTS`, stiffness
+`STIFFNESS_DIC`) and,
 built with the distal row, the two insertions (capitate,
 hamate) of the triquetrum–hamate–capitate ligament, the ulnar arm of the palmar arcuate
 (midcarpal) ligament and the main passive stabilizer of the midcarpal joint in neutral
@@ -137,9 +189,20 @@ COLUMN_LIGAMENTS = ("TZC_p", "TZC_d", "STT")
 """The fixed ligaments that hold the radial column (`model.BODY_PARTS`): built in every variant."""
 HAMATE_LIGAMENTS = ("CH_deep", "CH_d", "CH_p")
 """The fixed ligaments that hold the hamate to the capitate (`model.BODY_PARTS`): built in every variant."""
-BODY_LIGAMENTS = COLUMN_LIGAMENTS + HAMATE_LIGAMENTS
-"""The fixed ligaments that hold the distal row's free bodies: built in every variant (not TC and TH,
-which `builder.params.BuildParams.fixed_ligaments` can leave out)."""
+DIC_LIGAMENTS = ("DIC_s", "DIC_d", "DIC_tz")
+"""The dorsal intercarpal ligament (issue 54, step 4): from the dorsal tubercle of the triquetrum radially
+over the dorsal lunate to the dorsal ridge of the scaphoid, then on to the trapezium (Viegas 1999; Berger
+2001; Mizuseki & Ikuta 1989), with the DRC the dorsal "lateral V". A fibre here is straight between two bodies, with no via point, so the ligament is three segments,
+each ending where the ligament attaches: the deep component on the lunate (DIC_d), the superficial one on
+the scaphoid (DIC_s) and its continuation to the trapezium (DIC_tz) (Wessel 2021). Their triquetral ends
+lie on the lunate body's triquetrum (`model.BODY_PARTS`): DIC_d joins two bones of one rigid body and
+carries nothing until the triquetrum moves on its own (issue 54, step 3); DIC_s passes over the dorsal
+lunate as a chord, so the lunate's own motion does not lengthen it. Built wherever their bones are (the
+distal row)."""
+BODY_LIGAMENTS = COLUMN_LIGAMENTS + HAMATE_LIGAMENTS + DIC_LIGAMENTS
+"""The fixed ligaments built in every variant whose bodies carry their sites: those that hold the distal
+row's free bodies and the DIC (not TC and TH, which `builder.params.BuildParams.fixed_ligaments` can leave
+out)."""
 ALL_LIGAMENTS = LIGAMENTS + FIXED_LIGAMENTS
 ALL_LIGAMENT_NAMES = tuple(lig.name for lig in ALL_LIGAMENTS)
 """The design's eleven ligaments, then the fixed ones: the order of every per-bundle output."""

@@ -6,7 +6,8 @@ cites (Table 2): Berger 2001 (SLIL regions, RSC, LRL), Nagao 2005 (SRL, DRC,
 UL), Mizuseki 1989 (DRC), Ringler 2013 (RCL), Apergis 2013 (SCL), Moritomo
 2013 (UCL); Berger 2001 and Garcia-Elias 2017 for the fixed TC and TH; Garcia-Elias 1989,
 Nanno 2006 and Bettinger 1999 for the radial column's TZC_p, TZC_d and STT; Ritt 1996 for the
-hamate's capitohamate CH_deep, CH_d and CH_p. A rule
+hamate's capitohamate CH_deep, CH_d and CH_p; Viegas 1999 and Wessel 2021 for the dorsal intercarpal
+ligament's DIC_s, DIC_d and DIC_tz. A rule
 picks the extreme vertex of a bone region along an anatomical direction; the patch is the bone surface within `radius_mm` of it.
 Cartilage coverage is the part of each bone facing its partner within a gap.
 
@@ -220,6 +221,45 @@ def main() -> None:
                 "centre_mm": np.round(extreme(V["capitate"], direction, level), 3).tolist(),
             },
         }
+    # The dorsal intercarpal ligament (DIC; issue 54, step 4; `design.DIC_LIGAMENTS`). It leaves the dorsal
+    # tubercle of the triquetrum, conjoined there with the DRC's insertion, runs radially over the dorsal
+    # lunate to the dorsal ridge of the scaphoid and on to the trapezium (Viegas 1999, J Hand Surg Am
+    # 24:456; Mizuseki 1989; Berger 2001). Wessel et al. 2021 (PMID 34294477) found a deep component
+    # inserting on the lunate, distal to the DRC's lunate insertion, and a superficial one running on to
+    # the scaphoid ridge, the trapezium and the trapezoid. Sites: the triquetrum's dorsal extreme, leaning
+    # distal (the DRC takes the dorsal extreme itself); the lunate's dorsal extreme leaning distal; the
+    # scaphoid's dorsal ridge at its waist (dorsal extreme leaning distal, within 3 mm of the waist's level),
+    # where the superficial segment ends and the distal one begins; the trapezium's dorsal extreme where it
+    # meets the trapezoid (within 3 mm of it).
+    dic_tri = {
+        "bone": "lunate",
+        "part": "triquetrum",
+        "radius_mm": 2.0,
+        "centre_mm": np.round(extreme(V["triquetrum"], (-1, -0.3, 0)), 3).tolist(),
+    }
+    scaphoid_waist = np.abs(V["scaphoid"][:, 1] - sca_c[1]) < 3.0
+    dic_scaphoid = {
+        "bone": "scaphoid",
+        "radius_mm": 2.0,
+        "centre_mm": np.round(extreme(V["scaphoid"], (-1, -0.3, 0), scaphoid_waist), 3).tolist(),
+    }
+    ligaments["DIC_s"] = {"origin": dic_tri, "insertion": dic_scaphoid}
+    ligaments["DIC_d"] = {
+        "origin": dic_tri,
+        "insertion": {
+            "bone": "lunate",
+            "radius_mm": 2.0,
+            "centre_mm": np.round(extreme(V["lunate"], (-1, -0.5, 0)), 3).tolist(),
+        },
+    }
+    ligaments["DIC_tz"] = {
+        "origin": dic_scaphoid,
+        "insertion": {
+            "bone": "trapezium",
+            "radius_mm": 2.0,
+            "centre_mm": np.round(extreme(V["trapezium"], (-1, 0, 0), near("trapezium", "trapezoid", 3.0)), 3).tolist(),
+        },
+    }
     ligaments["STT"] = {
         "origin": {
             "bone": "scaphoid",

@@ -101,3 +101,48 @@ def test_the_capitohamate_bands_span_the_joint_at_its_dorsal_palmar_and_deep_dis
         origin, insertion = sites[name]
         assert (origin.bone, insertion.bone) == ("hamate", "capitate")
         assert origin.mask.sum() >= 5 and insertion.mask.sum() >= 5, name
+
+
+def test_the_dorsal_intercarpal_ligament_runs_from_the_triquetrum_over_the_lunate_to_the_scaphoid_and_trapezium():
+    """The DIC (design.DIC_LIGAMENTS; Viegas 1999, Wessel 2021): its triquetral end on the dorsal tubercle, on
+    the part "triquetrum" of the lunate body, conjoined with the DRC's insertion (within 1 mm); the deep
+    segment to the dorsal lunate distal to the DRC's lunate site (y proximal); the superficial one to the
+    scaphoid's dorsal ridge, radial and distal of the dorsal SLIL's scaphoid site, and on from the same site
+    to the trapezium where it meets the trapezoid. Every site within 0.5 mm of its bone's most dorsal point
+    along its rule's direction, none on the palmar half of its bone (x volar); the triquetral segments are
+    resolved only where the lunate body carries the triquetrum, the distal one in every variant."""
+    from scipy.spatial import cKDTree
+
+    from wrist_env.anatomy.template import load_template
+    from wrist_env.design import DIC_LIGAMENTS
+
+    data = read_annotation_data()["ligaments"]
+    parts = load_template().parts
+    c = {n: (np.array(data[n]["origin"]["centre_mm"]), np.array(data[n]["insertion"]["centre_mm"])) for n in data}
+    for name in ("DIC_s", "DIC_d"):
+        spec = data[name]["origin"]
+        assert (spec["bone"], spec["part"]) == ("lunate", "triquetrum")
+        assert np.linalg.norm(c[name][0] - np.array(data["DRC"]["insertion"]["centre_mm"])) < 1.0
+    assert (data["DIC_s"]["insertion"]["bone"], data["DIC_d"]["insertion"]["bone"]) == ("scaphoid", "lunate")
+    assert data["DIC_tz"]["origin"] == data["DIC_s"]["insertion"]
+    assert data["DIC_tz"]["insertion"]["bone"] == "trapezium" and "part" not in data["DIC_tz"]["insertion"]
+    ends = {
+        "triquetrum": c["DIC_s"][0],
+        "lunate": c["DIC_d"][1],
+        "scaphoid": c["DIC_s"][1],
+        "trapezium": c["DIC_tz"][1],
+    }
+    for bone, point in ends.items():
+        v = parts[bone].vertices
+        assert cKDTree(v).query(point)[0] < 1e-3, bone  # on the bone (centres rounded to 1 µm)
+        assert point[0] < v[:, 0].mean() and point[0] < v[:, 0].min() + 1.5, (bone, point)  # dorsal
+    lunate_drc = np.array(data["DRC"]["insertion"]["without_part"]["centre_mm"])
+    assert ends["lunate"][1] < lunate_drc[1] - 1.0  # distal of the DRC's lunate insertion
+    slil_d = c["SLIL_d"][0]
+    assert ends["scaphoid"][2] > slil_d[2] + 1.0 and ends["scaphoid"][1] < slil_d[1] - 1.0
+    assert cKDTree(parts["trapezoid"].vertices).query(ends["trapezium"])[0] < 3.0
+    with_row, without = template_annotations((20.0, 10.0), True), template_annotations()
+    for name in DIC_LIGAMENTS:
+        origin, insertion = with_row.sites[name]
+        assert origin.mask.sum() >= 5 and insertion.mask.sum() >= 5, name
+    assert "DIC_s" not in without.sites and "DIC_d" not in without.sites and "DIC_tz" in without.sites
