@@ -197,3 +197,46 @@ def test_the_default_solver_validates_like_the_diagonal_mass(built):
         assert abs(a - b) < 0.1, (k, a, b)
     with pytest.raises(ValueError, match="solver must be one of"):
         solver_settings("implicit")
+
+
+def test_the_dorsal_intercarpal_ligament_is_taut_in_flexion_and_holds_the_scaphoid_after_an_slil_cut(
+    built, monkeypatch
+):
+    """P1, population design, the idealized ±40° sweep: the dorsal ligaments stretch in flexion, so the DIC's
+    superficial segment (triquetrum to scaphoid) carries tension at 40° of flexion and less at 40° of
+    extension; its deep segment, within the lunate body, nothing. With all three SLIL bundles torn it takes
+    up the scaphoid (more tension in flexion) and, on a triquetrum rigid on the lunate, holds it to the
+    lunate: the SL gap at full extension grows by less than validate's 3 mm (Haug 2021), which it did
+    without the DIC (its stiffness zeroed here: ≥ 3 mm). An open item of issue 54: the DIC alone does not
+    prevent dissociation in cadavers (Short 2007; Mitsuyasu 2004); update when the triquetrum moves on its
+    own (step 3)."""
+    import dataclasses
+
+    from wrist_env import design as design_mod
+    from wrist_env.solver import drivers
+    from wrist_env.solver.simulate import simulate_batch
+
+    p1 = built("P1")
+    pop = design_mod.population()
+    sweep = drivers.idealized(p1)
+    names = design_mod.ALL_LIGAMENT_NAMES
+
+    def runs():
+        intact, torn = simulate_batch(p1, [pop, validation.with_tears(pop, validation.SLIL)], sweep)
+        assert intact.ok and torn.ok
+        growth = validation.sl_gap_mm(p1, torn.poses)[-1] - validation.sl_gap_mm(p1, intact.poses)[-1]
+        return intact.bundle_force, torn.bundle_force, growth
+
+    intact, torn, growth = runs()
+    assert sweep.angle_deg[0] == 40.0 and sweep.angle_deg[-1] == -40.0  # flexion +
+    s, d = names.index("DIC_s"), names.index("DIC_d")
+    assert intact[0, s] > 0.5 and intact[0, s] > intact[-1, s] + 0.5
+    assert np.abs(intact[:, d]).max() < 1e-9 and np.abs(torn[:, d]).max() < 1e-9  # round-off only
+    assert torn[0, s] > 2.0 * intact[0, s]
+    assert growth < validation.SL_DISSOCIATION_MM
+    zero = tuple(
+        dataclasses.replace(lig, stiffness_mean=0.0) if lig.name in design_mod.DIC_LIGAMENTS else lig
+        for lig in design_mod.FIXED_LIGAMENTS
+    )
+    monkeypatch.setattr(design_mod, "FIXED_LIGAMENTS", zero)
+    assert runs()[2] >= validation.SL_DISSOCIATION_MM
