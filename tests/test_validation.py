@@ -207,9 +207,9 @@ def test_the_dorsal_intercarpal_ligament_is_taut_in_flexion_and_holds_the_scapho
     extension; its deep segment, within the lunate body, nothing. With all three SLIL bundles torn it takes
     up the scaphoid (more tension in flexion) and, on a triquetrum rigid on the lunate, holds it to the
     lunate: the SL gap at full extension grows by less than validate's 3 mm (Haug 2021), which it did
-    without the DIC (its stiffness zeroed here: ≥ 3 mm). An open item of issue 54: the DIC alone does not
-    prevent dissociation in cadavers (Short 2007; Mitsuyasu 2004); update when the triquetrum moves on its
-    own (step 3)."""
+    without the DIC (its stiffness zeroed here: ≥ 3 mm). An open item of issue 54: cadavers' SL joints part
+    with the SLIL divided (Haug 2021) and the DIC intact (Short 2002, 2007); a triquetrum of its own (step 3)
+    did not change this on a trial merge; the DIC's neutral tension did (docs/history.md)."""
     import dataclasses
 
     from wrist_env import design as design_mod
