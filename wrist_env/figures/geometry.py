@@ -98,6 +98,17 @@ ANNOTATION_PANELS = (
 )
 
 
+ARTICULATION_COLOURS = dict(
+    zip(
+        ARTICULATIONS,
+        ("#f4a6a0", "#9fc3e0", "#b9e3ae", "#d3bde0", "#fdd49e", "#a6dcd0", "#e0c39f", "#c9c9f2")
+        + ("#f2c6de", "#c7e9b4", "#fbb4ae", "#b3cde3"),
+        strict=False,
+    )
+)
+"""One colour per annotated articulation (`annotations.ARTICULATIONS`) of the annotations figure."""
+
+
 def annotations_figure(out: Path | None = None) -> Path:
     """The template with its cartilage coverage and ligament attachment sites, for review."""
 
@@ -105,8 +116,7 @@ def annotations_figure(out: Path | None = None) -> Path:
     bones = load_template(*anatomy).bones
     ann = template_annotations(*anatomy)
     out = out or draw.FIGURES / "template_annotations.png"
-    palette = ("#f4a6a0", "#9fc3e0", "#b9e3ae", "#d3bde0", "#fdd49e", "#a6dcd0", "#e0c39f", "#c9c9f2")
-    art_colours = dict(zip(ARTICULATIONS, palette))
+    art_colours = ARTICULATION_COLOURS
     fig = plt.figure(figsize=(18, 5.6))
     for k, (title, shown, elev, azim) in enumerate(ANNOTATION_PANELS):
         ax = fig.add_subplot(1, 4, k + 1, projection="3d")
