@@ -114,3 +114,25 @@ def test_the_capitohamate_bands_stiffness_is_ritt_1996s_distraction_shared_by_th
     stiffness, strain, torn = design.ligament_arrays(design.population())
     k = design.ALL_LIGAMENT_NAMES.index("CH_deep")
     assert stiffness[k] == design.STIFFNESS_CH and strain[k] == 1.0 and not torn[k] and design.N_DESIGN == 27
+
+
+def test_the_lunotriquetral_bands_and_joint_are_ritt_1998s_constraint_and_the_design_is_unchanged():
+    """The triquetrum's ligaments are fixed, outside the 27 variables (Table 2's eleven unchanged): each
+    lunotriquetral band Ritt 1998's 20 N over 0.3 mm distraction shared by three (22.2 N/mm); the joint's
+    in-plane spring 20 N over the mean of the four translations, 1.475 mm (13.6 N/mm), and 0.5 N m over
+    35 deg about the normal (0.82 N m/rad), nothing along the normal nor about the in-plane axes; the UT at
+    the UL's Table 2 mean."""
+    fixed = {lig.name: lig for lig in design.FIXED_LIGAMENTS}
+    assert design.TRIQUETRUM_LIGAMENTS == ("LT_v", "LT_p", "LT_d", "UT")
+    assert set(design.TRIQUETRUM_LIGAMENTS) <= set(design.BODY_LIGAMENTS)
+    for name in ("LT_v", "LT_p", "LT_d"):
+        assert fixed[name].stiffness_mean == pytest.approx(20.0 / 0.3 / 3) and not fixed[name].injurable
+    ul = next(lig for lig in design.LIGAMENTS if lig.name == "UL")
+    assert fixed["UT"].stiffness_mean == ul.stiffness_mean == 40.0
+    k = dict(design.JOINTS)["lunotriquetral"]
+    assert k[0] == k[1] == pytest.approx(20.0 / 1.475) == pytest.approx(13.56, abs=0.01)
+    assert k[2] == k[3] == k[4] == 0.0
+    assert k[5] == pytest.approx(500.0 / np.radians(35.0)) == pytest.approx(818.5, abs=0.1)
+    assert dict(design.JOINTS)["capitohamate"] == design.CH_JOINT_STIFFNESS
+    assert design.N_LIGAMENTS == 11 and design.N_DESIGN == 27 and len(design.NAMES) == 27
+    assert not any(n in design.LIGAMENT_NAMES for n in design.TRIQUETRUM_LIGAMENTS)

@@ -361,9 +361,9 @@ def test_a_trial_of_too_many_rows_is_refused_before_it_is_parsed(tmp_path, monke
 
     monkeypatch.setattr(trial_module, "MAX_TRIAL_FRAMES", 10)
     path = tmp_path / "long.csv"
-    write_trial_csv(make_trial(n_frames=15), path)  # 15 frames × 5 bones = 75 rows > 10 × 7 (`model.BONES`)
+    write_trial_csv(make_trial(n_frames=17), path)  # 17 frames × 5 bones = 85 rows > 10 × 8 (`model.BONES`)
     monkeypatch.setattr(trial_module.pd, "read_csv", lambda *a, **k: pytest.fail("parsed"))
-    with raises(path, r"at most 10 frames \(limits.MAX_TRIAL_FRAMES\), so at most 70 rows .* but the file has 75"):
+    with raises(path, r"at most 10 frames \(limits.MAX_TRIAL_FRAMES\), so at most 80 rows .* but the file has 85"):
         read_trial_csv(path, "u", "calibrate")
 
 

@@ -24,6 +24,7 @@ CHECK_IDS = (
     "ulnar_share_pct",
     "column_rotation_deg",
     "hamate_rotation_deg",
+    "lunotriquetral_rotation_deg",
     "sl_gap_growth_mm",
     "rs_mean_pressure_mpa",
     "slil_force_30ext_n",
@@ -99,7 +100,7 @@ def test_report_json_is_strict_and_round_trips():
     assert "FAIL" in validation.format_table(report)
 
 
-def test_cli_validate_json_has_the_fourteen_checks(capsys, built, tmp_path):
+def test_cli_validate_json_has_the_fifteen_checks(capsys, built, tmp_path):
     built("P1")
     code = main(["validate", "P1", "--json", "--out", str(tmp_path)])
     out = json.loads(capsys.readouterr().out)

@@ -105,6 +105,55 @@ there, the ligaments' in-plane constraint, is this linear spring between the two
 centre: 20 N over 0.65 mm (30.8 N/mm) in the plane, 0.5 N·m over 9 deg (3.18 N·m/rad) about the normal;
 nothing along the normal (the bands and the contact) nor
 about the in-plane axes (they open the joint: the bands and the contact)."""
+LT_DISTRACTION_MM = 0.3
+"""The lunotriquetral joint's distraction under `CH_RIG_FORCE_N` with its interosseous ligament's three
+regions (dorsal, proximal, palmar) intact: 0.3 ± 0.1 mm (Ritt, Linscheid, Cooney & Berger 1998, J Hand
+Surg Am 23:425, 12 specimens, the rig of their capitohamate study)."""
+LT_BANDS = 3
+STIFFNESS_LT = CH_RIG_FORCE_N / LT_DISTRACTION_MM / LT_BANDS
+"""Stiffness (N/mm) of each lunotriquetral interosseous band (LT_v, LT_p, LT_d), derived as the
+capitohamate bands' (`STIFFNESS_CH`): distraction pulls along all three at once, so they act in parallel
+along the joint's normal: 20 N / 0.3 mm = 66.7 N/mm for the three. Ritt 1998 measured the distraction of
+the whole ligament; what they measured by region is the share of rotational resistance (dorsal 62 ± 27 %)
+and of palmar translation (palmar 67 ± 14 %), and the palmar region's thickness (2.3 mm, the thickest):
+none of them a distraction stiffness, so the three share it equally (22.2 N/mm each), and the regions'
+roles come from where they lie. Those shares matter when a region is cut, which this fixed ligament
+never is; the intact joint's in-plane constraint is `LT_JOINT_STIFFNESS`. SD 30 % as in Table 2."""
+SOURCE_LT = "Ritt 1998 (20 N / 0.3 mm distraction, three regions)"
+LT_SHEAR_MM = (1.6 + 1.2 + 1.8 + 1.3) / 4
+"""The lunotriquetral joint's translation in its own plane under `CH_RIG_FORCE_N` (mm): the mean of Ritt
+1998's four, dorsopalmar 1.6 ± 0.4 / 1.2 ± 0.5 and proximodistal 1.8 ± 0.5 / 1.3 ± 0.5 mm (1.475 mm).
+One value for the plane, as for the capitohamate joint (`CH_SHEAR_MM`): the two directions' means (1.4,
+1.55 mm) differ by less than their SDs, and a spring the same every way in the plane needs only the
+joint's normal, which the geometry gives in any frame."""
+LT_ROTATION_DEG = 35.0
+"""The lunotriquetral joint's flexion–extension rotation (the triquetrum turning on the lunate about the
+joint's normal, the radioulnar axis) under `CH_RIG_MOMENT_NMM`: 35 ± 5.1 deg (Ritt 1998), read as one
+way, as the load-path study (section 5) and the capitohamate joint's 9 deg each way are read; if it is
+the whole arc, the joint is twice as stiff in rotation as modelled."""
+LT_JOINT_STIFFNESS = (
+    CH_RIG_FORCE_N / LT_SHEAR_MM,
+    CH_RIG_FORCE_N / LT_SHEAR_MM,
+    0.0,
+    0.0,
+    0.0,
+    CH_RIG_MOMENT_NMM / float(np.radians(LT_ROTATION_DEG)),
+)
+"""The lunotriquetral joint's in-plane constraint (`solver.forces.joint_forces`), in the joint's axes
+carried by the lunate (as `CH_JOINT_STIFFNESS`): 20 N over 1.475 mm (13.6 N/mm) in the plane, 0.5 N·m
+over 35 deg (0.82 N·m/rad) about the normal, nothing along the normal or about the in-plane axes (the
+bands and the contact). It is needed for the reason the capitohamate joint's is: the lunotriquetral joint
+is nearly planar too (Berger, in Hand Surgery, ch. 26: "the mutually articulating surfaces of the lunate
+and triquetrum are nearly planar"), and its three bands, tension-only fibres straight across a joint of
+1-2 mm, resist distraction but, to first order, neither a shear nor a turn in its plane (a fibre's end
+moved sideways by δ stretches it by δ²/2L), while Ritt 1998 measured the ligament's constraint there. The
+joint is about 4x softer in rotation and 2x softer in shear than the capitohamate (Ritt 1996's 9 deg and
+0.65 mm), as the proximal row is less tightly bound than the distal (Ruby 1988)."""
+STIFFNESS_UT, SOURCE_UT = 40.0, "Nagao 2005 (Table 2's UL); Berger 2001"
+"""The ulnotriquetral ligament runs from the palmar radioulnar ligament of the TFCC, ulnar to the
+ulnolunate, to the palmar triquetrum (Berger 2001, Clin Orthop 383:32; Nagao 2005): a twin of the UL
+from the same origin. No stiffness of it is published; it takes the UL's Table 2 mean (40 N/mm, Nagao
+2005), SD 30 %, as the fixed ligaments without data take a neighbour's (`STIFFNESS_TZC`)."""
 FIXED_LIGAMENTS = (
     Ligament("TC", "palmar triquetrocapitate ligament", 3, 20.0, 6.0, False, "Garcia-Elias 2017; Weaver 1994"),
     Ligament("TH", "palmar triquetrohamate ligament", 3, 20.0, 6.0, False, "Garcia-Elias 2017; Weaver 1994"),
@@ -120,9 +169,26 @@ FIXED_LIGAMENTS = (
     Ligament(
         "CH_p", "palmar capitohamate interosseous ligament", 3, STIFFNESS_CH, 0.3 * STIFFNESS_CH, False, SOURCE_CH
     ),
+    Ligament(
+        "LT_v", "palmar lunotriquetral interosseous ligament", 3, STIFFNESS_LT, 0.3 * STIFFNESS_LT, False, SOURCE_LT
+    ),
+    Ligament(
+        "LT_p",
+        "proximal (membranous) lunotriquetral interosseous ligament",
+        3,
+        STIFFNESS_LT,
+        0.3 * STIFFNESS_LT,
+        False,
+        SOURCE_LT,
+    ),
+    Ligament(
+        "LT_d", "dorsal lunotriquetral interosseous ligament", 3, STIFFNESS_LT, 0.3 * STIFFNESS_LT, False, SOURCE_LT
+    ),
+    Ligament("UT", "ulnotriquetral ligament", 3, STIFFNESS_UT, 0.3 * STIFFNESS_UT, False, SOURCE_UT),
 )
 """Ligaments outside the design: the radial column's (TZC_p, TZC_d, STT: `COLUMN_LIGAMENTS`,
-stiffness above), the hamate's (CH_deep, CH_d, CH_p: `HAMATE_LIGAMENTS`, stiffness `STIFFNESS_CH`) and,
+stiffness above), the hamate's (CH_deep, CH_d, CH_p: `HAMATE_LIGAMENTS`, stiffness `STIFFNESS_CH`), the
+triquetrum's (LT_v, LT_p, LT_d, UT: `TRIQUETRUM_LIGAMENTS`, stiffness `STIFFNESS_LT`, `STIFFNESS_UT`) and,
 built with the distal row, the two insertions (capitate,
 hamate) of the triquetrum–hamate–capitate ligament, the ulnar arm of the palmar arcuate
 (midcarpal) ligament and the main passive stabilizer of the midcarpal joint in neutral
@@ -137,9 +203,17 @@ COLUMN_LIGAMENTS = ("TZC_p", "TZC_d", "STT")
 """The fixed ligaments that hold the radial column (`model.BODY_PARTS`): built in every variant."""
 HAMATE_LIGAMENTS = ("CH_deep", "CH_d", "CH_p")
 """The fixed ligaments that hold the hamate to the capitate (`model.BODY_PARTS`): built in every variant."""
-BODY_LIGAMENTS = COLUMN_LIGAMENTS + HAMATE_LIGAMENTS
-"""The fixed ligaments that hold the distal row's free bodies: built in every variant (not TC and TH,
-which `builder.params.BuildParams.fixed_ligaments` can leave out)."""
+TRIQUETRUM_LIGAMENTS = ("LT_v", "LT_p", "LT_d", "UT")
+"""The fixed ligaments that hold the triquetrum (`model.BODY_PARTS`): its lunotriquetral interosseous
+ligament's palmar, proximal and dorsal regions (Ritt 1998) and the ulnotriquetral ligament; built in every
+variant with the distal row (without it the triquetrum is detached: `model.DETACHED_WITHOUT_DISTAL_ROW`)."""
+BODY_LIGAMENTS = COLUMN_LIGAMENTS + HAMATE_LIGAMENTS + TRIQUETRUM_LIGAMENTS
+"""The fixed ligaments that hold the free bodies other than the scaphoid and lunate: built in every
+variant (not TC and TH, which `builder.params.BuildParams.fixed_ligaments` can leave out)."""
+JOINTS = (("capitohamate", CH_JOINT_STIFFNESS), ("lunotriquetral", LT_JOINT_STIFFNESS))
+"""The planar joints whose ligaments' in-plane constraint is a spring (`solver.forces.joint_forces`): each
+contact pair (`model.PAIRS`: its sample body moves on its grid body, which carries the joint's axes) and
+its stiffness (N/mm, N/mm, N/mm, then N·mm/rad, in the joint's two in-plane axes and its normal)."""
 ALL_LIGAMENTS = LIGAMENTS + FIXED_LIGAMENTS
 ALL_LIGAMENT_NAMES = tuple(lig.name for lig in ALL_LIGAMENTS)
 """The design's eleven ligaments, then the fixed ones: the order of every per-bundle output."""

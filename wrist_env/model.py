@@ -17,26 +17,35 @@ from numpy.typing import ArrayLike
 from wrist_env.errors import InputError
 from wrist_env.io import load_dataclass, save_dataclass
 
-BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate", "trapezium", "hamate")
-"""The seven rigid bodies, each named after its principal bone."""
-RADIUS, ULNA, SCAPHOID, LUNATE, CAPITATE, TRAPEZIUM, HAMATE = range(7)
+BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate", "trapezium", "hamate", "triquetrum")
+"""The eight rigid bodies, each named after its principal bone."""
+RADIUS, ULNA, SCAPHOID, LUNATE, CAPITATE, TRAPEZIUM, HAMATE, TRIQUETRUM = range(8)
 N_BODIES = len(BONES)
-FREE = (SCAPHOID, LUNATE, TRAPEZIUM, HAMATE)
+FREE = (SCAPHOID, LUNATE, TRAPEZIUM, HAMATE, TRIQUETRUM)
 """The bodies free in 6 DOF under every driver (the capitate is driven; the radius and ulna fixed)."""
 CARRIED = (TRAPEZIUM, HAMATE)
 """The free bodies of the distal row, which the driven capitate carries: their dislocation is measured
-from where the capitate carries them (`solver.stopping.displacement`)."""
+from where the capitate carries them (`solver.stopping.displacement`). The triquetrum is a proximal-row
+bone: like the scaphoid and lunate, its dislocation is measured from its neutral place."""
 BODY_PARTS = {
     "radius": ("radius",),
     "ulna": ("ulna",),
     "scaphoid": ("scaphoid",),
-    "lunate": ("lunate", "triquetrum"),
+    "lunate": ("lunate",),
     "capitate": ("capitate",),
     "trapezium": ("trapezium", "trapezoid"),
     "hamate": ("hamate",),
+    "triquetrum": ("triquetrum",),
 }
-"""The bones of each rigid body, principal bone first: the triquetrum moves with the lunate
-(lunotriquetral motion is small beside scapholunate motion: Ruby 1988, Kobayashi 1997). The trapezium
+"""The bones of each rigid body, principal bone first. The triquetrum is a body of its own (issue 54,
+step 3; until builder 8 it moved with the lunate): the ulnar column (hamate → triquetrohamate joint →
+triquetrum → TFCC → ulna) needs it to balance its own loads, as in every full-carpus model that bears
+load (Fischli 2009; Bajuri 2012); it is held to the lunate by the lunotriquetral interosseous ligament's
+three regions and joint, of measured constraint (Ritt, Linscheid, Cooney & Berger 1998, J Hand Surg Am
+23:425; `design.TRIQUETRUM_LIGAMENTS`, `design.LT_JOINT_STIFFNESS`), and to the ulna by the
+ulnotriquetral ligament; the lunotriquetral motion it allows stays small beside the scapholunate's
+(the proximal row's bones "less tightly bound but still moving together": Ruby 1988, J Hand Surg Am
+13:1; Kobayashi 1997, Hand Clin 13:143; `validation` checks it). The trapezium
 and trapezoid are the radial column, a body of its own: it loads the scaphoid's distal pole through the
 STT joint with the 1st and 2nd rays' loads (issue 33: with it on the driven capitate no load reached the
 STT joint), held to the capitate by the trapezocapitate ligaments and joint (`design.FIXED_LIGAMENTS`).
@@ -53,10 +62,14 @@ SUPPLIED = ("radius", "ulna", "scaphoid", "lunate", "capitate")
 hamate and the other parts are carried from the template with the capitate (`anatomy.template.carry_parts`)."""
 CARPALS = ("scaphoid", "lunate", "capitate")
 """The carpals a participant supplies meshes of and a trial tracks (the forearm bones are the radius and ulna)."""
-CARRIED_WITH = {"trapezium": "capitate", "hamate": "capitate"}
+CARRIED_WITH = {"trapezium": "capitate", "hamate": "capitate", "triquetrum": "lunate"}
 """Bodies not in `SUPPLIED`, and the supplied body whose registration carries them."""
 PARTS = tuple(p for b in BONES for p in BODY_PARTS[b])
 """All nine bones of the model, body by body (`BODY_PARTS`)."""
+DETACHED_WITHOUT_DISTAL_ROW = ("triquetrum",)
+"""Bodies a model without the distal row (`builder.params.BuildParams.distal_row`) builds but leaves
+detached: no contact samples and no ligaments of theirs (so no load reaches them and they stay where
+they are), the lunate alone as it was before the triquetrum joined its body."""
 PAIRS = (
     "radioscaphoid",
     "radiolunate",
@@ -65,9 +78,11 @@ PAIRS = (
     "lunocapitate",
     "scaphotrapezial",
     "trapeziocapitate",
-    "ulnocarpal",
+    "ulnolunate",
     "capitohamate",
     "triquetrohamate",
+    "ulnotriquetral",
+    "lunotriquetral",
 )
 PAIR_BONES = np.array(
     [
@@ -80,33 +95,40 @@ PAIR_BONES = np.array(
         [TRAPEZIUM, CAPITATE],
         [LUNATE, ULNA],
         [HAMATE, CAPITATE],
-        [LUNATE, HAMATE],
+        [TRIQUETRUM, HAMATE],
+        [TRIQUETRUM, ULNA],
+        [TRIQUETRUM, LUNATE],
     ]
 )
 """(sample bone, grid bone) of each contact pair: samples of the first are looked up in the second's grid.
 "scaphotrapezial" is the STT joint (the trapezium's and trapezoid's facets on the scaphoid's distal
 pole), "trapeziocapitate" the radial column against the capitate (chiefly the trapezoid–capitate joint),
-"ulnocarpal" the lunate and triquetrum on the ulnar head through the TFCC, a compliant layer on the ulna
-filling the ulnocarpal space (`builder.pipeline`): the ulnar load path (Palmer & Werner 1984).
-"capitohamate" is the hamate against the capitate, "triquetrohamate" the lunate body (the triquetrum,
-and the lunate where it reaches the hamate: a type II lunate's hamate facet, Viegas 1990) on the hamate."""
+"ulnolunate" and "ulnotriquetral" the lunate and the triquetrum, each its own pair, on the ulnar head
+through the TFCC, a compliant layer on the ulna filling the ulnocarpal space (`builder.pipeline`): the
+ulnar load path (Palmer & Werner 1984). "capitohamate" is the hamate against the capitate,
+"triquetrohamate" the triquetrum on the hamate, "lunotriquetral" the triquetrum against the lunate (a
+nearly planar joint: Berger, in Hand Surgery, ch. 26). No lunohamate pair: the template's lunate has no
+hamate facet (builder 8's lunate body had no sample of its lunate on the hamate within the 2.5 mm
+coverage gap on P1-P3: a type I lunate, Viegas 1990), so the pair would be empty."""
 ARTICULATIONS = {
     "radioscaphoid": ("radioscaphoid", ("scaphoid",)),
-    "radiolunate": ("radiolunate", ("lunate", "triquetrum")),
+    "radiolunate": ("radiolunate", ("lunate",)),
     "scapholunate": ("scapholunate", ("scaphoid",)),
     "scaphotrapeziotrapezoid": ("scaphotrapezial", ("trapezium", "trapezoid")),
     "scaphocapitate": ("scaphocapitate", ("capitate",)),
     "lunocapitate": ("lunocapitate", ("capitate",)),
     "triquetrohamate": ("triquetrohamate", ("triquetrum",)),
-    "lunohamate": ("triquetrohamate", ("lunate",)),
     "trapeziocapitate": ("trapeziocapitate", ("trapezium", "trapezoid")),
-    "ulnolunate": ("ulnocarpal", ("lunate",)),
-    "ulnotriquetral": ("ulnocarpal", ("triquetrum",)),
+    "ulnolunate": ("ulnolunate", ("lunate",)),
+    "ulnotriquetral": ("ulnotriquetral", ("triquetrum",)),
     "capitohamate": ("capitohamate", ("hamate",)),
+    "lunotriquetral": ("lunotriquetral", ("triquetrum",)),
 }
 """Each articulation as (contact pair, the parts of the pair's sample body on its side): a pair whose
-sample body holds several bones (`BODY_PARTS`) spans several joints (the lunate body's samples on the
-hamate are the triquetrohamate joint on the triquetrum, the lunohamate on the lunate)."""
+sample body holds several bones (`BODY_PARTS`) spans several joints (the radial column's samples on the
+scaphoid are the STT joint on the trapezium and the trapezoid)."""
+TFCC_PAIRS = ("ulnolunate", "ulnotriquetral")
+"""The contact pairs through the TFCC (the ulnar load path: their sum is the ulnocarpal share)."""
 MIDCARPAL = ("scaphotrapeziotrapezoid", "scaphocapitate", "lunocapitate", "triquetrohamate")
 """The midcarpal articulations whose load shares Viegas 1993 measured (STT, SC, LC, TH)."""
 
@@ -115,20 +137,20 @@ MIDCARPAL = ("scaphotrapeziotrapezoid", "scaphocapitate", "lunocapitate", "triqu
 class Model:
     """A participant model.
 
-    Bones (7, `BONES` order):
-        vertices (V, 3) mm, vertex_offsets (8,); faces (F, 3) local indices, face_offsets (8,);
+    Bones (8, `BONES` order):
+        vertices (V, 3) mm, vertex_offsets (9,); faces (F, 3) local indices, face_offsets (9,);
         vertex_part (V,) index into `BODY_PARTS[body]` of the bone each vertex belongs to;
         thickness (V,) mm, cartilage thickness per vertex (0 off cartilage);
-        mass (7,) t; com (7, 3) mm; inertia (7, 3, 3) t·mm² about the com, RCS axes;
-        centroid (7, 3) mm, volume centroid of each body's principal bone alone (the point
-        whose motion the kinematic cost tracks; the lunate's without the triquetrum).
-    Contact grids (one per bone; empty for the radial column; the ulna's its head, closed, with the TFCC):
-        grid_origin (7, 3) mm; grid_spacing (7,) mm; grid_shape (7, 3);
-        grid_values (G,) float32 mm, C-order per bone, grid_offsets (8,).
-    Contact samples (pair-sorted, 10 pairs in `PAIRS` order, bones in `PAIR_BONES`):
+        mass (8,) t; com (8, 3) mm; inertia (8, 3, 3) t·mm² about the com, RCS axes;
+        centroid (8, 3) mm, volume centroid of each body's principal bone alone (the point
+        whose motion the kinematic cost tracks: the scaphoid's and the lunate's).
+    Contact grids (one per bone; empty for the radial column and the triquetrum, sample bodies only; the ulna's its head, closed, with the TFCC):
+        grid_origin (8, 3) mm; grid_spacing (8,) mm; grid_shape (8, 3);
+        grid_values (G,) float32 mm, C-order per bone, grid_offsets (9,).
+    Contact samples (pair-sorted, 12 pairs in `PAIRS` order, bones in `PAIR_BONES`):
         sample_points (S, 3) mm on the sample bone's cartilage surface; sample_normals (S, 3);
         sample_area (S,) mm²; sample_thickness (S,) mm, total cartilage thickness of both layers;
-        sample_offsets (11,).
+        sample_offsets (13,).
     contact_law (5,): tri-linear pressure–strain law [e1, e2, k1, k2, k3] (strain, MPa).
     Ligament fibres (1D bundles, Table 2 order):
         fibre_ligament (N,) ligament index; fibre_bones (N, 2) origin, insertion bone;

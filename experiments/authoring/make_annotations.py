@@ -6,7 +6,8 @@ cites (Table 2): Berger 2001 (SLIL regions, RSC, LRL), Nagao 2005 (SRL, DRC,
 UL), Mizuseki 1989 (DRC), Ringler 2013 (RCL), Apergis 2013 (SCL), Moritomo
 2013 (UCL); Berger 2001 and Garcia-Elias 2017 for the fixed TC and TH; Garcia-Elias 1989,
 Nanno 2006 and Bettinger 1999 for the radial column's TZC_p, TZC_d and STT; Ritt 1996 for the
-hamate's capitohamate CH_deep, CH_d and CH_p. A rule
+hamate's capitohamate CH_deep, CH_d and CH_p; Ritt 1998 for the triquetrum's lunotriquetral LT_v, LT_p and
+LT_d, Berger 2001 and Nagao 2005 for its ulnotriquetral UT. A rule
 picks the extreme vertex of a bone region along an anatomical direction; the patch is the bone surface within `radius_mm` of it.
 Cartilage coverage is the part of each bone facing its partner within a gap.
 
@@ -112,7 +113,7 @@ def main() -> None:
         ),
         # Nagao 2005, Mizuseki 1989: DRC from the dorsal rim of the radius (Lister's region)
         # to the dorsal lunate (with the distal row and triquetrum: on to the dorsal tubercle
-        # of the triquetrum, which moves with the lunate body; see `part` below).
+        # of the triquetrum, its own body; see below).
         "DRC": (
             ("radius", extreme(V["radius"], (-1, -0.2, 0), distal_radius & (np.abs(V["radius"][:, 2]) < 5))),
             ("lunate", extreme(V["lunate"], (-1, 0, 0))),
@@ -142,11 +143,11 @@ def main() -> None:
             "origin": {"bone": ob, "centre_mm": np.round(oc, 3).tolist(), "radius_mm": patch_radius(ob, lig)},
             "insertion": {"bone": ib, "centre_mm": np.round(ic, 3).tolist(), "radius_mm": patch_radius(ib, lig)},
         }
-    # Mizuseki 1989: the DRC's main insertion is the dorsal tubercle of the triquetrum.
+    # Mizuseki 1989: the DRC's main insertion is the dorsal tubercle of the triquetrum (its own body;
+    # without the distal row, the triquetrum detached, the dorsal lunate: `without_part`).
     drc = ligaments["DRC"]["insertion"]
     ligaments["DRC"]["insertion"] = {
-        "bone": "lunate",
-        "part": "triquetrum",
+        "bone": "triquetrum",
         "centre_mm": np.round(extreme(V["triquetrum"], (-1, 0, 0)), 3).tolist(),
         "radius_mm": drc["radius_mm"],
         "without_part": drc,
@@ -155,8 +156,7 @@ def main() -> None:
     # palmar-distal triquetrum to the palmar capitate neck (TC, beside the UCL's insertion) and
     # to the palmar hamate body proximal to its hook (TH). Fixed ligaments of the distal row.
     tri = {
-        "bone": "lunate",
-        "part": "triquetrum",
+        "bone": "triquetrum",
         "radius_mm": 2.0,
         "centre_mm": np.round(extreme(V["triquetrum"], (1, -0.6, 0.4)), 3).tolist(),
     }
@@ -220,6 +220,42 @@ def main() -> None:
                 "centre_mm": np.round(extreme(V["capitate"], direction, level), 3).tolist(),
             },
         }
+    # The triquetrum (its own body, issue 54 step 3): bound to the lunate by the lunotriquetral
+    # interosseous ligament, C-shaped like the SLIL, of three regions spanning the rims of the joint:
+    # palmar and dorsal true ligaments and a proximal membranous (fibrocartilage) region (Ritt,
+    # Linscheid, Cooney & Berger 1998, J Hand Surg Am 23:425; Berger, Hand Surgery ch. 26). Each band's
+    # ends are the two bones' extremes, along its direction, of their surfaces within 3 mm of each
+    # other, as the SLIL's.
+    t_l, l_t = near("triquetrum", "lunate", 3.0), near("lunate", "triquetrum", 3.0)
+    for name, direction in (("LT_v", (1, 0, 0)), ("LT_p", (0, 1, 0)), ("LT_d", (-1, 0, 0))):
+        ligaments[name] = {
+            "origin": {
+                "bone": "triquetrum",
+                "radius_mm": 2.0,
+                "centre_mm": np.round(extreme(V["triquetrum"], direction, t_l), 3).tolist(),
+            },
+            "insertion": {
+                "bone": "lunate",
+                "radius_mm": 2.0,
+                "centre_mm": np.round(extreme(V["lunate"], direction, l_t), 3).tolist(),
+            },
+        }
+    # The ulnotriquetral ligament: from the palmar radioulnar ligament of the TFCC at the ulnar head's
+    # palmar-distal edge, ulnar to the UL's origin (midway across the head, not yet the styloid), to the
+    # palmar face of the triquetrum, proximal to the TC/TH origin (Berger 2001, Clin Orthop 383:32;
+    # Nagao 2005).
+    ligaments["UT"] = {
+        "origin": {
+            "bone": "ulna",
+            "radius_mm": 3.0,
+            "centre_mm": np.round(extreme(V["ulna"], (1, -0.5, 0), distal_ulna), 3).tolist(),
+        },
+        "insertion": {
+            "bone": "triquetrum",
+            "radius_mm": 2.0,
+            "centre_mm": np.round(extreme(V["triquetrum"], (1, 0.5, 0)), 3).tolist(),
+        },
+    }
     ligaments["STT"] = {
         "origin": {
             "bone": "scaphoid",
@@ -244,12 +280,16 @@ def main() -> None:
         "scaphotrapezial": {"bones": ["scaphoid", "trapezium"], "max_gap_mm": 3.0},
         "trapeziocapitate": {"bones": ["trapezium", "capitate"], "max_gap_mm": 2.5},
         # the TFCC fills the ulnocarpal space: the lunate lies 5.8-6.6 mm and the triquetrum 8.8-10.1 mm
-        # from the template's ulnar head (issue 33); the disc covers the head's distal face
-        "ulnocarpal": {"bones": ["ulna", "lunate"], "max_gap_mm": 10.5},
-        # the hamate, its own body (issue 54): against the capitate, and the lunate body on it (the
-        # triquetrum's helicoid facet; the lunate's, where a type II lunate reaches it)
+        # from the template's ulnar head (issue 33); the disc covers the head's distal face. The lunate and
+        # the triquetrum, each its own body, each bear on it as a pair of their own
+        "ulnolunate": {"bones": ["ulna", "lunate"], "max_gap_mm": 10.5},
+        # the hamate, its own body (issue 54): against the capitate, and the triquetrum's helicoid facet
+        # on it (the template's lunate is type I: no hamate facet)
         "capitohamate": {"bones": ["hamate", "capitate"], "max_gap_mm": 2.5},
-        "triquetrohamate": {"bones": ["lunate", "hamate"], "max_gap_mm": 2.5},
+        "triquetrohamate": {"bones": ["triquetrum", "hamate"], "max_gap_mm": 2.5},
+        "ulnotriquetral": {"bones": ["ulna", "triquetrum"], "max_gap_mm": 10.5},
+        # the triquetrum against the lunate: the lunotriquetral joint, nearly planar (Berger, ch. 26)
+        "lunotriquetral": {"bones": ["triquetrum", "lunate"], "max_gap_mm": 2.5},
     }
     data = {
         "about": "wrist-env template annotations in the template RCS (mm); written by experiments/authoring/make_annotations.py",

@@ -3,8 +3,8 @@
 For each participant (population design, capitate held at neutral under the validation's 100 N), one
 section per `--only` key:
 
-- `paths`: the contact force on each bone of each contact pair's sample body (the distal row's parts,
-  the triquetrum with the lunate) with the neutral gaps of those samples to the opposing surface, then
+- `paths`: the contact force on each bone of each contact pair's sample body (the radial column's
+  parts) with the neutral gaps of those samples to the opposing surface, then
   the force and share of each articulation (`model.ARTICULATIONS`: the midcarpal shares against Viegas
   1993, the ulnar share against Palmer & Werner 1984) as `wrist-bench validate` checks them, and the
   space a TFCC would fill (`ulnocarpal_space`).
@@ -118,9 +118,13 @@ def ulnocarpal_space(model) -> dict:
     to the ulna's surface, and the ulnar variance (mm, + ulna plus) the build seated the ulna at, its
     osteotomy included (`recorded_variance`)."""
     ulna_v, ulna_f, _ = _body(model, BONES.index("ulna"))
-    lunate_v, _, part = _body(model, BONES.index("lunate"))
-    _, distance, _ = trimesh.proximity.closest_point(trimesh.Trimesh(ulna_v, ulna_f, process=False), lunate_v)
-    out = {f"{p}_to_ulna_mm": float(distance[part == q].min()) for q, p in enumerate(BODY_PARTS["lunate"])}
+    ulna = trimesh.Trimesh(ulna_v, ulna_f, process=False)
+    out = {}
+    for bone in ("lunate", "triquetrum"):  # each its own body since builder 9
+        body = next(b for b in BONES if bone in BODY_PARTS[b])
+        v, _, part = _body(model, BONES.index(body))
+        _, distance, _ = trimesh.proximity.closest_point(ulna, v[part == BODY_PARTS[body].index(bone)])
+        out[f"{bone}_to_ulna_mm"] = float(distance.min())
     return out | {"ulnar_variance_mm": recorded_variance(model)}
 
 

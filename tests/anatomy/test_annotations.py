@@ -11,16 +11,13 @@ def ann():
 
 
 def test_every_articulation_is_covered_on_both_bones(ann):
-    """Each articulation has cartilage on both bones; the triquetrohamate one only with the distal row (the
-    lunate body's triquetrum: the template's lunate, a type I lunate, comes no nearer the hamate than 3.8 mm)."""
+    """Each articulation has cartilage on both bones in both variants (the triquetrum is a body of its own in
+    both: a model without the distal row drops its pairs, `builder.pipeline.ABSENT_WITHOUT_DISTAL_ROW`)."""
     with_row = template_annotations((20.0, 10.0), True)
     for art in ARTICULATIONS:
         for coverage in (ann.coverage, with_row.coverage):
             a, b, ma, mb = coverage[art]
-            if art == "triquetrohamate" and coverage is ann.coverage:
-                assert ma.sum() == 0, art
-                continue
-            least = 30 if art == "triquetrohamate" else 100
+            least = 30 if art in ("triquetrohamate", "ulnotriquetral") else 100
             assert ma.sum() > least and mb.sum() > least, (art, ma.sum(), mb.sum())
 
 
@@ -46,9 +43,9 @@ def test_site_bones_follow_the_anatomy():
 
 
 def test_fixed_midcarpal_ligaments_join_the_triquetrum_to_the_distal_row():
-    """TC and TH (design.FIXED_LIGAMENTS) run palmar, from the triquetrum to the capitate neck and the
-    hamate body (a body of its own); they are resolved only on bodies that carry the triquetrum (the
-    distal row)."""
+    """TC and TH (design.FIXED_LIGAMENTS) run palmar, from the triquetrum (a body of its own) to the capitate
+    neck and the hamate body (a body of its own); they are resolved only with the distal row (without it
+    the triquetrum is detached: `model.DETACHED_WITHOUT_DISTAL_ROW`)."""
     from wrist_env.anatomy.annotations import template_annotations
     from wrist_env.anatomy.template import load_template
     from wrist_env.design import FIXED_LIGAMENTS
@@ -58,7 +55,7 @@ def test_fixed_midcarpal_ligaments_join_the_triquetrum_to_the_distal_row():
     bones = load_template((20.0, 10.0), True).bones
     for lig in (lig for lig in FIXED_LIGAMENTS if lig.name in ("TC", "TH")):
         spec = data[lig.name]
-        assert spec["origin"]["part"] == "triquetrum"
+        assert spec["origin"]["bone"] == "triquetrum" and "part" not in spec["origin"]
         assert spec["insertion"]["bone"] == {"TC": "capitate", "TH": "hamate"}[lig.name]
         assert "part" not in spec["insertion"]
         assert spec["origin"]["centre_mm"][0] > 5.0 and spec["insertion"]["centre_mm"][0] > 5.0  # palmar (x volar)
@@ -101,3 +98,40 @@ def test_the_capitohamate_bands_span_the_joint_at_its_dorsal_palmar_and_deep_dis
         origin, insertion = sites[name]
         assert (origin.bone, insertion.bone) == ("hamate", "capitate")
         assert origin.mask.sum() >= 5 and insertion.mask.sum() >= 5, name
+
+
+def test_the_lunotriquetral_bands_span_the_joint_at_its_palmar_proximal_and_dorsal_rims():
+    """LT_v, LT_p and LT_d (design.TRIQUETRUM_LIGAMENTS, Ritt 1998: a C-shaped ligament like the SLIL) run
+    from the triquetrum to the lunate, each end within 3 mm of the other bone, the palmar band palmar of the
+    proximal and the dorsal dorsal of it (x volar), the proximal band the most proximal (y proximal), each
+    2-5 mm long; the UT from the ulna's palmar-distal head to the palmar triquetrum, ulnar to the UL's
+    origin. All resolved with the distal row, none without it (the triquetrum detached), and the DRC then
+    inserts on the lunate instead (its `without_part`)."""
+    from scipy.spatial import cKDTree
+
+    from wrist_env.anatomy.template import load_template
+    from wrist_env.design import TRIQUETRUM_LIGAMENTS
+
+    data = read_annotation_data()["ligaments"]
+    parts = load_template().parts
+    near = {b: cKDTree(parts[b].vertices) for b in ("triquetrum", "lunate")}
+    centre = {}
+    for name in ("LT_v", "LT_p", "LT_d"):
+        o, i = data[name]["origin"], data[name]["insertion"]
+        assert (o["bone"], i["bone"]) == ("triquetrum", "lunate")
+        a, b = np.array(o["centre_mm"]), np.array(i["centre_mm"])
+        assert near["lunate"].query(a)[0] < 3.0 and near["triquetrum"].query(b)[0] < 3.0, name
+        assert 2.0 < np.linalg.norm(b - a) < 5.0, name
+        centre[name] = (a + b) / 2
+    assert centre["LT_d"][0] < centre["LT_p"][0] < centre["LT_v"][0]
+    assert centre["LT_p"][1] > max(centre["LT_v"][1], centre["LT_d"][1])
+    ut, ul = data["UT"], data["UL"]
+    assert (ut["origin"]["bone"], ut["insertion"]["bone"]) == ("ulna", "triquetrum")
+    assert ut["origin"]["centre_mm"][2] < ul["origin"]["centre_mm"][2]  # ulnar (z radial) to the UL
+    assert ut["origin"]["centre_mm"][0] > 0 and ut["insertion"]["centre_mm"][0] > 5.0  # palmar
+    with_row, without = template_annotations((20.0, 10.0), True), template_annotations((20.0, 10.0), False)
+    for name in TRIQUETRUM_LIGAMENTS:
+        origin, insertion = with_row.sites[name]
+        assert origin.mask.sum() >= 5 and insertion.mask.sum() >= 5, name
+        assert name not in without.sites
+    assert with_row.sites["DRC"][1].bone == "triquetrum" and without.sites["DRC"][1].bone == "lunate"

@@ -110,38 +110,46 @@ def test_lines_need_a_known_rig(p1):
         model_lines(p1, "no_such_rig")
 
 
-def test_the_capitohamate_joint_resists_a_shift_and_a_turn_in_its_plane_by_ritts_constraint(p1):
-    """`forces.joint_forces` (the capitohamate joint's in-plane constraint, `design.CH_JOINT_STIFFNESS` from
-    Ritt 1996): the hamate moved by 0.5 mm along the joint's dorsopalmar axis, 0.3 mm proximodistally and
-    0.2 mm along the normal, and turned 5 deg about the normal, gets back 30.8 N/mm × 0.5 and × 0.3 mm in
-    the plane, nothing along the normal, and −3.18 N·m/rad × 5 deg about it plus the shift's lever; the
-    capitate gets the opposite force and moment (about its own centre point)."""
+@pytest.mark.parametrize(
+    "pair, shear_mm, turn_deg",
+    [("capitohamate", 0.65, 9.0), ("lunotriquetral", 1.475, 35.0)],
+)
+def test_a_planar_joint_resists_a_shift_and_a_turn_in_its_plane_by_ritts_constraint(p1, pair, shear_mm, turn_deg):
+    """`forces.joint_forces` (the planar joints' in-plane constraint, `design.JOINTS`: the capitohamate from
+    Ritt 1996, the lunotriquetral from Ritt 1998): the moving body (hamate, triquetrum) moved by 0.5 mm
+    along the joint's dorsopalmar axis, 0.3 mm along the other in-plane axis and 0.2 mm along the normal,
+    and turned 5 deg about the normal, gets back 20 N / shear × 0.5 and × 0.3 mm in the plane, nothing
+    along the normal, and −0.5 N·m / turn × 5 deg about it plus the shift's lever; the carrier (capitate,
+    lunate) gets the opposite force and moment (about its own centre point)."""
     from scipy.spatial.transform import Rotation
 
-    from wrist_env.design import CH_JOINT_STIFFNESS
-    from wrist_env.model import CAPITATE, HAMATE
+    from wrist_env.design import JOINTS
+    from wrist_env.model import PAIR_BONES, PAIRS
     from wrist_env.solver.forces import joint_forces
 
     p = prepare(p1, mode=1)
     bod = p.bodies
-    centre, axes = bod.joint_centre, bod.joint_axes
-    assert np.allclose(axes @ axes.T, np.eye(3)) and axes[2, 2] > 0.8  # the normal is radioulnar
+    j = [name for name, _ in JOINTS].index(pair)
+    mover, carrier = PAIR_BONES[PAIRS.index(pair)]
+    assert bod.joint_bodies[j].tolist() == [mover, carrier]
+    centre, axes = bod.joint_centre[j], bod.joint_axes[j]
+    assert np.allclose(axes @ axes.T, np.eye(3)) and abs(axes[2, 2]) > 0.7  # the normal is radioulnar
     R = np.tile(np.eye(3), (len(BONES), 1, 1))
     turn = np.radians(5.0)
-    R[HAMATE] = Rotation.from_rotvec(turn * axes[2]).as_matrix()
+    R[mover] = Rotation.from_rotvec(turn * axes[2]).as_matrix()
     x = bod.com0.copy()
     shift = 0.5 * axes[0] + 0.3 * axes[1] + 0.2 * axes[2]
-    # the hamate's centre point (its neutral place of the joint's centre) at centre + shift
-    x[HAMATE] = centre + shift - R[HAMATE] @ (centre - bod.com0[HAMATE])
+    # the mover's centre point (its neutral place of the joint's centre) at centre + shift
+    x[mover] = centre + shift - R[mover] @ (centre - bod.com0[mover])
     F, T = np.zeros((len(BONES), 3)), np.zeros((len(BONES), 3))
     energy = joint_forces(R, x, bod.com0, bod, F, T, True)
-    k = CH_JOINT_STIFFNESS
+    k = bod.joint_stiffness[j]
     force = -(k[0] * 0.5 * axes[0] + k[1] * 0.3 * axes[1])
-    np.testing.assert_allclose(F[HAMATE], force, atol=1e-9)
-    np.testing.assert_allclose(F[CAPITATE], -force, atol=1e-9)
-    lever_h = centre + shift - x[HAMATE]
-    np.testing.assert_allclose(T[HAMATE], np.cross(lever_h, force) - k[5] * turn * axes[2], atol=1e-6)
-    np.testing.assert_allclose(T[CAPITATE], np.cross(centre - x[CAPITATE], -force) + k[5] * turn * axes[2], atol=1e-6)
+    np.testing.assert_allclose(F[mover], force, atol=1e-9)
+    np.testing.assert_allclose(F[carrier], -force, atol=1e-9)
+    lever = centre + shift - x[mover]
+    np.testing.assert_allclose(T[mover], np.cross(lever, force) - k[5] * turn * axes[2], atol=1e-6)
+    np.testing.assert_allclose(T[carrier], np.cross(centre - x[carrier], -force) + k[5] * turn * axes[2], atol=1e-6)
     assert energy == pytest.approx(0.5 * (k[0] * 0.25 + k[1] * 0.09 + k[5] * turn**2))
-    assert k[0] == k[1] == pytest.approx(20 / 0.65)
-    assert k[5] == pytest.approx(500 / np.radians(9.0)) and k[2] == k[3] == k[4] == 0.0
+    assert k[0] == k[1] == pytest.approx(20 / shear_mm)
+    assert k[5] == pytest.approx(500 / np.radians(turn_deg)) and k[2] == k[3] == k[4] == 0.0

@@ -88,6 +88,7 @@ def _rigid_path(t):
     per unit t about its own axis and moves 0.3 mm per unit t."""
     axes = np.array(
         [[0, 0, 1.0], [1.0, 0, 0], [0, 1.0, 0], [1.0, 1.0, 0], [0, 1.0, 1.0], [1.0, 0, 1.0], [1.0, 1.0, 1.0]]
+        + [[1.0, -1.0, 0.5]]
     )[:N_BODIES]
     R = np.stack([Rotation.from_rotvec(0.05 * t * a / np.linalg.norm(a)).as_matrix() for a in axes])
     x = np.arange(3.0 * N_BODIES).reshape(N_BODIES, 3) + 0.3 * t * axes

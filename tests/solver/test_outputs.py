@@ -172,7 +172,8 @@ def test_articulations_split_each_pair_by_the_bone_under_its_samples(p1, sweep):
         named = {BODY_PARTS[body].index(q) for j in joints for q in ARTICULATIONS[j][1]}
         assert set(np.unique(sample_parts(p1, pair))) <= named, pair
     assert split["scaphocapitate"] > 0 and split["lunocapitate"] > 0
-    assert split["ulnocarpal"] > 0.0  # the TFCC: the lunate body bears on the ulnar head (issue 33)
+    assert split["ulnocarpal"] > 0.0  # the TFCC: the lunate bears on the ulnar head (issue 33)
+    assert split["ulnocarpal"] == pytest.approx(split["ulnolunate"] + split["ulnotriquetral"])  # both pairs
 
 
 def test_the_driven_bodys_load_adds_a_line_on_it_as_r_cross_f(p1):

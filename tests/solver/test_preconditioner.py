@@ -123,27 +123,30 @@ def test_the_block_mass_finds_the_diagonal_mass_answer_in_fewer_steps(p1, motion
     assert d[0] < 0.02 and d[1] < 0.15, d
 
 
-def test_the_tangent_includes_the_hamate_and_matches_the_force_kernels_jacobian_there(p1):
-    """The hamate (issue 54, step 2), the last of the free bodies: at frame 8 of P1's population sweep the
-    analytic tangent's hamate block (its 6 unknowns) and the block coupling it to the others are within
-    15 % (Frobenius) of the finite-difference tangent's, the hamate's block is not zero, and its rotations
-    carry at least the capitohamate joint's turn stiffness (`design.CH_JOINT_STIFFNESS`, 3.18 N·m/rad about
-    the joint's normal, `arrays.capitohamate_joint`)."""
-    from wrist_env.design import CH_JOINT_STIFFNESS
-    from wrist_env.model import FREE, HAMATE
-    from wrist_env.solver.arrays import capitohamate_joint
+@pytest.mark.parametrize("body, pair", [("hamate", "capitohamate"), ("triquetrum", "lunotriquetral")])
+def test_the_tangent_includes_the_split_bodies_and_matches_the_force_kernels_jacobian_there(p1, body, pair):
+    """The hamate (issue 54, step 2) and the triquetrum (step 3, the last of the free bodies): at frame 8 of
+    P1's population sweep the analytic tangent's block of the body (its 6 unknowns) and the block coupling
+    it to the others are within 15 % (Frobenius) of the finite-difference tangent's, its block is not
+    zero, and its rotations carry at least its planar joint's turn stiffness (`design.JOINTS`: 3.18 N·m/rad
+    about the capitohamate joint's normal, 0.82 about the lunotriquetral's, `arrays.planar_joint`)."""
+    from wrist_env.design import JOINTS
+    from wrist_env.model import BONES, FREE, PAIR_BONES, PAIRS, TRIQUETRUM
+    from wrist_env.solver.arrays import planar_joint
 
     driver = idealized(p1)
     result = simulate(p1, design.population(), driver)
     exact = tangent_stiffness(p1, design.population(), driver, result, frame=8).stiffness
     analytic = block_mass(p1, design.population(), driver, result, frame=8).stiffness
-    h = slice(6 * FREE.index(HAMATE), 6 * FREE.index(HAMATE) + 6)
+    b = BONES.index(body)
+    h = slice(6 * FREE.index(b), 6 * FREE.index(b) + 6)
     n = 6 * len(FREE) + 3  # the sweep's loaded capitate: its shift too
-    assert exact.shape == analytic.shape == (n, n) and FREE[-1] == HAMATE
+    assert exact.shape == analytic.shape == (n, n) and FREE[-1] == TRIQUETRUM
     assert np.linalg.norm(analytic[h, h]) > 0.0
     assert np.linalg.norm(analytic[h, h] - exact[h, h]) / np.linalg.norm(exact[h, h]) < 0.15
     assert np.linalg.norm(analytic[h, :] - exact[h, :]) / np.linalg.norm(exact[h, :]) < 0.15
-    _, axes, _ = capitohamate_joint(p1)
-    R = result.poses[8, 4, :3, :3]  # the capitate carries the joint's axes
+    stiffness = dict(JOINTS)[pair]
+    _, _, axes, _ = planar_joint(p1, pair, stiffness)
+    R = result.poses[8, PAIR_BONES[PAIRS.index(pair)][1], :3, :3]  # the carrier carries the joint's axes
     normal = R @ axes[2]
-    assert normal @ analytic[h, h][3:, 3:] @ normal >= CH_JOINT_STIFFNESS[5] * (1 - 1e-9)
+    assert normal @ analytic[h, h][3:, 3:] @ normal >= stiffness[5] * (1 - 1e-9)

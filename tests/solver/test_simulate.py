@@ -170,3 +170,21 @@ def test_the_column_carried_by_the_capitate_is_not_a_dislocation(p1):
         carried = np.einsum("fij,j->fi", R[:, CAPITATE], p1.com[body] - p1.com[CAPITATE]) + centre[:, CAPITATE]
         assert np.linalg.norm(centre[:, body] - p1.com[body], axis=1).max() > 8.0, body
         assert np.linalg.norm(centre[:, body] - carried, axis=1).max() < 1.0, body
+
+
+def test_the_triquetrum_is_measured_from_its_neutral_place_and_stays_near_it(p1):
+    """The triquetrum (issue 54, step 3) is a proximal-row bone: the dislocation check measures it from its
+    neutral place (`solver.stopping.displacement`, as the scaphoid and lunate), not from where the capitate
+    carries it; over the ±40° sweep it moves with the lunate, within 5 mm of its neutral place, and its
+    centre stays within 1.5 mm of where the lunate carries it (the lunotriquetral joint's shear under
+    20 N is 1.2-1.8 mm: Ritt 1998)."""
+    from wrist_env.model import CARRIED, LUNATE, TRIQUETRUM
+
+    assert TRIQUETRUM not in CARRIED
+    result = simulate(p1, design.population(), idealized(p1), SolverSettings(max_disp_mm=5.0))
+    assert result.ok, result.message
+    R, t = result.poses[:, :, :3, :3], result.poses[:, :, :3, 3]
+    centre = np.einsum("fbij,bj->fbi", R, p1.com) + t
+    assert np.linalg.norm(centre[:, TRIQUETRUM] - p1.com[TRIQUETRUM], axis=1).max() < 5.0
+    carried = np.einsum("fij,j->fi", R[:, LUNATE], p1.com[TRIQUETRUM] - p1.com[LUNATE]) + centre[:, LUNATE]
+    assert np.linalg.norm(centre[:, TRIQUETRUM] - carried, axis=1).max() < 1.5

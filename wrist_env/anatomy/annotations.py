@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike
 
 from wrist_env.anatomy.template import load_template
 from wrist_env.design import ALL_LIGAMENT_NAMES, LIGAMENT_NAMES
-from wrist_env.model import BODY_PARTS, PAIRS
+from wrist_env.model import BODY_PARTS, DETACHED_WITHOUT_DISTAL_ROW, PAIRS
 
 ARTICULATIONS = PAIRS
 """The cartilage-covered articulations: the contact pairs (`model.PAIRS`)."""
@@ -71,18 +71,22 @@ def facing_within(
 ENDS = ("origin", "insertion")
 
 
-def _has_part(bones: dict, spec: dict) -> bool:
-    """Whether the body of a site spec carries the bone (`part`) the site lies on."""
+def _has_part(bones: dict, spec: dict, distal_row: bool = True) -> bool:
+    """Whether the body of a site spec carries the bone (`part`) the site lies on, and is attached (a body of
+    `model.DETACHED_WITHOUT_DISTAL_ROW` is not without the distal row)."""
+    if not distal_row and spec["bone"] in DETACHED_WITHOUT_DISTAL_ROW:
+        return False
     return "part" not in spec or BODY_PARTS[spec["bone"]].index(spec["part"]) <= bones[spec["bone"]].part.max()
 
 
-def resolve(bones: dict, data: dict | None = None) -> Annotations:
+def resolve(bones: dict, data: dict | None = None, distal_row: bool = True) -> Annotations:
     """Resolve annotation data on `bones` (name -> BoneSurface in the template RCS).
 
     A site lies on one bone of its body (its `part`, default the principal bone; e.g. the
-    DRC's insertion on the triquetrum); on bodies without that part (no distal row) its
-    `without_part` site is used instead, and a fixed ligament (`design.FIXED_LIGAMENTS`)
-    without one is not built.
+    TZC bands' origins on the trapezoid); on bodies without that part, or on a body that a model
+    without the distal row leaves detached (`model.DETACHED_WITHOUT_DISTAL_ROW`: the DRC's insertion on
+    the triquetrum), its `without_part` site is used instead, and a fixed ligament
+    (`design.FIXED_LIGAMENTS`) without one is not built.
     """
     data = read_annotation_data() if data is None else data
     solids = {name: b.trimesh(solid_only=True) for name, b in bones.items() if b.solid.any()}
@@ -104,12 +108,14 @@ def resolve(bones: dict, data: dict | None = None) -> Annotations:
         coverage[art] = (a, b, masks[0], masks[1])
     sites = {}
     for lig in ALL_LIGAMENT_NAMES:
-        if lig not in LIGAMENT_NAMES and not all(_has_part(bones, data["ligaments"][lig][end]) for end in ENDS):
-            continue  # a fixed ligament of a bone this variant lacks (the distal row's)
+        if lig not in LIGAMENT_NAMES and not all(
+            _has_part(bones, data["ligaments"][lig][end], distal_row) for end in ENDS
+        ):
+            continue  # a fixed ligament of a bone this variant lacks or leaves detached (the triquetrum's)
         pair = []
         for end in ENDS:
             spec = data["ligaments"][lig][end]
-            if not _has_part(bones, spec):
+            if not _has_part(bones, spec, distal_row):
                 spec = spec["without_part"]
             body = bones[spec["bone"]]
             own = body.part == BODY_PARTS[spec["bone"]].index(spec.get("part", spec["bone"]))
@@ -127,4 +133,4 @@ def resolve(bones: dict, data: dict | None = None) -> Annotations:
 @functools.lru_cache(maxsize=4)
 def template_annotations(fossa_sweep_deg: tuple = (0.0, 0.0), distal_row: bool = False) -> Annotations:
     """Annotations resolved on the anatomy template (variant as in `load_template`)."""
-    return resolve(load_template(tuple(fossa_sweep_deg), distal_row).bones)
+    return resolve(load_template(tuple(fossa_sweep_deg), distal_row).bones, distal_row=distal_row)

@@ -213,8 +213,9 @@ def load_template(fossa_sweep_deg: tuple = (0.0, 0.0), distal_row: bool = False)
     """The anatomy template (built once per process and variant, ~1–5 s).
 
     fossa_sweep_deg: (flexion, deviation) half-ranges (deg) of the row's sweep that shapes
-    the radius fossae ((0, 0): moulded to the neutral row). distal_row: the lunate body
-    carries the triquetrum and the capitate body the trapezium, trapezoid and hamate.
+    the radius fossae ((0, 0): moulded to the neutral row). distal_row: the variant's key (every body is
+    whole in both since the triquetrum is a body of its own; a model without the distal row leaves it
+    detached: `model.DETACHED_WITHOUT_DISTAL_ROW`, `anatomy.annotations.resolve`).
     """
     fossa_sweep_deg = check_fossa_sweep(fossa_sweep_deg)  # NaN or out-of-range angles: refused, not swept
     m, oriented = oriented_parts()

@@ -13,7 +13,7 @@ from wrist_env.anatomy.annotations import read_annotation_data
 from wrist_env.builder.params import BuildParams
 from wrist_env.model import BONES
 
-BUILDER_VERSION = 8  # 8: the hamate a body of its own, its capitohamate ligaments (CH_deep, CH_d, CH_p) and joint, its capitohamate and triquetrohamate contacts and grid; 7: the fossae end at the radius' ulnar border, the ulna seated by the corner rule on bone, the TFCC at fibrocartilage's stiffness; 6: the TFCC (the ulna's head closed and gridded, the ulnocarpal pair); 5: the radial column a body of its own (trapezium + trapezoid), its STT and trapeziocapitate contacts and ligaments; 2: distal row and triquetrum as body parts, swept fossae; 3: both by default, TC and TH; 4: the distal row seated (anatomy.midcarpal)
+BUILDER_VERSION = 9  # 9: the triquetrum a body of its own, its lunotriquetral ligaments (LT_v, LT_p, LT_d) and joint, the ulnotriquetral ligament (UT), its lunotriquetral, ulnotriquetral and triquetrohamate contacts ("ulnocarpal" split into ulnolunate and ulnotriquetral); 8: the hamate a body of its own, its capitohamate ligaments (CH_deep, CH_d, CH_p) and joint, its capitohamate and triquetrohamate contacts and grid; 7: the fossae end at the radius' ulnar border, the ulna seated by the corner rule on bone, the TFCC at fibrocartilage's stiffness; 6: the TFCC (the ulna's head closed and gridded, the ulnocarpal pair); 5: the radial column a body of its own (trapezium + trapezoid), its STT and trapeziocapitate contacts and ligaments; 2: distal row and triquetrum as body parts, swept fossae; 3: both by default, TC and TH; 4: the distal row seated (anatomy.midcarpal)
 
 
 def source_hash(name: str, bones: dict, params: BuildParams) -> str:

@@ -26,14 +26,15 @@ from wrist_env.builder.params import BuildParams
 from wrist_env.builder.surface import displaced_vertices, extrusion_directions, gap_to, grnn_smooth
 from wrist_env.design import ALL_LIGAMENTS, BODY_LIGAMENTS, LIGAMENT_NAMES, LIGAMENTS, RSC_INDEX
 from wrist_env.errors import BuildError
-from wrist_env.model import BONES, PAIRS, Model, offsets
+from wrist_env.model import BONES, PAIRS, TFCC_PAIRS, Model, offsets
 
 BUILD_STEPS = ("morph", "cartilage", "ligaments", "contact_law", "grids", "mass")  # timed in the report
 GRID_BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate", "hamate")
-TFCC = "ulnocarpal"
-"""The pair through the TFCC: its articular disc and meniscus homologue fill the ulnocarpal space
-between the ulnar head and the lunate and triquetrum (Palmer & Werner 1981), so the disc is a layer
-on the ulnar head as thick as that space at neutral (`tfcc_thickness`), under the cartilage law."""
+TFCC = TFCC_PAIRS
+"""The pairs through the TFCC (the lunate's and the triquetrum's, `model.TFCC_PAIRS`): its articular disc
+and meniscus homologue fill the ulnocarpal space between the ulnar head and the lunate and triquetrum
+(Palmer & Werner 1981), so the disc is one layer on the ulnar head as thick as that space at neutral
+(`tfcc_thickness`), under the cartilage law."""
 MIN_SITE_VERTICES = 8
 JOINT_SPACE_MM = {art: (0.3, 4.0) for art in PAIRS} | {"scapholunate": (0.3, 8.0)}
 """Plausible neutral joint space per articulation (mm; the median bone-to-bone gap over its cartilage
@@ -137,30 +138,40 @@ def _ligaments(bones: dict, sites: dict, params: BuildParams):
     return bundles, membrane
 
 
-ABSENT_WITHOUT_DISTAL_ROW = ("triquetrohamate",)
+ABSENT_WITHOUT_DISTAL_ROW = ("triquetrohamate", "ulnotriquetral", "lunotriquetral")
 """Articulations a model without the distal row (`BuildParams.distal_row`) has no cartilage of: the
-triquetrohamate pair is the lunate body's triquetrum on the hamate; its pair stays, without samples."""
+triquetrum's, which that model leaves detached (`model.DETACHED_WITHOUT_DISTAL_ROW`); their pairs stay,
+without samples."""
 
 
 def tfcc_thickness(
-    bones: dict, thickness: dict, coverage: tuple, bandwidth_mm: float, disc_mm: float | None = None
+    bones: dict, thickness: dict, coverages: list, bandwidth_mm: float, disc_mm: float | None = None
 ) -> tuple[np.ndarray, dict]:
-    """The TFCC as a layer on the ulnar head (`TFCC`): per ulna vertex (mm, zero off its coverage) the
-    distance along its extrusion direction (`surface.extrusion_directions`) to the lunate body's
-    cartilage surface (the closest distance where that ray misses or runs beyond the coverage's
-    max_gap_mm), smoothed over the patch (`surface.grnn_smooth`), and no thicker than `disc_mm` (None:
-    the space filled); and its min/mean/max."""
-    a, _, mask_a, mask_b = coverage
-    ulna, carpal = (mask_a, mask_b) if a == "ulna" else (mask_b, mask_a)
-    head, lunate = bones["ulna"], bones["lunate"]
-    surface = displaced_vertices(lunate.vertices, lunate.faces, thickness["lunate"])
-    gap = gap_to(head.vertices, ulna, surface, lunate.faces, carpal)[0]
+    """The TFCC as one layer on the ulnar head (`TFCC`): per ulna vertex (mm, zero off its coverage) the
+    distance along its extrusion direction (`surface.extrusion_directions`) to the carpals' cartilage
+    surface (the lunate's and the triquetrum's, the union of the `coverages` of the TFCC pairs present;
+    the closest distance where that ray misses or runs beyond the coverage's max_gap_mm), smoothed over
+    the patch (`surface.grnn_smooth`), and no thicker than `disc_mm` (None: the space filled); and its
+    min/mean/max."""
+    head = bones["ulna"]
+    ulna = np.zeros(len(head.vertices), bool)
+    surfaces, faces, covers, base = [], [], [], 0
+    for a, b, mask_a, mask_b in coverages:
+        mine, carpal, name = (mask_a, mask_b, b) if a == "ulna" else (mask_b, mask_a, a)
+        ulna |= mine
+        bone = bones[name]
+        surfaces.append(displaced_vertices(bone.vertices, bone.faces, thickness[name]))
+        faces.append(bone.faces + base)
+        covers.append(carpal)
+        base += len(bone.vertices)
+    surface, carpal_faces, carpal = np.vstack(surfaces), np.vstack(faces), np.concatenate(covers)
+    gap = gap_to(head.vertices, ulna, surface, carpal_faces, carpal)[0]
     origins = head.vertices[ulna]
     rays = extrusion_directions(head.vertices, head.faces, ulna)[ulna]
-    target = trimesh.Trimesh(surface, lunate.faces, process=False)
+    target = trimesh.Trimesh(surface, carpal_faces, process=False)
     hits, ray_ids, _ = target.ray.intersects_location(origins, rays, multiple_hits=False)
     along = np.einsum("ij,ij->i", hits - origins[ray_ids], rays[ray_ids])
-    reach = read_annotation_data()["cartilage"][TFCC]["max_gap_mm"]  # a grazing ray leaves the space
+    reach = max(read_annotation_data()["cartilage"][p]["max_gap_mm"] for p in TFCC)  # a grazing ray leaves
     gap[ray_ids] = np.where((along > 0) & (along <= reach), along, gap[ray_ids])
     out = np.zeros(len(head.vertices))
     out[ulna] = grnn_smooth(origins, gap, bandwidth_mm)
@@ -232,9 +243,9 @@ def build_model(
     morphs, morph_report = _morph_all(bones, params, workers)
     lap("morph")
     coverage, sites, relocated = _transfer(morphs, bones, params)
-    if not params.distal_row:  # the lunate without its triquetrum reaches no hamate (a type I lunate)
+    if not params.distal_row:  # the triquetrum detached: no cartilage of its joints
         coverage = {art: c for art, c in coverage.items() if art not in ABSENT_WITHOUT_DISTAL_ROW}
-    articulations = {(a, b): (ma, mb) for art, (a, b, ma, mb) in coverage.items() if art != TFCC}
+    articulations = {(a, b): (ma, mb) for art, (a, b, ma, mb) in coverage.items() if art not in TFCC}
     verts = {b: bones[b].vertices for b in BONES}
     faces = {b: bones[b].faces for b in BONES}
     thickness, cart_report = cartilage.build_cartilage(
@@ -242,7 +253,7 @@ def build_model(
     )
     thickness = {b: thickness.get(b, np.zeros(len(verts[b]))) for b in BONES}
     thickness["ulna"], tfcc_report = tfcc_thickness(
-        bones, thickness, coverage[TFCC], params.grnn_bandwidth_mm, params.tfc_disc_mm
+        bones, thickness, [coverage[p] for p in TFCC if p in coverage], params.grnn_bandwidth_mm, params.tfc_disc_mm
     )
     bones = _osteotomy(bones, params.ulnar_osteotomy_mm)  # the ulna moved with its layer, after it is made
     summary = _articulation_summary(cart_report["cartilage"]["articulations"])

@@ -11,12 +11,14 @@ from collections import namedtuple
 
 import numpy as np
 
-from wrist_env.design import CH_JOINT_STIFFNESS, RSC_INDEX, Design, ligament_arrays
+from wrist_env.design import JOINTS, RSC_INDEX, Design, ligament_arrays
 from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model
 from wrist_env.solver.contact import nodal_normals
 from wrist_env.solver.settings import SolverSettings
 
-Bodies = namedtuple("Bodies", "com0 inv_mass inv_inertia mass inertia joint_centre joint_axes joint_stiffness")
+Bodies = namedtuple(
+    "Bodies", "com0 inv_mass inv_inertia mass inertia joint_bodies joint_centre joint_axes joint_stiffness"
+)
 Grids = namedtuple(
     "Grids",
     "pair_bones sample_offsets points thickness area values offsets shape origin spacing normals pair_centre pair_reach",
@@ -46,28 +48,43 @@ def bodies(model: Model, s: SolverSettings) -> Bodies:
     inertia = model.inertia * (s.mass_scale * s.inertia_scale)
     inv_mass = np.where(mass > 0, 1.0 / np.where(mass > 0, mass, 1.0), 0.0)
     inv_inertia = np.array([np.linalg.inv(I) if m > 0 else np.zeros((3, 3)) for I, m in zip(inertia, mass)])
-    return Bodies(np.ascontiguousarray(model.com), inv_mass, inv_inertia, mass, inertia, *capitohamate_joint(model))
+    return Bodies(np.ascontiguousarray(model.com), inv_mass, inv_inertia, mass, inertia, *joints(model))
 
 
-def capitohamate_joint(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The capitohamate joint's in-plane constraint (`forces.joint_forces`): its centre (3,) mm, the
-    area-weighted mean of the hamate's contact samples on the capitate at neutral; its axes (3, 3), rows
-    in the RCS at neutral (carried by the capitate): dorsopalmar (the RCS volar axis x in the joint's
-    plane), proximodistal in the plane, and the normal (the samples' area-weighted mean normal, hamate to
-    capitate); and its stiffness (6,) along and about them (`design.CH_JOINT_STIFFNESS`). A model without
-    samples on that pair (a synthetic test model) gets zero stiffness."""
-    k = PAIRS.index("capitohamate")
+def planar_joint(model: Model, pair: str, stiffness) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A planar joint's in-plane constraint (`forces.joint_forces`; `design.JOINTS`): its bodies (2,), the
+    pair's sample body (which moves on the joint) and grid body (which carries the axes); its centre (3,)
+    mm, the area-weighted mean of the pair's contact samples at neutral; its axes (3, 3), rows in the RCS
+    at neutral (carried by the grid body): dorsopalmar (the RCS volar axis x in the joint's plane), the
+    second in-plane axis, and the normal (the samples' area-weighted mean normal, sample body to grid
+    body); and its stiffness (6,) along and about them. A model without samples on the pair (a synthetic
+    test model, a variant without the triquetrum's contacts) gets zero stiffness."""
+    k = PAIRS.index(pair)
+    bodies = np.array(PAIR_BONES[k], dtype=np.int64)
     lo, hi = model.sample_offsets[k], model.sample_offsets[k + 1]
     area = np.asarray(model.sample_area[lo:hi], np.float64)
     if hi <= lo or area.sum() <= 0:
-        return np.zeros(3), np.eye(3), np.zeros(6)
+        return bodies, np.zeros(3), np.eye(3), np.zeros(6)
     centre = area @ np.asarray(model.sample_points[lo:hi], np.float64) / area.sum()
     normal = area @ np.asarray(model.sample_normals[lo:hi], np.float64)
     normal /= np.linalg.norm(normal)
     volar = np.array([1.0, 0.0, 0.0]) - normal[0] * normal
     volar /= np.linalg.norm(volar)
     axes = np.vstack([volar, np.cross(normal, volar), normal])
-    return centre, np.ascontiguousarray(axes), np.array(CH_JOINT_STIFFNESS, dtype=np.float64)
+    return bodies, centre, axes, np.array(stiffness, dtype=np.float64)
+
+
+def joints(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Every planar joint of `design.JOINTS` (`planar_joint`), stacked: bodies (J, 2), centres (J, 3) mm,
+    axes (J, 3, 3), stiffness (J, 6)."""
+    parts = [planar_joint(model, pair, k) for pair, k in JOINTS]
+    return tuple(np.ascontiguousarray(np.stack([p[i] for p in parts])) for i in range(4))
+
+
+def capitohamate_joint(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The capitohamate joint's (centre (3,), axes (3, 3), stiffness (6,)) (`planar_joint`)."""
+    pair, k = JOINTS[0]
+    return planar_joint(model, pair, k)[1:]
 
 
 _NORMALS: dict[int, tuple[weakref.ref, np.ndarray]] = {}

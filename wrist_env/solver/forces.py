@@ -15,7 +15,6 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from wrist_env.model import CAPITATE, HAMATE
 from wrist_env.solver.contact import law_energy, law_pressure, sdf_distance, sdf_lookup_scalar, sdf_lookup_smooth
 from wrist_env.solver.ligaments import blankevoort_energy, blankevoort_force
 from wrist_env.solver.rigid import rotvec_between
@@ -307,41 +306,43 @@ def fibre_forces(R, x, v, w, com0, fibres, l0, K, damping_s, F, T, bundle_force,
 
 @njit(cache=True, error_model="numpy")
 def joint_forces(R, x, com0, bod, F, T, want_energy):
-    """The capitohamate joint's in-plane constraint (`arrays.capitohamate_joint`, `design.CH_JOINT_STIFFNESS`):
-    a linear spring between the hamate and the capitate at the joint's centre, in the joint's axes carried by
-    the capitate. The centre's shift on the hamate from the capitate's, d, gives the hamate −Σ kₖ(eₖ·d)eₖ
-    at its centre point (the capitate the opposite at its own), the hamate's turn from the capitate θ
-    (`rigid.rotvec_between`) the couple −Σ k₃₊ₖ(eₖ·θ)eₖ (the capitate the opposite); returns the energy
-    (N·mm; 0 unless `want_energy`)."""
-    k = bod.joint_stiffness
-    if k[0] == 0.0 and k[1] == 0.0 and k[2] == 0.0 and k[3] == 0.0 and k[4] == 0.0 and k[5] == 0.0:
-        return 0.0
-    c, E = bod.joint_centre, bod.joint_axes
-    hx, hy, hz = to_world(R, x, com0, HAMATE, c[0], c[1], c[2])
-    cx, cy, cz = to_world(R, x, com0, CAPITATE, c[0], c[1], c[2])
-    d = (hx - cx, hy - cy, hz - cz)
-    theta = rotvec_between(R[HAMATE], R[CAPITATE])
-    fx = fy = fz = 0.0
-    mx = my = mz = 0.0
+    """The planar joints' in-plane constraint (`arrays.joints`, `design.JOINTS`: the capitohamate and the
+    lunotriquetral): for each joint j a linear spring between its moving body a = joint_bodies[j, 0] and its
+    carrier b = joint_bodies[j, 1] at the joint's centre, in the joint's axes carried by b. The centre's shift
+    on a from b's, d, gives a −Σ kₖ(eₖ·d)eₖ at its centre point (b the opposite at its own), a's turn from b
+    θ (`rigid.rotvec_between`) the couple −Σ k₃₊ₖ(eₖ·θ)eₖ (b the opposite); returns the energy (N·mm; 0
+    unless `want_energy`). A joint of zero stiffness (no samples on its pair) is skipped."""
     energy = 0.0
-    for a in range(3):
-        ex, ey, ez = rotate(R, CAPITATE, E[a, 0], E[a, 1], E[a, 2])
-        s = ex * d[0] + ey * d[1] + ez * d[2]
-        r = ex * theta[0] + ey * theta[1] + ez * theta[2]
-        fx -= k[a] * s * ex
-        fy -= k[a] * s * ey
-        fz -= k[a] * s * ez
-        mx -= k[3 + a] * r * ex
-        my -= k[3 + a] * r * ey
-        mz -= k[3 + a] * r * ez
-        if want_energy:
-            energy += 0.5 * (k[a] * s * s + k[3 + a] * r * r)
-    apply_force(F, T, x, HAMATE, fx, fy, fz, hx, hy, hz)
-    apply_force(F, T, x, CAPITATE, -fx, -fy, -fz, cx, cy, cz)
-    T[HAMATE, 0] += mx
-    T[HAMATE, 1] += my
-    T[HAMATE, 2] += mz
-    T[CAPITATE, 0] -= mx
-    T[CAPITATE, 1] -= my
-    T[CAPITATE, 2] -= mz
+    for j in range(bod.joint_stiffness.shape[0]):
+        k = bod.joint_stiffness[j]
+        if k[0] == 0.0 and k[1] == 0.0 and k[2] == 0.0 and k[3] == 0.0 and k[4] == 0.0 and k[5] == 0.0:
+            continue
+        a, b = bod.joint_bodies[j, 0], bod.joint_bodies[j, 1]
+        c, E = bod.joint_centre[j], bod.joint_axes[j]
+        hx, hy, hz = to_world(R, x, com0, a, c[0], c[1], c[2])
+        cx, cy, cz = to_world(R, x, com0, b, c[0], c[1], c[2])
+        d = (hx - cx, hy - cy, hz - cz)
+        theta = rotvec_between(R[a], R[b])
+        fx = fy = fz = 0.0
+        mx = my = mz = 0.0
+        for q in range(3):
+            ex, ey, ez = rotate(R, b, E[q, 0], E[q, 1], E[q, 2])
+            s = ex * d[0] + ey * d[1] + ez * d[2]
+            r = ex * theta[0] + ey * theta[1] + ez * theta[2]
+            fx -= k[q] * s * ex
+            fy -= k[q] * s * ey
+            fz -= k[q] * s * ez
+            mx -= k[3 + q] * r * ex
+            my -= k[3 + q] * r * ey
+            mz -= k[3 + q] * r * ez
+            if want_energy:
+                energy += 0.5 * (k[q] * s * s + k[3 + q] * r * r)
+        apply_force(F, T, x, a, fx, fy, fz, hx, hy, hz)
+        apply_force(F, T, x, b, -fx, -fy, -fz, cx, cy, cz)
+        T[a, 0] += mx
+        T[a, 1] += my
+        T[a, 2] += mz
+        T[b, 0] -= mx
+        T[b, 1] -= my
+        T[b, 2] -= mz
     return energy

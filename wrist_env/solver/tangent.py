@@ -4,9 +4,9 @@ reference (`equilibrium`) take.
 K is the Gauss–Newton tangent of the force kernels: each overclosed contact
 sample κ·JJᵀ with J = [n; r×n] and κ = p′(ε)·A/h; each taut fibre, and each RSC
 connector at its attached ends, dT/dl·uuᵀ + T/L·(I − uuᵀ) between its ends; the
-membrane's free nodes' contact with the scaphoid k·nnᵀ; the capitohamate joint's
-in-plane spring (`forces.joint_forces`) Σ kₖeₖeₖᵀ between its centre points and
-Σ k₃₊ₖeₖeₖᵀ on the hamate's rotations. No geometric terms of
+membrane's free nodes' contact with the scaphoid k·nnᵀ; the planar joints'
+in-plane springs (`forces.joint_forces`: capitohamate, lunotriquetral) Σ kₖeₖeₖᵀ between their
+centre points and Σ k₃₊ₖeₖeₖᵀ on their bodies' rotations. No geometric terms of
 the moments. Coordinates per bone: shift (mm, world) then rotation (rad, world),
 as `equilibrium.tangent_stiffness`.
 """
@@ -16,7 +16,6 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from wrist_env.model import CAPITATE, HAMATE
 from wrist_env.solver.contact import law_slope, sdf_lookup_scalar
 from wrist_env.solver.forces import pair_transform, rotate, sample_lookup, sample_lookup_smooth, to_local, to_world
 from wrist_env.solver.ligaments import blankevoort_force, blankevoort_slope
@@ -204,27 +203,39 @@ def tangent(R, x, nodes, system, stiffness, active, n_active, m, smooth):
 
 @njit(cache=True, error_model="numpy")
 def _joint(K, st, m, R, x, com0, bod, ra, rb):
-    """The capitohamate joint's spring (`forces.joint_forces`): its shift stiffness between the hamate's and
-    the capitate's centre points, its turn stiffness on the hamate's rotations (the capitate's rotations are
-    prescribed: no unknowns)."""
-    k = bod.joint_stiffness
-    c, E = bod.joint_centre, bod.joint_axes
+    """The planar joints' springs (`forces.joint_forces`): each joint's shift stiffness between its moving
+    body's and its carrier's centre points, its turn stiffness Σ k₃₊ₖeₖeₖᵀ on the two bodies' rotations
+    (on their diagonal blocks, minus it between them; a carrier without rotational unknowns, the driven
+    capitate, adds none)."""
     k_shift = m.coupling
-    k_shift[:] = 0.0
-    i0, n = dof(st, HAMATE)
-    for a in range(3):
-        e = rotate(R, CAPITATE, E[a, 0], E[a, 1], E[a, 2])
-        for p in range(3):
-            for q in range(3):
-                k_shift[p, q] += k[a] * e[p] * e[q]
-                if i0 >= 0:
-                    K[i0 + 3 + p, i0 + 3 + q] += k[3 + a] * e[p] * e[q]
-    ph = to_world(R, x, com0, HAMATE, c[0], c[1], c[2])
-    pc = to_world(R, x, com0, CAPITATE, c[0], c[1], c[2])
-    for e in range(3):
-        ra[e] = ph[e] - x[HAMATE, e]
-        rb[e] = pc[e] - x[CAPITATE, e]
-    add_point(K, st, HAMATE, ra, CAPITATE, rb, m)
+    for j in range(bod.joint_stiffness.shape[0]):
+        k = bod.joint_stiffness[j]
+        if k[0] == 0.0 and k[1] == 0.0 and k[2] == 0.0 and k[3] == 0.0 and k[4] == 0.0 and k[5] == 0.0:
+            continue
+        a, b = bod.joint_bodies[j, 0], bod.joint_bodies[j, 1]
+        c, E = bod.joint_centre[j], bod.joint_axes[j]
+        k_shift[:] = 0.0
+        ia, na = dof(st, a)
+        ib, nb = dof(st, b)
+        for q in range(3):
+            e = rotate(R, b, E[q, 0], E[q, 1], E[q, 2])
+            for p in range(3):
+                for r in range(3):
+                    k_shift[p, r] += k[q] * e[p] * e[r]
+                    turn = k[3 + q] * e[p] * e[r]
+                    if na == 6:
+                        K[ia + 3 + p, ia + 3 + r] += turn
+                    if nb == 6:
+                        K[ib + 3 + p, ib + 3 + r] += turn
+                    if na == 6 and nb == 6:
+                        K[ia + 3 + p, ib + 3 + r] -= turn
+                        K[ib + 3 + p, ia + 3 + r] -= turn
+        pa = to_world(R, x, com0, a, c[0], c[1], c[2])
+        pb = to_world(R, x, com0, b, c[0], c[1], c[2])
+        for e in range(3):
+            ra[e] = pa[e] - x[a, e]
+            rb[e] = pb[e] - x[b, e]
+        add_point(K, st, a, ra, b, rb, m)
 
 
 @njit(cache=True, error_model="numpy")

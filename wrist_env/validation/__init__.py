@@ -11,6 +11,7 @@ and names the solver's status in its description.
 
 from wrist_env.validation.bands import (
     EXTENSION_30_DEG,
+    LUNOTRIQUETRAL_DEG,
     NEUTRAL_LOAD_N,
     RAINBOW_LUNATE,
     RAINBOW_SCAPHOID,
@@ -26,6 +27,7 @@ from wrist_env.validation.measures import (
     column_rotation_deg,
     hamate_rotation_deg,
     load_shares_pct,
+    lunotriquetral_rotation_deg,
     sl_gap_mm,
     slope,
     surface_gap_mm,
@@ -34,7 +36,7 @@ from wrist_env.validation.measures import (
 from wrist_env.validation.report import Check, Report, _row, format_table
 
 __all__ = [
-    "EXTENSION_30_DEG", "NEUTRAL_LOAD_N", "RAINBOW_LUNATE", "RAINBOW_SCAPHOID", "SL_DISSOCIATION_MM", "SLIL",
+    "EXTENSION_30_DEG", "LUNOTRIQUETRAL_DEG", "NEUTRAL_LOAD_N", "RAINBOW_LUNATE", "RAINBOW_SCAPHOID", "SL_DISSOCIATION_MM", "SLIL",
     "SOURCES", "ULNAR_SHARE_PCT", "VIEGAS_1993", "Check", "Report", "_row", "at_angle", "column_rotation_deg",
-    "format_table", "hamate_rotation_deg", "load_shares_pct", "sl_gap_mm", "slope", "surface_gap_mm", "validate", "with_tears",
+    "format_table", "hamate_rotation_deg", "load_shares_pct", "lunotriquetral_rotation_deg", "sl_gap_mm", "slope", "surface_gap_mm", "validate", "with_tears",
 ]  # fmt: skip

@@ -12,6 +12,7 @@ NEUTRAL_LOAD_N = 100.0  # axial load of the load-share check: Hara 1992 loaded n
 VIEGAS_1993 = {"stt": 23, "sc": 28, "lc": 29, "th": 20}
 """Midcarpal load shares (%), Viegas 1993, in `model.MIDCARPAL` order."""
 ULNAR_SHARE_PCT = (10.0, 25.0)  # Palmer & Werner 1984 (18.4 %), Hara 1992 (15 %)
+LUNOTRIQUETRAL_DEG = 5.0  # Ruby 1988, Kobayashi 1997: a few degrees of LT rotation over +-40 deg (recalled)
 
 RAINBOW = (
     "Rainbow et al. 2013, J Hand Surg Am 38:278-288 (in vivo CT, 12 wrists, extreme loaded flexion and "
@@ -56,6 +57,13 @@ SOURCES = {
         "Akhbari et al. 2019, J Orthop Res 37:2661-2670 (in-vivo CT, the distal row moves as one rigid "
         "body within 3 deg); the capitohamate joint rotates ~9 deg under 0.5 N m with its ligaments "
         "intact (Ritt et al. 1996, J Hand Surg Br 21:451)"
+    ),
+    "lunotriquetral_rotation_deg": (
+        "Ruby et al. 1988, J Hand Surg Am 13:1-10 (5 cadaver wrists, metal markers: the proximal row's "
+        "bones less tightly bound than the distal row's but still moving together); Kobayashi et al. 1997, "
+        "Hand Clin 13:143-149 (22 cadaver wrists: measurable relative motion between the proximal row's "
+        "bones). Band: a few degrees between lunate and triquetrum over +-40 deg, as recalled from their "
+        "figures (not read here: see the validation page)"
     ),
     "slil_force_30ext_n": (
         "Dimitris et al. 2015, J Hand Surg Am 40:1525-1533 (total SLIL force in active wrist "

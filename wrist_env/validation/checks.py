@@ -1,4 +1,4 @@
-"""`validate`: the population design's three runs and the fourteen checks against published bands."""
+"""`validate`: the population design's three runs and the fifteen checks against published bands."""
 
 from __future__ import annotations
 
@@ -20,6 +20,7 @@ from wrist_env.solver.outputs import cardan_deg
 from wrist_env.solver.settings import DEFAULT_LOADS, JIG
 from wrist_env.validation.bands import (
     EXTENSION_30_DEG,
+    LUNOTRIQUETRAL_DEG,
     NEUTRAL_LOAD_N,
     SL_DISSOCIATION_MM,
     SLIL,
@@ -31,6 +32,7 @@ from wrist_env.validation.measures import (
     column_rotation_deg,
     hamate_rotation_deg,
     load_shares_pct,
+    lunotriquetral_rotation_deg,
     sl_gap_mm,
     slope,
     with_tears,
@@ -182,6 +184,14 @@ def validate(
             "largest rotation of the hamate relative to the capitate over the sweep",
             hamate_rotation_deg(intact.poses) if intact.ok else np.nan,
             (0.0, 3.0),
+            "deg",
+            fail_i,
+        ),
+        _row(
+            "lunotriquetral_rotation_deg",
+            "largest rotation of the triquetrum relative to the lunate over the sweep",
+            lunotriquetral_rotation_deg(intact.poses) if intact.ok else np.nan,
+            (0.0, LUNOTRIQUETRAL_DEG),
             "deg",
             fail_i,
         ),

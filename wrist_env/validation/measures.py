@@ -1,4 +1,5 @@
-"""What `validate` measures on a run: slopes, the SL gap, load shares, the radial column's and the hamate's turns."""
+"""What `validate` measures on a run: slopes, the SL gap, load shares, the radial column's and the hamate's turns
+from the capitate, the triquetrum's from the lunate."""
 
 from __future__ import annotations
 
@@ -10,13 +11,14 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from wrist_env import design as design_mod
-from wrist_env.model import BONES, CAPITATE, HAMATE, MIDCARPAL, TRAPEZIUM, Model
+from wrist_env.model import BONES, CAPITATE, HAMATE, LUNATE, MIDCARPAL, TRAPEZIUM, TRIQUETRUM, Model
 from wrist_env.solver.outputs import articulation_forces
 
 
-def rotation_from_capitate_deg(poses: np.ndarray, body: int) -> np.ndarray:
-    """The rotation (deg, per frame) of `body` relative to the capitate over a run's poses (n, 7, 4, 4)."""
-    relative = np.einsum("fij,fkj->fik", poses[:, body, :3, :3], poses[:, CAPITATE, :3, :3])
+def rotation_from_capitate_deg(poses: np.ndarray, body: int, reference: int = CAPITATE) -> np.ndarray:
+    """The rotation (deg, per frame) of `body` relative to the capitate (or `reference`) over a run's poses
+    (n, 8, 4, 4)."""
+    relative = np.einsum("fij,fkj->fik", poses[:, body, :3, :3], poses[:, reference, :3, :3])
     cos = np.clip((np.trace(relative, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
     return np.degrees(np.arccos(cos))
 
@@ -30,6 +32,12 @@ def hamate_rotation_deg(poses: np.ndarray) -> float:
     """The hamate's largest rotation (deg) relative to the capitate over a run's poses (n, 7, 4, 4): the
     distal row moves rigidly together, < 3 deg (Akhbari 2019, J Orthop Res 37:2661)."""
     return float(rotation_from_capitate_deg(poses, HAMATE).max())
+
+
+def lunotriquetral_rotation_deg(poses: np.ndarray) -> float:
+    """The triquetrum's largest rotation (deg) relative to the lunate over a run's poses (n, 8, 4, 4): the
+    proximal row's bones move together with a small relative motion (Ruby 1988; Kobayashi 1997)."""
+    return float(rotation_from_capitate_deg(poses, TRIQUETRUM, LUNATE).max())
 
 
 def slope(x: ArrayLike, y: ArrayLike) -> float:
