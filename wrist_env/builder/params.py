@@ -61,10 +61,11 @@ class BuildParams:
     """(flexion, deviation) half-ranges, deg, of the row's sweep that shapes the radius fossae
     ((0, 0): moulded to the neutral row; see `anatomy.radius_cap`)."""
     distal_row: bool = True
-    """The triquetrum moves with the lunate and the trapezium, trapezoid and hamate with the
-    capitate, bringing the STT and triquetrohamate contacts (`model.BODY_PARTS`) and the fixed
-    TC and TH ligaments (`design.FIXED_LIGAMENTS`); participant folders get these bones from
-    the template (`anatomy.template.carry_parts`)."""
+    """The triquetrum takes part: its contacts (lunotriquetral, triquetrohamate, ulnotriquetral) and
+    ligaments (LT_v, LT_p, LT_d, UT, the DRC's insertion and the fixed TC and TH: `design.FIXED_LIGAMENTS`).
+    False: the triquetrum body is built but detached (`model.DETACHED_WITHOUT_DISTAL_ROW`), the lunate
+    alone as before the triquetrum joined it. The radial column and the hamate are bodies of their own in
+    both; participant folders get these bones from the template (`anatomy.template.carry_parts`)."""
     fixed_ligaments: bool = True
     """Build the fixed TC and TH with the distal row (False: the lunate body is tied to the
     distal row by contact alone; for studying what they do)."""
@@ -128,8 +129,8 @@ def add_anatomy_arguments(parser: argparse.ArgumentParser) -> None:
         "--no-distal-row",
         dest="distal_row",
         action="store_false",
-        help="anatomy variant: the five principal bones alone (no triquetrum, trapezium, trapezoid, "
-        "hamate; no TC/TH ligaments)",
+        help="anatomy variant: the triquetrum detached (built, without its contacts and ligaments; no TC/TH "
+        "ligaments, the DRC on the lunate)",
     )
     parser.add_argument(
         "--no-fixed-ligaments",

@@ -15,8 +15,8 @@ from wrist_env.solver.rigid import LEVER_MM
 
 @njit(cache=True, error_model="numpy")
 def displacement(R, x, com0, b):
-    """How far (mm) free body b has moved from its place: the proximal row's (scaphoid, lunate) from its
-    neutral place on the radius; the radial column's and the hamate's (`model.CARRIED`) from where the
+    """How far (mm) free body b has moved from its place: the proximal row's (scaphoid, lunate, triquetrum)
+    from its neutral place on the radius; the radial column's and the hamate's (`model.CARRIED`) from where the
     capitate carries them (the distal row moves as one, Akhbari 2019; at ±40° the capitate carries the
     column's centre 15–18 mm)."""
     d2 = 0.0
