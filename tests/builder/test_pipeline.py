@@ -103,9 +103,34 @@ def test_the_tfcc_layer_fills_the_space_up_to_the_discs_thickness(disc_mm, expec
     cover_head = facing & (head.vertices[:, 1] < 3.0 + 1e-9)
     cover_lunate = lunate.vertices[:, 1] > -1e-9
     thickness = {"lunate": np.zeros(len(lunate.vertices))}
-    layer, report = tfcc_thickness(bones, thickness, ("ulna", "lunate", cover_head, cover_lunate), 1.0, disc_mm)
+    layer, report = tfcc_thickness(bones, thickness, [("ulna", "lunate", cover_head, cover_lunate)], 1.0, disc_mm)
     assert report["min"] == pytest.approx(expected, abs=1e-6) and report["max"] == pytest.approx(expected, abs=1e-6)
     assert (layer[~cover_head] == 0).all()
+
+
+def test_the_tfcc_layer_fills_the_space_to_the_nearer_of_the_lunate_and_the_triquetrum():
+    """Two carpals over the head, each its own TFCC pair (`model.TFCC_PAIRS`): a lunate slab 3 mm distal of
+    it and a triquetrum slab 2 mm further: the one layer fills the space to the nearer, 3 mm, over the
+    union of the two pairs' coverage of the head."""
+    from wrist_env.anatomy.template import BoneSurface
+    from wrist_env.builder.pipeline import tfcc_thickness
+
+    head, lunate, triquetrum = _slab(3.0, 20.0), _slab(-10.0, 0.0), _slab(-12.0, -2.0)
+    bones = {
+        name: BoneSurface(name, m.vertices, m.faces, np.ones(len(m.vertices), bool))
+        for name, m in (("ulna", head), ("lunate", lunate), ("triquetrum", triquetrum))
+    }
+    facing = (np.abs(head.vertices[:, [0, 2]]).max(axis=1) < 6.0) & (head.vertices[:, 1] < 3.0 + 1e-9)
+    left, right = facing & (head.vertices[:, 0] <= 0.0), facing & (head.vertices[:, 0] > 0.0)
+    thickness = {b: np.zeros(len(bones[b].vertices)) for b in ("lunate", "triquetrum")}
+    coverages = [
+        ("ulna", "lunate", left, lunate.vertices[:, 1] > -1e-9),
+        ("ulna", "triquetrum", right, triquetrum.vertices[:, 1] > -2.0 - 1e-9),
+    ]
+    layer, report = tfcc_thickness(bones, thickness, coverages, 1.0, None)
+    assert report["vertices"] == int((left | right).sum())
+    assert report["min"] == pytest.approx(3.0, abs=1e-6) and report["max"] == pytest.approx(3.0, abs=1e-6)
+    assert (layer[~(left | right)] == 0).all()
 
 
 def test_an_osteotomy_moves_the_ulna_alone_along_the_radius_axis():

@@ -29,6 +29,7 @@ BONE_COLOUR = {
     "capitate": "#eadfcf",
     "trapezium": "#e6d9c4",
     "hamate": "#e1d3bf",
+    "triquetrum": "#dccdb4",
 }
 DISTAL_CROP_MM = 12.0  # radius and ulna are drawn by their distal end only (RCS y below this, mm)
 VIEWS = (("volar view", 0, 0), ("radial view", 0, 90), ("oblique", 25, 40))
@@ -36,7 +37,8 @@ LIGAMENT_COLOURS = dict(
     zip(
         ALL_LIGAMENT_NAMES,
         plt.get_cmap("tab10").colors
-        + ("#000000", "#7a5195", "#ef5675", "#ffa600", "#003f5c", "#58508d", "#bc5090", "#2f4b7c", "#a05195"),
+        + ("#000000", "#7a5195", "#ef5675", "#ffa600", "#003f5c", "#58508d", "#bc5090", "#2f4b7c", "#a05195")
+        + ("#665191", "#d45087", "#f95d6a", "#2a9d8f"),
     )
 )
 

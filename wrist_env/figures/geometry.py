@@ -91,11 +91,21 @@ def model_figure(name: str, out: Path | None = None) -> Path:
 
 ANNOTATION_PANELS = (
     # title, bones shown, elevation, azimuth (plot frame: x radial, y dorsal-negative, z proximal)
-    ("carpus, volar view", ("scaphoid", "lunate", "capitate", "trapezium"), 0, 0),
-    ("carpus, dorsal view", ("scaphoid", "lunate", "capitate", "trapezium"), 0, 180),
-    ("carpus, proximal view", ("scaphoid", "lunate", "capitate", "trapezium"), 90, 0),
+    ("carpus, volar view", ("scaphoid", "lunate", "capitate", "trapezium", "triquetrum"), 0, 0),
+    ("carpus, dorsal view", ("scaphoid", "lunate", "capitate", "trapezium", "triquetrum"), 0, 180),
+    ("carpus, proximal view", ("scaphoid", "lunate", "capitate", "trapezium", "triquetrum"), 90, 0),
     ("radius and ulna, distal view", ("radius", "ulna"), -90, 0),
 )
+
+
+ARTICULATION_COLOURS = dict(
+    zip(
+        ARTICULATIONS,
+        ("#f4a6a0", "#9fc3e0", "#b9e3ae", "#d3bde0", "#fdd49e", "#a6dcd0", "#e0c39f", "#c9c9f2")
+        + ("#f2c6de", "#c7e9b4", "#fbb4ae", "#b3cde3"),
+    )
+)
+"""One colour per articulation (contact pair) of the annotations figure."""
 
 
 def annotations_figure(out: Path | None = None) -> Path:
@@ -105,8 +115,7 @@ def annotations_figure(out: Path | None = None) -> Path:
     bones = load_template(*anatomy).bones
     ann = template_annotations(*anatomy)
     out = out or draw.FIGURES / "template_annotations.png"
-    palette = ("#f4a6a0", "#9fc3e0", "#b9e3ae", "#d3bde0", "#fdd49e", "#a6dcd0", "#e0c39f", "#c9c9f2")
-    art_colours = dict(zip(ARTICULATIONS, palette))
+    art_colours = ARTICULATION_COLOURS
     fig = plt.figure(figsize=(18, 5.6))
     for k, (title, shown, elev, azim) in enumerate(ANNOTATION_PANELS):
         ax = fig.add_subplot(1, 4, k + 1, projection="3d")
