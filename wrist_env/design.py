@@ -107,7 +107,7 @@ nothing along the normal (the bands and the contact) nor
 about the in-plane axes (they open the joint: the bands and the contact)."""
 LT_DISTRACTION_MM = 0.3
 """The lunotriquetral joint's distraction under `CH_RIG_FORCE_N` with its interosseous ligament's three
-regions (dorsal, proximal, palmar) intact: 0.3 ± 0.1 mm (Ritt, Linscheid, Cooney & Berger 1998, J Hand
+regions (dorsal, proximal, palmar) intact: 0.3 ± 0.1 mm (Ritt et al. 1998, J Hand
 Surg Am 23:425, 12 specimens, the rig of their capitohamate study)."""
 LT_BANDS = 3
 STIFFNESS_LT = CH_RIG_FORCE_N / LT_DISTRACTION_MM / LT_BANDS

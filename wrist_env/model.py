@@ -41,7 +41,7 @@ BODY_PARTS = {
 step 3; until builder 8 it moved with the lunate): the ulnar column (hamate → triquetrohamate joint →
 triquetrum → TFCC → ulna) needs it to balance its own loads, as in every full-carpus model that bears
 load (Fischli 2009; Bajuri 2012); it is held to the lunate by the lunotriquetral interosseous ligament's
-three regions and joint, of measured constraint (Ritt, Linscheid, Cooney & Berger 1998, J Hand Surg Am
+three regions and joint, of measured constraint (Ritt et al. 1998, J Hand Surg Am
 23:425; `design.TRIQUETRUM_LIGAMENTS`, `design.LT_JOINT_STIFFNESS`), and to the ulna by the
 ulnotriquetral ligament; the lunotriquetral motion it allows stays small beside the scapholunate's
 (the proximal row's bones "less tightly bound but still moving together": Ruby 1988, J Hand Surg Am

@@ -222,8 +222,8 @@ def main() -> None:
         }
     # The triquetrum (its own body, issue 54 step 3): bound to the lunate by the lunotriquetral
     # interosseous ligament, C-shaped like the SLIL, of three regions spanning the rims of the joint:
-    # palmar and dorsal true ligaments and a proximal membranous (fibrocartilage) region (Ritt,
-    # Linscheid, Cooney & Berger 1998, J Hand Surg Am 23:425; Berger, Hand Surgery ch. 26). Each band's
+    # palmar and dorsal true ligaments and a proximal membranous (fibrocartilage) region (Ritt et al.
+    # 1998, J Hand Surg Am 23:425; Berger, Hand Surgery ch. 26). Each band's
     # ends are the two bones' extremes, along its direction, of their surfaces within 3 mm of each
     # other, as the SLIL's.
     t_l, l_t = near("triquetrum", "lunate", 3.0), near("lunate", "triquetrum", 3.0)
