@@ -80,6 +80,8 @@ def _seat_samples(points, normals, sample_offsets, grids):
     for p in range(len(PAIRS)):
         grid = grids[BONES[PAIR_BONES[p][1]]]
         sl = slice(sample_offsets[p], sample_offsets[p + 1])
+        if sample_offsets[p + 1] == sample_offsets[p]:  # a pair without samples (`pipeline.ABSENT_WITHOUT_DISTAL_ROW`)
+            continue
         for _ in range(SEAT_ITERATIONS):
             d, _ = sdf.trilinear(grid, points[sl])
             inside = np.minimum(d, 0.0)

@@ -33,10 +33,10 @@ STATUS = {
 class Result:
     """Per-frame outputs of one simulation.
 
-    poses (n_frames, 6, 4, 4): neutral → frame transforms of `BONES`, RCS mm.
-    contact (n_frames, 7, 4): per pair (`model.PAIRS`) mean pressure over the
+    poses (n_frames, 8, 4, 4): neutral → frame transforms of `BONES`, RCS mm.
+    contact (n_frames, 12, 4): per pair (`model.PAIRS`) mean pressure over the
         contacting area (MPa), peak pressure (MPa), contact area (mm²), force (N).
-    bundle_force (n_frames, 16): tension of each ligament, `design.ALL_LIGAMENT_NAMES` order (N).
+    bundle_force (n_frames, 23): tension of each ligament, `design.ALL_LIGAMENT_NAMES` order (N).
     energy (n_frames, 2): kinetic and internal energy (N·mm).
     residual (n_frames, 2): largest net force (N) and moment (N·mm) on the free bones.
     steps (n_frames,): explicit steps since the previous frame (ramp + hold to equilibrium;
