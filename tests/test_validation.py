@@ -130,7 +130,7 @@ def test_a_failed_run_fails_its_check_and_says_why():
 
 
 @pytest.mark.xfail(
-    reason="issue 54: under the jig the load path misses RS/RL and the STT, LC and TH shares; the column's turn; docs/validation.md: The load path",
+    reason="issue 54: under the jig the load path misses RS/RL and the STT, LC and TH shares; the column's, the hamate's and the triquetrum's turns (P2: the SLIL force); docs/validation.md: The load path",
     strict=True,
     raises=AssertionError,
 )
