@@ -157,7 +157,6 @@ class OptunaCMAES(OptunaOptimizer):
         return self.popsize
 
     def _make_sampler(self):
-
         o = self.options
         x0 = dict(zip(self._names, self.start_point().tolist()))
         # one-dimensional spaces: Optuna's CMA-ES falls back to its independent (random) sampler

@@ -404,7 +404,7 @@ def test_calibrate_storage_memory_is_none(monkeypatch):
 
     seen = {}
 
-    def fake(participant, name, budget, seed, *, log, storage):
+    def fake(participant, name, budget, seed, *, log, storage, instance):
         seen["storage"] = storage
         raise KeyboardInterrupt  # stop here: the storage is what is tested
 

@@ -220,7 +220,7 @@ def test_a_participant_changed_since_its_cells_ran_runs_them_again(p1, finished,
     today = provenance.of_participant(p1)
     assert RunLog(runs).summary(RunKey(p1, "random", 0, 12))["provenance"] == today
     edited = {**today, "trials": {**today["trials"], "unresisted": "0" * 64}}
-    monkeypatch.setattr(provenance, "of_participant", lambda name: edited)
+    monkeypatch.setattr(provenance, "of_participant", lambda name, instance=0: edited)
     with pytest.raises(StoreError, match=r"seed0.budget12.json: this cell was calibrated on another model or trials"):
         write_leaderboard(runs, tmp_path / "lb")
     with pytest.warns(UserWarning, match=r"made on another model or trials of P1 \(trials unresisted changed\)"):
