@@ -48,3 +48,14 @@ def test_bad_instances_are_refused_naming_them(instances, message):
 def test_seeds_other_than_a_count_a_list_or_instance_are_refused():
     with pytest.raises(InputError, match=r"seeds must be a count, a list of seeds or 'instance', but got 'inst'"):
         make_cells(["P1"], ["random"], "inst", 8, instances=2)
+
+
+def test_a_folder_participant_has_no_drawn_instances(tmp_path, monkeypatch):
+    from wrist_env.bench import benchmark
+    from wrist_env.errors import ParticipantError
+    from wrist_env.participants import registry
+
+    monkeypatch.setattr(registry, "require", lambda *names: None)  # as if U1 were a registered folder
+    with pytest.raises(ParticipantError, match=r"instances k >= 1 .* but U1 is not one: run it on instance 0"):
+        benchmark(["U1"], ["random"], 1, 8, tmp_path / "runs", instances=[0, 2], progress=False)
+    assert not (tmp_path / "runs" / "evals").exists()  # refused before anything ran

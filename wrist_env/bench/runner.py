@@ -84,13 +84,7 @@ def make_cells(
         one run per instance, seeded with the instance (`make_cells(ps, os, "instance", 300, instances=5)`
         is instances 1 … 5 with seeds 1 … 5).
     `InputError` if one is empty or repeats a name, instance or seed, or a size is out of bounds (`limits`)."""
-    instances = _instances(instances)
-    per_instance = isinstance(seeds, str) and seeds == SEED_IS_INSTANCE
-    if isinstance(seeds, str) and not per_instance:
-        raise InputError(f"seeds must be a count, a list of seeds or {SEED_IS_INSTANCE!r}, but got {seeds!r}")
-    if isinstance(seeds, numbers.Integral):
-        seeds = list(range(check_int("seeds", seeds, 1, MAX_SEEDS)))
-    seeds = [None] if per_instance else check_unique("seeds", seeds)
+    instances, seeds = _instances(instances), _seeds(seeds)
     if not seeds or not participants or not optimizers:
         raise InputError("a benchmark needs at least one participant, optimizer and seed")
     participants, optimizers = check_unique("participants", participants), check_unique("optimizers", optimizers)
@@ -98,6 +92,18 @@ def make_cells(
         RunKey(p, o, k if s is None else s, budget, k)
         for p, k, o, s in itertools.product(participants, instances, optimizers, seeds)
     ]
+
+
+def _seeds(seeds: int | Iterable[int] | str) -> list[int | None]:
+    """`make_cells`'s seeds as a list: a count n → 0 … n−1; a list checked; `SEED_IS_INSTANCE` → [None] (the
+    seed is the cell's instance)."""
+    if isinstance(seeds, str):
+        if seeds != SEED_IS_INSTANCE:
+            raise InputError(f"seeds must be a count, a list of seeds or {SEED_IS_INSTANCE!r}, but got {seeds!r}")
+        return [None]
+    if isinstance(seeds, numbers.Integral):
+        return list(range(check_int("seeds", seeds, 1, MAX_SEEDS)))
+    return check_unique("seeds", seeds)
 
 
 def _instances(instances: int | Iterable[int] | None) -> list[int]:
