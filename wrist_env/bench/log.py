@@ -130,7 +130,7 @@ def _check_summary(path: Path, summary) -> None:
         raise StoreError(f"{path}: not a whole cell summary (no {', '.join(missing)}); {RERUN}")
 
 
-def problem_label(participant: str, instance: int) -> str:
+def describe_problem(participant: str, instance: int) -> str:
     """A problem in words: "P1" for instance 0, "P1 instance 3" for instance 3."""
     return participant if instance == 0 else f"{participant} instance {instance}"
 
@@ -197,8 +197,8 @@ class RunKey:
 
     @property
     def problem(self) -> str:
-        """The problem in words: the participant, and its instance unless 0 (`problem_label`)."""
-        return problem_label(self.participant, self.instance)
+        """The problem in words: the participant, and its instance unless 0 (`describe_problem`)."""
+        return describe_problem(self.participant, self.instance)
 
     def as_dict(self) -> dict:
         return {
@@ -348,7 +348,7 @@ class RunLog:
             changed = "" if today is None else provenance.differences(summary.get(provenance.FIELD), today)
             if changed:
                 raise StoreError(
-                    f"{path}: this cell was calibrated on another model or trials of {problem_label(*problem)} "
+                    f"{path}: this cell was calibrated on another model or trials of {describe_problem(*problem)} "
                     f"({changed}); {RERUN} on today's model"
                 )
 
