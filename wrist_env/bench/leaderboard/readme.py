@@ -54,8 +54,8 @@ def readme(board: Leaderboard, title: str | None = None) -> str:
     problems = (
         f"{len(participants)} participants"
         if instances == [0]
-        else f"{len(participants)} problems, a participant's instance k named <participant>.i<k> "
-        f"(instances {', '.join(str(k) for k in instances)}; instance 0 is the participant's own name)"
+        else f"{len(participants)} problems — instances {', '.join(str(k) for k in instances)} of the participants, "
+        "instance k ≥ 1 named <participant>.i<k>, instance 0 by the participant's name —"
     )
     lines = [
         f"# {title or 'Calibration benchmark leaderboard'}",
