@@ -59,3 +59,9 @@ def test_a_folder_participant_has_no_drawn_instances(tmp_path, monkeypatch):
     with pytest.raises(ParticipantError, match=r"instances k >= 1 .* but U1 is not one: run it on instance 0"):
         benchmark(["U1"], ["random"], 1, 8, tmp_path / "runs", instances=[0, 2], progress=False)
     assert not (tmp_path / "runs" / "evals").exists()  # refused before anything ran
+
+
+def test_instances_times_seeds_is_bounded_before_the_cells_are_made():
+    with pytest.raises(InputError, match=r"instances x seeds\) must be at most 10,000, but got 10,000 x 2"):
+        make_cells(["P1"], ["random"], 2, 8, instances=10_000)
+    assert len(make_cells(["P1"], ["random"], SEED_IS_INSTANCE, 8, instances=10_000)) == 10_000

@@ -87,6 +87,11 @@ def make_cells(
     instances, seeds = _instances(instances), _seeds(seeds)
     if not seeds or not participants or not optimizers:
         raise InputError("a benchmark needs at least one participant, optimizer and seed")
+    if len(instances) * len(seeds) > MAX_SEEDS:  # checked before the cells are made (10^8 asked ~20 GB)
+        raise InputError(
+            f"runs per participant and calibrator (instances x seeds) must be at most {MAX_SEEDS:,}, but got "
+            f"{len(instances):,} x {len(seeds):,}"
+        )
     participants, optimizers = check_unique("participants", participants), check_unique("optimizers", optimizers)
     return [
         RunKey(p, o, k if s is None else s, budget, k)
