@@ -470,6 +470,26 @@ def test_benchmark_instances_and_seeds(extra, seeds, instances, monkeypatch, tmp
     assert capsys.readouterr().out.startswith(f"{n_instances * n_seeds} cells: participants P1")
 
 
+def test_benchmark_names_a_range_of_instances_as_one(monkeypatch, tmp_path, capsys):
+    from wrist_env.cli.run import studies
+
+    monkeypatch.setattr(studies.bench, "benchmark", lambda *a, **k: (_ for _ in ()).throw(KeyboardInterrupt))
+    argv = [
+        "benchmark",
+        "--participants",
+        "P1",
+        "--optimizers",
+        "random",
+        "--out",
+        str(tmp_path / "b"),
+        "--no-progress",
+    ]
+    assert main([*argv, "--instances", "500"]) == 130
+    assert capsys.readouterr().out.startswith(
+        "500 cells: participants P1 (instances 1-500) x calibrators random x seed"
+    )
+
+
 def test_ctrl_c_in_calibrate_says_what_was_saved(capsys, tmp_path, monkeypatch):
     from wrist_env.cli.run import studies
 

@@ -54,12 +54,11 @@ def load_runs(runs: str | Path) -> tuple[pd.DataFrame, list[dict], int]:
     log = RunLog(runs)
     evals = log.read()
     summaries = log.summaries()
-    finished = {key_of(s) for s in summaries}
     fields = ("participant", "optimizer", "seed", "budget", "instance")
+    finished = {tuple(getattr(key_of(s), f) for f in fields) for s in summaries}
     keys = list(zip(*(evals[f] for f in fields)))
-    finished_keys = {tuple(getattr(k, f) for f in fields) for k in finished}
-    mask = np.array([k in finished_keys for k in keys], dtype=bool)
-    unfinished = len(set(keys) - finished_keys)
+    mask = np.array([k in finished for k in keys], dtype=bool)
+    unfinished = len(set(keys) - finished)
     return evals[mask].reset_index(drop=True), summaries, unfinished
 
 

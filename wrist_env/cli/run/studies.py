@@ -176,7 +176,11 @@ def benchmark_seeds(seeds: int | None, instances: int | list[int] | None) -> int
 def _instances_text(cells) -> str:
     """ " (instances 1, 2, 3)" of the cells, or "" when they are all instance 0."""
     instances = sorted({k.instance for k in cells})
-    return "" if instances == [0] else f" (instances {', '.join(str(k) for k in instances)})"
+    if instances == [0]:
+        return ""
+    if len(instances) > 2 and instances == list(range(instances[0], instances[-1] + 1)):
+        return f" (instances {instances[0]}-{instances[-1]})"
+    return f" (instances {', '.join(str(k) for k in instances)})"
 
 
 def _seeds_text(seeds: int | str) -> str:
