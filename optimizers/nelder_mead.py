@@ -83,8 +83,14 @@ def _runs(request, budget, lower, upper, x0, rng, scale, restart, perturb, optio
 class NelderMead(Optimizer):
     """`scipy.optimize.minimize(method="Nelder-Mead", bounds=...)`, one point per ask, restarted until the budget.
 
+    The first run starts where the seed puts it: at a draw from the prior (`base.prior_draw`: Table 2's
+    normals truncated at ±3 SD, as `design.sample_materials` draws them) from the seeded `self.rng`,
+    so each seed is another run (before issue 55 every seed started at the box centre, the population
+    design, and gave the same run).
+
     Options:
-      x0: start of the first run (default the box centre);
+      x0: start of the first run (default the seed's draw from the prior; the box centre is x0=0 on
+        the benchmark's box);
       simplex_scale: initial simplex x0 + simplex_scale·(upper − lower)·e_i
         (default 0.25; steps go down where up would leave the box);
       restart: where a run starts after SciPy converges before the budget —
@@ -92,8 +98,8 @@ class NelderMead(Optimizer):
         far plus N(0, perturb·(upper − lower)), clipped);
       perturb: default 0.1;
       xatol, fatol, adaptive: SciPy's (defaults 1e-4, 1e-4, False).
-    Each run gets maxfev = the remaining budget. The first run is
-    deterministic (independent of the seed); restarts draw from `self.rng`.
+    Each run gets maxfev = the remaining budget. Given its start, the first run is deterministic;
+    the start (without x0) and the restarts draw from `self.rng`.
     """
 
     OPTIONS = ("adaptive", "fatol", "perturb", "restart", "simplex_scale", "x0", "xatol")

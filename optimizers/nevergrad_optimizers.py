@@ -7,9 +7,12 @@
     "ng-tbpsa"        TBPSA, test-based population-size adaptation (robust to noisy values)
 
 Each drives one Nevergrad optimizer through its ask/tell API on a bounded
-`nevergrad.p.Array` (init `x0`, default the box centre) whose random state is
-seeded with the calibrator's seed, so a run is deterministic for a seed (the
-benchmark resumes a cut-short cell by replay). A batch is `batch_size`
+`nevergrad.p.Array` whose random state is seeded with the calibrator's seed, so a
+run is deterministic for a seed (the benchmark resumes a cut-short cell by replay).
+Its init is `x0`, by default where the seed puts it: a draw from the prior
+(`base.prior_draw`: Table 2's normals truncated at ±3 SD, as `design.sample_materials`
+draws them) from the seeded `self.rng` — so NGOpt, which runs a deterministic method
+(COBYLA) one point at a time for small budgets, gives another run for each seed. A batch is `batch_size`
 candidates asked before any is told (`num_workers` of the optimizer; default
 1, Nevergrad's default). A failed evaluation's +inf is told as it is.
 

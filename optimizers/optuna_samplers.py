@@ -15,7 +15,7 @@ Options (all calibrators):
   and ignores the rest); 1 for "optuna-gp".
 - n_startup_trials: random trials before the model takes over. Defaults:
   Optuna's for TPE (10) and the GP sampler (10); 0 for CMA-ES (it starts
-  from the box centre with sigma0 = 1/6 of the narrowest side, Optuna's default).
+  where the seed puts it, sigma0 = 1/6 of the narrowest side, Optuna's default).
 - storage: an Optuna storage, its URL (e.g. "sqlite:///runs/studies.db"),
   or a path without "://" — a journal file (Optuna's JournalStorage), several
   times faster than SQLite (measured, 300 trials in 22-D: ~30 s of SQLite
@@ -26,7 +26,10 @@ Options (all calibrators):
 
 Sampler options: "optuna-tpe" multivariate (default True, as Optuna ≥ 4
 for one objective), n_ei_candidates (24); "optuna-cmaes" popsize (default
-4 + ⌊3 ln dim⌋), sigma0, use_separable_cma, restart_strategy; "optuna-gp"
+4 + ⌊3 ln dim⌋), sigma0, use_separable_cma, restart_strategy, x0 (the start mean;
+default a draw from the prior, `base.prior_draw`: Table 2's normals truncated at ±3 SD as
+`design.sample_materials` draws them, from the seeded `self.rng` — Optuna's default, the box
+centre, would start every seed at the population design); "optuna-gp"
 deterministic_objective (default False).
 
 "optuna-gp" needs PyTorch, which wrist-env does not depend on (the CPU build
@@ -144,7 +147,7 @@ class OptunaTPE(OptunaOptimizer):
 class OptunaCMAES(OptunaOptimizer):
     """Optuna's CMA-ES sampler (the `cmaes` package); one generation per batch by default."""
 
-    OPTIONS = OptunaOptimizer.OPTIONS + ("popsize", "restart_strategy", "sigma0", "use_separable_cma")
+    OPTIONS = OptunaOptimizer.OPTIONS + ("popsize", "restart_strategy", "sigma0", "use_separable_cma", "x0")
 
     @property
     def popsize(self) -> int:
@@ -154,11 +157,18 @@ class OptunaCMAES(OptunaOptimizer):
         return self.popsize
 
     def _make_sampler(self):
+        o = self.options
+        x0 = dict(zip(self._names, self.start_point().tolist()))
+        # one-dimensional spaces: Optuna's CMA-ES falls back to its independent (random) sampler
+        with warnings.catch_warnings():  # Optuna ≥ 4.9 deprecates x0 (its removal is planned for 6.0)
+            warnings.filterwarnings("ignore", message=".*`x0`", category=FutureWarning)
+            return self._cma_sampler(x0, o)
+
+    def _cma_sampler(self, x0: dict, o: dict):
         import optuna
 
-        o = self.options
-        # one-dimensional spaces: Optuna's CMA-ES falls back to its independent (random) sampler
         return optuna.samplers.CmaEsSampler(
+            x0=x0,
             seed=self.seed,
             popsize=self.popsize,
             n_startup_trials=int(o.get("n_startup_trials", 0)),

@@ -289,6 +289,11 @@ ONE_LINE_USAGE_ERRORS = {
     "calibrate budget 0": (["calibrate", "P1", "--budget", "0"], r"budget must be an integer in \[1, 1,000,000\]"),
     "benchmark budget 0": (["benchmark", "--budget", "0"], r"budget must be an integer in \[1, 1,000,000\]"),
     "benchmark seeds 0": (["benchmark", "--seeds", "0"], r"seeds must be an integer in \[1, 10,000\]"),
+    "benchmark instances 0": (["benchmark", "--instances", "0"], r"instances must be an integer in \[1, 10,000\]"),
+    "benchmark instances 3-1": (["benchmark", "--instances", "3-1"], r"instances a-b must have a <= b, but got '3-1'"),
+    "benchmark instances list": (["benchmark", "--instances", "1,x"], r"instance must be an integer .*but got 'x'"),
+    "benchmark instances twice": (["benchmark", "--instances", "2,2"], r"instances must not repeat, but got \[2, 2\]"),
+    "calibrate instance -1": (["calibrate", "P1", "--instance", "-1"], r"instance must be an integer in \[0, 10,000\]"),
     "workers -3": (["benchmark", "--workers", "-3"], r"workers must be an integer in \[1, 256\], but got -3"),
     "workers 0": (["benchmark", "--workers", "0"], r"workers must be an integer in \[1, 256\], but got 0"),
     "threads 0": (["benchmark", "--threads", "0"], r"threads must be an integer in \[1, 256\], but got 0"),
@@ -404,13 +409,85 @@ def test_calibrate_storage_memory_is_none(monkeypatch):
 
     seen = {}
 
-    def fake(participant, name, budget, seed, *, log, storage):
+    def fake(participant, name, budget, seed, *, log, storage, instance):
         seen["storage"] = storage
         raise KeyboardInterrupt  # stop here: the storage is what is tested
 
     monkeypatch.setattr(studies.bench, "calibrate", fake)
     assert main(["calibrate", "P1", "--optimizer", "optuna-tpe", "--storage", "memory"]) == 130
     assert seen == {"storage": None}
+
+
+def test_calibrate_on_an_instance_is_seeded_with_it_unless_told(monkeypatch):
+    from wrist_env.cli.run import studies
+
+    seen = []
+
+    def fake(participant, name, budget, seed, *, log, storage, instance):
+        seen.append((seed, instance))
+        raise KeyboardInterrupt  # stop here: the seed and the instance are what is tested
+
+    monkeypatch.setattr(studies.bench, "calibrate", fake)
+    for extra in (["--instance", "3"], ["--instance", "3", "--seed", "7"], []):
+        assert main(["calibrate", "P1", *extra]) == 130
+    assert seen == [(3, 3), (7, 3), (0, 0)]
+
+
+@pytest.mark.parametrize(
+    "extra, seeds, instances",
+    [
+        ([], 5, None),  # the benchmark before instances: seeds 0 .. 4 on instance 0
+        (["--instances", "3"], "instance", 3),  # instances 1 .. 3, each seeded with its number
+        (["--instances", "3", "--seeds", "2"], 2, 3),
+        (["--instances", "2-4"], "instance", [2, 3, 4]),
+        (["--instances", "0,7"], "instance", [0, 7]),
+    ],
+)
+def test_benchmark_instances_and_seeds(extra, seeds, instances, monkeypatch, tmp_path, capsys):
+    from wrist_env.cli.run import studies
+
+    seen = {}
+
+    def fake(participants, names, seeds, budget, out, *, instances, **kwargs):
+        seen.update(seeds=seeds, instances=instances)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(studies.bench, "benchmark", fake)
+    argv = [
+        "benchmark",
+        "--participants",
+        "P1",
+        "--optimizers",
+        "random",
+        "--out",
+        str(tmp_path / "b"),
+        "--no-progress",
+    ]
+    assert main(argv + extra) == 130
+    assert seen == {"seeds": seeds, "instances": instances}
+    n_instances = 1 if instances is None else instances if isinstance(instances, int) else len(instances)
+    n_seeds = 1 if seeds == "instance" else seeds
+    assert capsys.readouterr().out.startswith(f"{n_instances * n_seeds} cells: participants P1")
+
+
+def test_benchmark_names_a_range_of_instances_as_one(monkeypatch, tmp_path, capsys):
+    from wrist_env.cli.run import studies
+
+    monkeypatch.setattr(studies.bench, "benchmark", lambda *a, **k: (_ for _ in ()).throw(KeyboardInterrupt))
+    argv = [
+        "benchmark",
+        "--participants",
+        "P1",
+        "--optimizers",
+        "random",
+        "--out",
+        str(tmp_path / "b"),
+        "--no-progress",
+    ]
+    assert main([*argv, "--instances", "500"]) == 130
+    assert capsys.readouterr().out.startswith(
+        "500 cells: participants P1 (instances 1-500) x calibrators random x seed"
+    )
 
 
 def test_ctrl_c_in_calibrate_says_what_was_saved(capsys, tmp_path, monkeypatch):

@@ -25,7 +25,7 @@ MAX_RUNS = 1_000_000
 MAX_BUDGET = 1_000_000
 """Evaluations of one calibration (`--budget`)."""
 MAX_SEEDS = 10_000
-"""Seeds per participant and calibrator (`--seeds`)."""
+"""Seeds per participant and calibrator (`--seeds`); also its runs over instances (instances x seeds)."""
 MAX_INSTANCE = 10_000
 """The largest problem instance of a participant (`participants.instances`; each one made is a few
 seconds of simulation and a few kB cached)."""

@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 import optimizers
@@ -220,7 +221,7 @@ def test_a_participant_changed_since_its_cells_ran_runs_them_again(p1, finished,
     today = provenance.of_participant(p1)
     assert RunLog(runs).summary(RunKey(p1, "random", 0, 12))["provenance"] == today
     edited = {**today, "trials": {**today["trials"], "unresisted": "0" * 64}}
-    monkeypatch.setattr(provenance, "of_participant", lambda name: edited)
+    monkeypatch.setattr(provenance, "of_participant", lambda name, instance=0: edited)
     with pytest.raises(StoreError, match=r"seed0.budget12.json: this cell was calibrated on another model or trials"):
         write_leaderboard(runs, tmp_path / "lb")
     with pytest.warns(UserWarning, match=r"made on another model or trials of P1 \(trials unresisted changed\)"):
@@ -343,3 +344,46 @@ def test_two_benchmarks_on_one_folder_at_once_log_every_evaluation_once(p1, tmp_
     log = RunLog(tmp_path / "runs")
     rows = log.read(dedupe=False)
     assert len(rows) == 3 * 24 and _duplicates(rows) == 0 and len(log.summaries()) == 3
+
+
+def test_a_calibration_on_instance_1_scores_against_instance_1(p1_instance_1, tmp_path):
+    """Its cost is instance 1's calibration trial's, its held-out score instance 1's validate trial's, its
+    recovery against instance 1's truth; its log and summary say instance 1 and its provenance binds it."""
+    from wrist_env import design
+    from wrist_env.bench.calibrate import action, recovery_error
+    from wrist_env.bench.log import X_COLUMNS
+    from wrist_env.participants import instances
+    from wrist_env.runs import provenance
+    from wrist_env.task import task
+
+    runs = tmp_path / "runs"
+    report = benchmark(["P1"], ["random"], "instance", 8, runs, instances=[0, 1], workers=1, progress=False)
+    assert not report.failed and [k.name for k in report.ran] == [
+        "P1.random.seed0.budget8",
+        "P1.i1.random.seed1.budget8",
+    ]
+    log, key = RunLog(runs), report.ran[1]
+    summary, rows = log.summary(key), log.read_cell(key)
+    assert summary["instance"] == 1 and rows.instance.tolist() == [1] * 8
+    calibrated = design.Design.from_dict(summary["design"])
+    truth = instances.truth("P1", 1)
+    assert summary["recovery_z"] == pytest.approx(recovery_error(calibrated, truth), rel=1e-9)
+    assert abs(summary["recovery_z"] - recovery_error(calibrated, instances.truth("P1", 0))) > 0.05
+    assert summary["recovery_z_population"] == pytest.approx(recovery_error(design.population(), truth), rel=1e-9)
+    first = design.from_action(action(rows[list(X_COLUMNS)].to_numpy()[0]))
+    on_1, on_0 = (task("P1", "calibrate", instance=k).evaluate(first).cost for k in (1, 0))
+    assert rows.cost[0] == pytest.approx(on_1, rel=1e-9) and abs(on_1 - on_0) > 1e-3
+    assert summary["validate"]["cost"] == pytest.approx(task("P1", "validate", instance=1).evaluate(calibrated).cost)
+    assert summary["provenance"] == provenance.of_participant("P1", 1) != provenance.of_participant("P1", 0)
+    # the leaderboard: a column per problem, each with its own references
+    write_leaderboard(runs, tmp_path / "lb")
+    best = pd.read_csv(tmp_path / "lb" / "best_cost.csv")
+    assert best.participant.tolist() == ["P1", "P1.i1"] and best.runs.tolist() == [1, 1]
+    population = [task("P1", "calibrate", instance=k).evaluate(design.population()).cost for k in (0, 1)]
+    np.testing.assert_allclose(best.population, population, rtol=1e-5)  # each problem's own trial
+    assert population[0] != population[1]
+    np.testing.assert_allclose(best.truth[1], task("P1", "calibrate", instance=1).evaluate(truth).cost, rtol=1e-5)
+    assert pd.read_csv(tmp_path / "lb" / "runs.csv").instance.tolist() == [0, 1]
+    # a cell made on instance 1 is not resumed on other trials
+    with pytest.warns(UserWarning, match=r"made on another model or trials of P1 instance 1 \(instance 1 \(now 0\)"):
+        assert log.move_aside_stale(key, provenance.of_participant("P1", 0)) == 2

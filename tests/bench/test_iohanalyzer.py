@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import wrist_env
-from wrist_env.bench import RunLog, benchmark
+from wrist_env.bench import RunKey, RunLog, benchmark
 from wrist_env.bench.log import X_COLUMNS
 from wrist_env.cli import main
 
@@ -108,3 +108,30 @@ def test_without_ioh_the_command_says_which_extra_to_install(tmp_path, monkeypat
     monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "ioh" else real(name, *a))
     with pytest.raises(SystemExit, match=r"needs ioh.*\[ioh\]"):
         main(["iohanalyzer", "--runs", str(tmp_path), "--out", str(tmp_path / "out")])
+
+
+def test_an_instance_is_ioh_instance_of_the_same_function(p1_instance_1):
+    """As `ioh.get_problem(fid, instance, dim)`: instance 1 is the same function, its instance id 1, its value
+    the cost on instance 1's calibration trial."""
+    from wrist_env import design
+    from wrist_env.task import task
+
+    zero, one = iohanalyzer.problem("P1"), iohanalyzer.problem("P1", 1)
+    assert (zero.meta_data.instance, one.meta_data.instance) == (0, 1)
+    assert zero.meta_data.problem_id == one.meta_data.problem_id and one.meta_data.name == "wrist-P1"
+    x = np.zeros(22)
+    expected = task("P1", "calibrate", instance=1).evaluate(design.from_action(np.r_[x, np.ones(5)])).cost
+    assert one(x) == pytest.approx(expected, rel=1e-12) and one(x) != pytest.approx(zero(x))
+
+
+def test_the_export_carries_each_runs_instance(tmp_path):
+    """Nothing simulated: a log of two instances' cells exports one problem, a run per (instance, seed)."""
+    log = RunLog(tmp_path / "runs")
+    for instance, seed in ((0, 0), (2, 2), (2, 5)):
+        key = RunKey("P1", "random", seed, 4, instance)
+        cost = np.arange(4.0) + 10 * instance + seed
+        log.append(key, 0, 0, np.zeros((4, 22)), cost, [False] * 4, np.zeros((4, 12)))
+    (folder,) = iohanalyzer.export(tmp_path / "runs", tmp_path / "ioh")
+    (meta_path,) = folder.glob("IOHprofiler_f*_wrist-P1.json")
+    (scenario,) = json.loads(meta_path.read_text())["scenarios"]
+    assert [(r["instance"], r["best"]["y"]) for r in scenario["runs"]] == [(0, 0.0), (2, 22.0), (2, 25.0)]

@@ -8,7 +8,8 @@ import pyarrow.parquet as pq
 import pytest
 
 from wrist_env.bench import RunKey, RunLog
-from wrist_env.errors import StoreError
+from wrist_env.errors import InputError, StoreError
+from wrist_env.runs.store import add_checksums
 
 KEY = RunKey("P1", "random", 0, 8)
 
@@ -145,12 +146,12 @@ def test_every_file_of_a_cell_records_its_provenance_and_a_stale_cell_moves_asid
     assert provenance.read_provenance(part) == MADE_FROM  # kept through compaction
     assert log.summary(KEY)["provenance"] == MADE_FROM
     assert log.move_aside_stale(KEY, MADE_FROM) == 0
-    log.check_made_from({"P1": MADE_FROM})
+    log.check_made_from({("P1", 0): MADE_FROM})
     edited = {**MADE_FROM, "trials": {**MADE_FROM["trials"], "unresisted": "d" * 64}}
     with pytest.raises(
         StoreError, match=r"this cell was calibrated on another model or trials of P1 \(trials unresisted"
     ):
-        log.check_made_from({"P1": edited})
+        log.check_made_from({("P1", 0): edited})
     with pytest.warns(UserWarning, match=r"made on another model or trials of P1 \(trials unresisted changed\)"):
         assert log.move_aside_stale(KEY, edited) == 2
     assert log.logged_range(KEY) == 0 and log.summary(KEY) is None
@@ -160,3 +161,63 @@ def test_a_cell_that_records_no_provenance_runs_again(tmp_path):
     log = _finished_cell(tmp_path, made_from=None)
     with pytest.warns(UserWarning, match="does not record the model and trials"):
         assert log.move_aside_stale(KEY, MADE_FROM) == 2
+
+
+def test_a_cell_on_instance_0_keeps_its_name_and_another_instance_is_named():
+    """Instance 0's names are those of logs and Optuna studies made before instances."""
+    assert RunKey("P1", "cmaes", 3, 300).name == "P1.cmaes.seed3.budget300"
+    assert RunKey("P1", "cmaes", 3, 300, 0).name == "P1.cmaes.seed3.budget300"
+    assert RunKey("P1", "cmaes", 3, 300, instance=3).name == "P1.i3.cmaes.seed3.budget300"
+    assert RunKey("P2", "ng-ngopt+prior", 0, 8, 12).name == "P2.i12.ng-ngopt+prior.seed0.budget8"
+    assert RunKey("P1", "cmaes", 3, 300, 3) != RunKey("P1", "cmaes", 3, 300)
+
+
+@pytest.mark.parametrize("bad", [-1, 10_001, 1.5, True])
+def test_a_bad_instance_is_refused_naming_it(bad):
+    with pytest.raises(InputError, match=rf"instance must be an integer in \[0, 10,000\], but got {bad!r}"):
+        RunKey("P1", "random", 0, 8, bad)
+
+
+def _without_instance_column(log: RunLog) -> None:
+    """Rewrite every Parquet file of `log` as a log written before instances: no `instance` column."""
+    for path in log.evals_dir.glob("*.parquet"):
+        table = pq.read_table(path)
+        pq.write_table(table.drop_columns(["instance"]), path)
+        path.with_name(path.name + ".sha256").unlink()
+    add_checksums(log.root)
+
+
+def test_a_log_written_before_instances_reads_as_instance_0(tmp_path):
+    log = _log_batches(tmp_path, 4)
+    log.write_summary(KEY, {k: v for k, v in _summary(8).items() if k != "instance"})
+    _without_instance_column(log)
+    assert "instance" not in pq.read_schema(next(log.evals_dir.glob("*.parquet"))).names
+    rows = log.read()
+    assert rows.instance.tolist() == [0] * 8 and rows.instance.dtype == np.int64
+    assert log.read_cell(KEY).cost.tolist() == list(range(8))
+    assert log.repair() == 0  # its files hold the cell their names say
+    assert log.summary(KEY)["nfev"] == 8 and "instance" not in log.summary(KEY)
+    log.compact(KEY)  # the compacted file has the column
+    assert pq.read_table(next(log.evals_dir.glob("cell-*.parquet"))).column("instance").to_pylist() == [0] * 8
+
+
+def test_cells_of_two_instances_are_two_cells(tmp_path):
+    log = _log_batches(tmp_path, 2)
+    other = RunKey("P1", "random", 0, 8, instance=2)
+    log.append(other, 0, 0, np.ones((3, 22)), [5.0, 6.0, 7.0], [False] * 3, np.zeros((3, 12)))
+    assert log.logged_range(KEY) == 4 and log.logged_range(other) == 3
+    assert log.read_cell(other).cost.tolist() == [5.0, 6.0, 7.0]
+    assert sorted(log.read().groupby("instance").size().items()) == [(0, 4), (2, 3)]
+    summary = {**_summary(3), "instance": 2}
+    log.write_summary(other, summary)
+    assert log.summary(other)["instance"] == 2 and log.summary(KEY) is None
+
+
+def test_a_cell_made_on_another_instance_moves_aside_and_the_leaderboard_refuses_it(tmp_path):
+    log = _finished_cell(tmp_path)  # instance 0's provenance records no instance
+    on_instance_1 = {**MADE_FROM, "instance": 1}
+    with pytest.raises(StoreError, match=r"calibrated on another model or trials of P1 \(instance 0 \(now 1\)\)"):
+        log.check_made_from({("P1", 0): on_instance_1})
+    log.check_made_from({("P1", 1): on_instance_1})  # not this cell's problem: nothing to compare
+    with pytest.warns(UserWarning, match=r"made on another model or trials of P1 \(instance 0 \(now 1\)\)"):
+        assert log.move_aside_stale(KEY, on_instance_1) == 2

@@ -48,7 +48,7 @@ def test_cmaes_matches_cma():
         xs.extend(population)
         fs.extend(values)
 
-    opt = optimizers.make("cmaes", dim=DIM, budget=BUDGET, seed=0, lower=LOWER, upper=UPPER)
+    opt = optimizers.make("cmaes", dim=DIM, budget=BUDGET, seed=0, lower=LOWER, upper=UPPER, x0=np.zeros(DIM))
     ours = optimizers.minimize(opt, rosenbrock_batch)
 
     assert opt.restarts == 0
@@ -113,7 +113,8 @@ def test_nelder_mead_matches_scipy():
     assert reference.nfev == BUDGET and not reference.success  # SciPy's run uses the whole budget
 
     ours = optimizers.minimize(
-        optimizers.make("nelder-mead", dim=DIM, budget=BUDGET, seed=0, lower=LOWER, upper=UPPER), rosenbrock_batch
+        optimizers.make("nelder-mead", dim=DIM, budget=BUDGET, seed=0, lower=LOWER, upper=UPPER, x0=np.zeros(DIM)),
+        rosenbrock_batch,
     )
     np.testing.assert_array_equal(ours.history_fun, evaluated)
     assert ours.fun == reference.fun
@@ -139,12 +140,15 @@ def test_nelder_mead_restarts():
     assert reference.success and reference.nfev < 200
     n = reference.nfev
 
-    a, b = (optimizers.minimize(optimizers.make("nelder-mead", dim=2, budget=400, seed=s), sphere) for s in (0, 1))
+    a, b = (
+        optimizers.minimize(optimizers.make("nelder-mead", dim=2, budget=400, seed=s, x0=np.zeros(2)), sphere)
+        for s in (0, 1)
+    )
     for result in (a, b):
         assert result.nfev == 400
         np.testing.assert_array_equal(result.history_fun[:n], evaluated)  # the first run is SciPy's
         assert result.fun <= reference.fun
-    # the restarts start from random points drawn from the seeded rng
+    # from the same x0, the restarts start from random points drawn from the seeded rng
     np.testing.assert_array_equal(a.history_x[:n], b.history_x[:n])
     assert not np.array_equal(a.history_x[n], b.history_x[n])
 

@@ -7,6 +7,7 @@ import optuna
 import pytest
 
 import optimizers
+from optimizers.base import prior_draw
 from optimizers.optuna_samplers import HAS_TORCH
 
 needs_torch = pytest.mark.skipif(not HAS_TORCH, reason="optuna-gp needs PyTorch, which is not installed")
@@ -86,9 +87,18 @@ def test_batch_size_option():
 def test_cmaes_improves_past_its_start():
     """One generation per batch: CMA-ES updates between batches and closes in on the minimum."""
     centre = np.array([0.1, 0.3, 2.6, -0.2, 0.1])  # inside the box run() gives
-    res = run("optuna-cmaes", 200, dim=5, fun=lambda x: np.sum((x - centre) ** 2, axis=1))[1]
+    box_centre = [0.0, 0.25, 2.5, 0.0, 0.0]  # a start far from the minimum, not the seed's draw
+    res = run("optuna-cmaes", 200, dim=5, fun=lambda x: np.sum((x - centre) ** 2, axis=1), x0=box_centre)[1]
     first = res.history_fun[:8].min()
     assert res.fun < 1e-2 * first
+
+
+def test_cmaes_starts_at_the_seeds_draw_from_the_prior():
+    """Optuna's default start, the box centre, would start every seed at the population design."""
+    starts = [optimizers.make("optuna-cmaes", 3, 10, seed=s).study.sampler._x0 for s in (4, 5)]
+    draw = prior_draw(np.random.default_rng(4), -np.ones(3), np.ones(3))
+    assert starts[0] == dict(zip(["x0", "x1", "x2"], draw.tolist()))
+    assert starts[0] != starts[1]
 
 
 def test_failed_evaluations_are_told_as_inf():

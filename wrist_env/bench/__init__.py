@@ -1,5 +1,5 @@
 """The calibration benchmark: one calibration (`calibrate`), the runner over participants ×
-calibrators × seeds (`benchmark`), its Parquet run log (`RunLog`) and the leaderboards
+instances × calibrators × seeds (`benchmark`, `make_cells`), its Parquet run log (`RunLog`) and the leaderboards
 (`write_leaderboard`). `wrist-bench calibrate | benchmark | leaderboard` are the commands."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from typing import Any
 from wrist_env.bench.calibrate import CalibrationRun, ResumeError, calibrate
 from wrist_env.bench.leaderboard import write_leaderboard as write
 from wrist_env.bench.log import DuplicateEvaluationError, RunKey, RunLog
-from wrist_env.bench.runner import BenchmarkReport, benchmark
+from wrist_env.bench.runner import SEED_IS_INSTANCE, BenchmarkReport, benchmark, make_cells
 
 
 def write_leaderboard(runs: str | Path, out: str | Path, **kwargs: Any) -> Path:
@@ -26,7 +26,9 @@ __all__ = [
     "ResumeError",
     "RunKey",
     "RunLog",
+    "SEED_IS_INSTANCE",
     "benchmark",
     "calibrate",
+    "make_cells",
     "write_leaderboard",
 ]

@@ -10,7 +10,8 @@ misfit in units of the 4DCT noise plus the population prior
 (`posterior.map_objective`); the log keeps both its cost and its objective.
 The best design is then scored on the held-out resisted trial ("validate")
 and, for built-in participants, against the hidden truth (parameter recovery
-in Table 2 SD units).
+in Table 2 SD units). On a problem instance k (`instance=k`, `participants.instances`) the trials are
+instance k's and the truth is instance k's draw (`Task.truth`); instance 0 is the shipped problem.
 
 With a run log, every batch is logged as it finishes, and a cell that was
 cut short resumes: its logged evaluations are replayed into a fresh
@@ -37,7 +38,6 @@ from wrist_env.design import N_MATERIAL, Design
 from wrist_env.errors import InputError, WristEnvError
 from wrist_env.frames import DOF_NAMES
 from wrist_env.identification.likelihood import map_objective
-from wrist_env.participants import builtin
 from wrist_env.runs import provenance
 from wrist_env.task import task
 
@@ -218,21 +218,25 @@ def calibrate(
     options: dict | None = None,
     callback: Callable[[int, int], object] | None = None,
     made_from: dict | None = None,
+    instance: int = 0,
 ) -> CalibrationRun:
     """Calibrate the 22 materials of `participant` with the calibrator `optimizer_name`.
 
+    instance: the problem instance (`participants.instances`): its calibrate trial is the objective, its
+        validate trial the held-out score and its hidden truth what recovery is measured against (0: the
+        shipped problem; k ≥ 1 only for built-in participants).
     log: a `RunLog` or its directory: every batch is logged as it finishes and a cell cut short
         resumes from it (see the module doc).
     storage: an Optuna storage URL, given (with study_name = the cell's key name) to calibrators
         that take one; ignored by the others. Its study is rebuilt from the log on every start.
     options: extra options for the calibrator (`optimizers.make(..., **options)`).
     callback(n_new, nfev): called after every batch with the number of new evaluations.
-    made_from: the participant's `provenance.of_participant`, if the caller has it (else read here when
+    made_from: the instance's `provenance.of_participant`, if the caller has it (else read here when
         there is a log).
     """
 
     start_time = time.perf_counter()
-    key = RunKey(participant, optimizer_name, int(seed), int(budget))
+    key = RunKey(participant, optimizer_name, int(seed), int(budget), instance)
     run_log = None if log is None else (log if isinstance(log, RunLog) else RunLog(Path(log)))
     options = dict(options or {})
     base_name, prior = split_prior(optimizer_name)
@@ -246,9 +250,9 @@ def calibrate(
         except KeyError:
             pass
         options.update(storage=storage_obj, study_name=key.name)
-    calibration = task(participant, "calibrate")
+    calibration = task(participant, "calibrate", instance=instance)
     if run_log is not None:
-        made_from = made_from or provenance.of_participant(participant)
+        made_from = made_from or provenance.of_participant(participant, instance)
         run_log.move_aside_stale(key, made_from)  # another model's evaluations are not replayed
 
     logged = run_log.read_cell(key) if run_log is not None else None
@@ -314,12 +318,11 @@ def calibrate(
     best_eval = int(np.argmin(result.history_fun))
     calibrated = design_vars.from_action(action(result.x))
     at_calibrate = _score(calibration.evaluate(calibrated))
-    at_validate = _score(task(participant, "validate").evaluate(calibrated))
+    at_validate = _score(task(participant, "validate", instance=instance).evaluate(calibrated))
     recovery = recovery_population = None
-    if participant in builtin.BUILTIN:
-        truth = builtin.truth(participant)
-        recovery = recovery_error(calibrated, truth)
-        recovery_population = recovery_error(design_vars.population(), truth)
+    if calibration.truth is not None:  # the instance's hidden truth
+        recovery = recovery_error(calibrated, calibration.truth)
+        recovery_population = recovery_error(design_vars.population(), calibration.truth)
     run = CalibrationRun(
         key,
         result,

@@ -12,7 +12,8 @@ Layout of a run directory (`RunLog(root)`)::
 It is a `wrist_env.runs.store.RunStore` (parts in `evals/`, records in
 `cells/`): every file is written whole or not at all (temporary name, fsync,
 `os.replace`), and a damaged file is a `StoreError` naming it. A row is one evaluation: the run key (participant, optimizer, seed,
-budget), its index in the run (`eval`, 0-based, the optimizer's order) and
+budget, instance: the problem instance, `participants.instances`; a log written before instances reads as
+instance 0), its index in the run (`eval`, 0-based, the optimizer's order) and
 batch (`batch`), the 22 normalized material variables (`x.<name>`), the
 kinematic cost on the calibration trial, `failed`, the RMSE of the 12
 scaphoid and lunate DOF (`rmse.<bone>.<DOF>`, mm and deg; NaN if failed),
@@ -43,6 +44,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import pyarrow as pa
+import pyarrow.compute as pc
 from numpy.typing import ArrayLike
 
 from wrist_env.cost import COST_BONES
@@ -50,7 +52,7 @@ from wrist_env.design import N_MATERIAL, NAMES
 from wrist_env.errors import StoreError, WristEnvError
 from wrist_env.frames import DOF_NAMES
 from wrist_env.io import read_json
-from wrist_env.limits import MAX_BUDGET, MAX_SEED, check_int
+from wrist_env.limits import MAX_BUDGET, MAX_INSTANCE, MAX_SEED, check_int
 from wrist_env.motions import TRIAL_MOTIONS
 from wrist_env.runs import provenance
 from wrist_env.runs.store import RunStore, read_parquet, remove_file, write_parquet
@@ -58,7 +60,7 @@ from wrist_env.runs.store import RunStore, read_parquet, remove_file, write_parq
 if TYPE_CHECKING:
     import pandas as pd
 
-KEY_FIELDS = ("participant", "optimizer", "seed", "budget")
+KEY_FIELDS = ("participant", "optimizer", "seed", "budget", "instance")
 X_COLUMNS = tuple(f"x.{n}" for n in NAMES[:N_MATERIAL])
 RMSE_COLUMNS = tuple(f"rmse.{bone}.{dof}" for bone in COST_BONES for dof in DOF_NAMES)
 SCHEMA = pa.schema(
@@ -67,6 +69,7 @@ SCHEMA = pa.schema(
         ("optimizer", pa.string()),
         ("seed", pa.int64()),
         ("budget", pa.int64()),
+        ("instance", pa.int64()),
         ("eval", pa.int64()),
         ("batch", pa.int64()),
         ("time", pa.float64()),
@@ -79,7 +82,8 @@ SCHEMA = pa.schema(
 """Columns of the evaluation log; `time` is the Unix time the batch finished; `objective` is the value
 the calibrator was told (the cost, or a `+prior` calibrator's MAP objective); `unsettled` the frames of
 the run whose hold ran out before equilibrium (its outputs are where the bones were then; null if the
-run failed). Both are null in logs older than them."""
+run failed). Both are null in logs older than them. `instance` is the problem instance (`RunKey.instance`);
+`RunLog` reads it as 0 in logs older than it."""
 
 SUMMARY_KEYS = (
     "participant",
@@ -94,7 +98,8 @@ SUMMARY_KEYS = (
     "recovery_z",
     "recovery_z_population",
 )
-"""Fields of a cell summary the leaderboard reads; `calibrate` and `validate` hold `SCORE_KEYS`."""
+"""Fields of a cell summary the leaderboard reads; `calibrate` and `validate` hold `SCORE_KEYS`. A summary also
+records its `instance`, read as 0 where it does not (`summary_instance`: written before instances)."""
 SCORE_KEYS = ("cost", "failed", "rmse")
 
 _PART = re.compile(r"^part-(?P<cell>.+)-b(?P<batch>\d+)-e(?P<start>\d+)-(?P<end>\d+)\.parquet$")
@@ -125,13 +130,40 @@ def _check_summary(path: Path, summary) -> None:
         raise StoreError(f"{path}: not a whole cell summary (no {', '.join(missing)}); {RERUN}")
 
 
+def describe_problem(participant: str, instance: int) -> str:
+    """A problem in words: "P1" for instance 0, "P1 instance 3" for instance 3."""
+    return participant if instance == 0 else f"{participant} instance {instance}"
+
+
+def summary_instance(summary: dict) -> int:
+    """The problem instance a cell summary (or a row) records; 0 for one written before instances."""
+    instance = summary.get("instance")
+    return 0 if instance is None else instance
+
+
+def key_of(summary: dict) -> RunKey:
+    """The `RunKey` of a cell summary or a row (instance 0 where it records none); `WristEnvError`,
+    `KeyError` or `TypeError` if its fields are not a key."""
+    return RunKey(**{k: summary[k] for k in KEY_FIELDS if k != "instance"}, instance=summary_instance(summary))
+
+
 def _summary_cell(summary: dict) -> str:
     """The cell name the key fields of a summary (or a row) give (`RunKey.name`), or a description if they
     are not a key."""
     try:
-        return RunKey(*(summary[k] for k in KEY_FIELDS)).name
-    except (WristEnvError, TypeError, ValueError):
+        return key_of(summary).name
+    except (WristEnvError, KeyError, TypeError, ValueError):
         return f"{[summary.get(k) for k in KEY_FIELDS]} (not a cell key)"
+
+
+def _with_instance(table: pa.Table) -> pa.Table:
+    """`table` with its null `instance` (a file written before instances: pyarrow reads a missing column as
+    nulls) as instance 0."""
+    column = table.column("instance")
+    if column.null_count == 0:
+        return table
+    filled = pc.fill_null(column, 0)
+    return table.set_column(table.schema.get_field_index("instance"), "instance", filled)
 
 
 class DuplicateEvaluationError(WristEnvError, RuntimeError):
@@ -140,25 +172,42 @@ class DuplicateEvaluationError(WristEnvError, RuntimeError):
 
 @dataclass(frozen=True, order=True)
 class RunKey:
-    """One benchmark cell: a calibrator run on a participant with a seed and a budget."""
+    """One benchmark cell: a calibrator run on a problem instance of a participant (`participants.instances`;
+    0, the default, its shipped truth and trials) with a seed and a budget."""
 
     participant: str
     optimizer: str
     seed: int
     budget: int
+    instance: int = 0
 
     def __post_init__(self):
         check_int("seed", self.seed, 0, MAX_SEED)
         check_int("budget", self.budget, 1, MAX_BUDGET)
+        check_int("instance", self.instance, 0, MAX_INSTANCE)
 
     @property
     def name(self) -> str:
-        """A file-name-safe identifier, also the Optuna study name."""
-        safe = re.sub(r"[^A-Za-z0-9_.+-]", "_", f"{self.participant}.{self.optimizer}")
+        """A file-name-safe identifier, also the Optuna study name: `P1.cmaes.seed3.budget300` on instance 0
+        (as before instances, so older logs and studies keep their names), `P1.i3.cmaes.seed3.budget300`
+        on instance 3."""
+        problem = self.participant if self.instance == 0 else f"{self.participant}.i{self.instance}"
+        safe = re.sub(r"[^A-Za-z0-9_.+-]", "_", f"{problem}.{self.optimizer}")
         return f"{safe}.seed{self.seed}.budget{self.budget}"
 
+    @property
+    def problem(self) -> str:
+        """The problem in words: the participant, and its instance unless 0 (`describe_problem`)."""
+        return describe_problem(self.participant, self.instance)
+
     def as_dict(self) -> dict:
-        return {"participant": self.participant, "optimizer": self.optimizer, "seed": self.seed, "budget": self.budget}
+        return {
+            "participant": self.participant,
+            "instance": self.instance,
+            "optimizer": self.optimizer,
+            "seed": self.seed,
+            "budget": self.budget,
+        }
 
 
 class IncompleteCellError(StoreError):
@@ -222,6 +271,7 @@ class RunLog:
             "optimizer": [key.optimizer] * k,
             "seed": [key.seed] * k,
             "budget": [key.budget] * k,
+            "instance": [key.instance] * k,
             "eval": list(range(start, start + k)),
             "batch": [batch] * k,
             "time": [now] * k,
@@ -280,24 +330,25 @@ class RunLog:
         changed = next(((p, d) for p, r in recorded if (d := provenance.differences(r, made_from))), None)
         if changed is None:
             return 0
-        why = f"made on another model or trials of {key.participant} ({changed[1]}); the cell runs again"
+        why = f"made on another model or trials of {key.problem} ({changed[1]}); the cell runs again"
         moved = sum(
             self.store.quarantine(p, why if p == changed[0] else f"{why} (as {changed[0].name})") is not None
             for p, _ in recorded
         )
         return moved
 
-    def check_made_from(self, made_from: dict[str, dict]) -> None:
+    def check_made_from(self, made_from: dict[tuple[str, int], dict]) -> None:
         """`StoreError` naming the first finished cell's summary made on another model or trials than
-        `made_from` ({participant: `provenance.of_participant`}) records (the leaderboard's check)."""
+        `made_from` ({(participant, instance): `provenance.of_participant`}) records (the leaderboard's check)."""
         for name in self.store.record_names():
             path = self.store.record_path(name)
             summary = self.store.read_record(name, advice=RERUN)
-            today = made_from.get(summary.get("participant")) if isinstance(summary, dict) else None
+            problem = (summary.get("participant"), summary_instance(summary)) if isinstance(summary, dict) else None
+            today = made_from.get(problem)
             changed = "" if today is None else provenance.differences(summary.get(provenance.FIELD), today)
             if changed:
                 raise StoreError(
-                    f"{path}: this cell was calibrated on another model or trials of {summary['participant']} "
+                    f"{path}: this cell was calibrated on another model or trials of {describe_problem(*problem)} "
                     f"({changed}); {RERUN} on today's model"
                 )
 
@@ -338,7 +389,7 @@ class RunLog:
         evaluation numbers: a copy under another name), or "" if they are (or it is unreadable: damage)."""
         m = _match(path.name)
         try:
-            cols = read_parquet(path, columns=[*KEY_FIELDS, "eval"], advice=RERUN).to_pydict()
+            cols = read_parquet(path, SCHEMA, columns=[*KEY_FIELDS, "eval"], advice=RERUN).to_pydict()
         except StoreError:
             return ""
         cells = {_summary_cell(dict(zip(KEY_FIELDS, k))) for k in zip(*(cols[f] for f in KEY_FIELDS))}
@@ -395,7 +446,8 @@ class RunLog:
         return out
 
     def _table(self, files) -> pa.Table:
-        return pa.concat_tables([read_parquet(p, SCHEMA, advice=RERUN) for p in files])
+        """The rows of `files` (`SCHEMA`; the instance of a file written before instances is 0)."""
+        return pa.concat_tables([_with_instance(read_parquet(p, SCHEMA, advice=RERUN)) for p in files])
 
     def read(self, *, dedupe: bool = True) -> pd.DataFrame:
         """Every logged evaluation as a pandas DataFrame (sorted by run key and eval), duplicates dropped."""
@@ -420,6 +472,7 @@ class RunLog:
             & (frame.optimizer == key.optimizer)
             & (frame.seed == key.seed)
             & (frame.budget == key.budget)
+            & (frame.instance == key.instance)
         ]
         frame = frame.drop_duplicates(subset=["eval"], keep="first").sort_values("eval", kind="stable")
         frame = frame.reset_index(drop=True)

@@ -1,4 +1,11 @@
-"""The benchmark runner: participants × calibrators × seeds, one cell each, logged and resumable.
+"""The benchmark runner: participants × instances × calibrators × seeds, one cell each, logged and resumable.
+
+A cell is (participant, instance, calibrator, seed) at a budget (`RunKey`). An instance is a problem
+of a built-in participant (`participants.instances`: instance 0 its shipped truth and trials, k ≥ 1 a
+truth drawn from the prior with the trials made from it). As in COCO's experiments, a run on instance
+k is seeded with k unless seeds are given (`make_cells`'s `seeds=SEED_IS_INSTANCE`): the benchmark
+over instances 1 … 5 is five runs per participant and calibrator, each on its own problem and seed.
+Explicit seeds cross every instance (n seeds on each).
 
 Cells run on local processes (the default) or on a `dask.distributed`
 scheduler given by address, one task per cell. Every cell writes its batches
@@ -28,9 +35,9 @@ from typing import TYPE_CHECKING
 import optimizers
 from wrist_env.bench.calibrate import accepts_storage, calibrate, open_storage, split_prior
 from wrist_env.bench.log import RunKey, RunLog
-from wrist_env.errors import InputError
-from wrist_env.limits import MAX_SEEDS, MAX_THREADS, MAX_WORKERS, check_int, check_unique
-from wrist_env.participants import registry
+from wrist_env.errors import InputError, ParticipantError
+from wrist_env.limits import MAX_INSTANCE, MAX_SEEDS, MAX_THREADS, MAX_WORKERS, check_int, check_unique
+from wrist_env.participants import builtin, registry
 from wrist_env.runs import provenance
 from wrist_env.runs.executor import describe, executor, set_threads
 
@@ -57,18 +64,63 @@ class BenchmarkReport:
         return sum(RunLog(self.out_dir).progress().get(k.name, 0) for k in self.cells)
 
 
+SEED_IS_INSTANCE = "instance"
+"""`seeds` of `make_cells` and `benchmark`: one run per instance, seeded with the instance's number (COCO's
+convention: a run on instance k uses seed k)."""
+
+
 def make_cells(
-    participants: Sequence[str], optimizers: Sequence[str], seeds: int | Iterable[int], budget: int
+    participants: Sequence[str],
+    optimizers: Sequence[str],
+    seeds: int | Iterable[int] | str,
+    budget: int,
+    instances: int | Iterable[int] | None = None,
 ) -> list[RunKey]:
-    """The cross product participants × optimizers × seeds (seeds: a count n → 0 … n−1, or a list);
-    `InputError` if one is empty or repeats a name or seed, or a size is out of bounds (`limits`)."""
-    if isinstance(seeds, numbers.Integral):
-        seeds = list(range(check_int("seeds", seeds, 1, MAX_SEEDS)))
-    seeds = check_unique("seeds", seeds)
+    """The cells participants × instances × optimizers × seeds, in that order.
+
+    instances: a count n → the drawn instances 1 … n; or a list of instances (0: the shipped problem);
+        None (the default): instance 0 alone, the benchmark before instances.
+    seeds: a count n → seeds 0 … n−1 on every instance; or a list; or `SEED_IS_INSTANCE` ("instance"):
+        one run per instance, seeded with the instance (`make_cells(ps, os, "instance", 300, instances=5)`
+        is instances 1 … 5 with seeds 1 … 5).
+    `InputError` if one is empty or repeats a name, instance or seed, or a size is out of bounds (`limits`)."""
+    instances, seeds = _instances(instances), _seeds(seeds)
     if not seeds or not participants or not optimizers:
         raise InputError("a benchmark needs at least one participant, optimizer and seed")
+    if len(instances) * len(seeds) > MAX_SEEDS:  # checked before the cells are made (10^8 asked ~20 GB)
+        raise InputError(
+            f"runs per participant and calibrator (instances x seeds) must be at most {MAX_SEEDS:,}, but got "
+            f"{len(instances):,} x {len(seeds):,}"
+        )
     participants, optimizers = check_unique("participants", participants), check_unique("optimizers", optimizers)
-    return [RunKey(p, o, s, budget) for p, o, s in itertools.product(participants, optimizers, seeds)]
+    return [
+        RunKey(p, o, k if s is None else s, budget, k)
+        for p, k, o, s in itertools.product(participants, instances, optimizers, seeds)
+    ]
+
+
+def _seeds(seeds: int | Iterable[int] | str) -> list[int | None]:
+    """`make_cells`'s seeds as a list: a count n → 0 … n−1; a list checked; `SEED_IS_INSTANCE` → [None] (the
+    seed is the cell's instance)."""
+    if isinstance(seeds, str):
+        if seeds != SEED_IS_INSTANCE:
+            raise InputError(f"seeds must be a count, a list of seeds or {SEED_IS_INSTANCE!r}, but got {seeds!r}")
+        return [None]
+    if isinstance(seeds, numbers.Integral):
+        return list(range(check_int("seeds", seeds, 1, MAX_SEEDS)))
+    return check_unique("seeds", seeds)
+
+
+def _instances(instances: int | Iterable[int] | None) -> list[int]:
+    """`make_cells`'s instances as a list: None → [0]; a count n → 1 … n; a list checked (`limits`)."""
+    if instances is None:
+        return [0]
+    if isinstance(instances, numbers.Integral):
+        return list(range(1, check_int("instances", instances, 1, MAX_INSTANCE) + 1))
+    instances = check_unique("instances", [check_int("instance", k, 0, MAX_INSTANCE) for k in instances])
+    if not instances:
+        raise InputError("a benchmark needs at least one instance (or none given: instance 0)")
+    return instances
 
 
 NO_STORAGE = ("memory", "none")
@@ -115,7 +167,7 @@ def run_cell(
         registry.ensure_folder(folder)
     log = RunLog(out_dir)
     with log.lock(key):
-        made_from = provenance.of_participant(key.participant)
+        made_from = provenance.of_participant(key.participant, key.instance)
         log.move_aside_stale(key, made_from)
         summary = log.summary(key)
         if summary is not None:
@@ -130,6 +182,7 @@ def run_cell(
             options=(options or {}).get(key.optimizer, (options or {}).get(split_prior(key.optimizer)[0])),
             callback=callback,
             made_from=made_from,
+            instance=key.instance,
         )
         return {"status": "ran", "summary": run.to_dict()}
 
@@ -137,10 +190,11 @@ def run_cell(
 def benchmark(
     participants: Sequence[str],
     optimizers: Sequence[str],
-    seeds: int | Iterable[int],
+    seeds: int | Iterable[int] | str,
     budget: int,
     out_dir: str | Path,
     *,
+    instances: int | Iterable[int] | None = None,
     workers: int | None = None,
     scheduler: str | Client | None = None,
     progress: bool = True,
@@ -149,8 +203,10 @@ def benchmark(
     options: dict | None = None,
     folders: Sequence[str | Path] = (),
 ) -> BenchmarkReport:
-    """Run every cell of participants × optimizers × seeds with `budget` evaluations into `out_dir`.
+    """Run every cell of participants × instances × optimizers × seeds with `budget` evaluations into `out_dir`.
 
+    seeds, instances: as `make_cells` takes them (instances None: instance 0 alone; seeds
+        `SEED_IS_INSTANCE`: one run per instance, seeded with it).
     workers: local processes (default: the number of cores; 1 runs the cells in this process).
     threads: Numba threads per local process (default ⌊cores / workers⌋).
     scheduler: a dask.distributed scheduler address (or a `distributed.Client`): one task per cell.
@@ -162,7 +218,7 @@ def benchmark(
     folders: participant folders to register (in every worker too).
     """
     start = time.perf_counter()
-    cells = make_cells(participants, optimizers, seeds, budget)
+    cells = make_cells(participants, optimizers, seeds, budget, instances)
     if workers is not None:
         check_int("workers", workers, 1, MAX_WORKERS)
     if threads is not None:
@@ -177,11 +233,11 @@ def benchmark(
     _prepare_storage(cells, storage)
     log = RunLog(out_dir)
     log.repair()
-    made_from: dict[str, dict] = {}  # loaded only for participants with something logged (no build here)
+    made_from: dict[tuple[str, int], dict] = {}  # loaded only for problems with something logged (no build here)
     for k in (k for k in cells if log.logged(k)):  # a cell made on another model or trials runs again
-        if k.participant not in made_from:
-            made_from[k.participant] = provenance.of_participant(k.participant)
-        log.move_aside_stale(k, made_from[k.participant])
+        if (k.participant, k.instance) not in made_from:
+            made_from[k.participant, k.instance] = provenance.of_participant(k.participant, k.instance)
+        log.move_aside_stale(k, made_from[k.participant, k.instance])
     done = {k for k in cells if log.summary(k) is not None}
     report = BenchmarkReport(out_dir, cells, skipped=[k for k in cells if k in done])
     todo = [k for k in cells if k not in done]
@@ -218,6 +274,12 @@ def _check_names(cells, folders) -> None:
     for folder in folders:
         registry.ensure_folder(folder)
     registry.require(*sorted({k.participant for k in cells}))
+    drawn = sorted({k.participant for k in cells if k.instance != 0} - set(builtin.BUILTIN))
+    if drawn:
+        raise ParticipantError(
+            f"instances k >= 1 draw a hidden truth and trials for a built-in participant {builtin.BUILTIN}, "
+            f"but {', '.join(drawn)} is not one: run it on instance 0 (its own trials)"
+        )
 
     for name in sorted({k.optimizer for k in cells}):
         optimizers.get(split_prior(name)[0])  # UnknownOptimizerError lists the registered ones

@@ -28,7 +28,7 @@ COMMANDS = {
     "calibrate": ("study_commands", "calibrate a participant's ligament materials with one calibrator"),
     "benchmark": (
         "study_commands",
-        "run participants x calibrators x seeds into a resumable run log, then the leaderboard",
+        "run participants x instances x calibrators x seeds into a resumable run log, then the leaderboard",
     ),
     "leaderboard": ("study_commands", "write the leaderboards of a benchmark run log"),
     "iohanalyzer": ("study_commands", "write a benchmark run log in IOHanalyzer's format (through ioh's logger)"),

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from wrist_env.limits import MAX_SEED, bounded_int
+from wrist_env.limits import MAX_INSTANCE, MAX_SEED, bounded_int
 from wrist_env.solver.settings import DEFAULT_LOADS, LOAD_DIRECTIONS
 
 
@@ -44,9 +44,47 @@ def json_option(s: argparse.ArgumentParser, what: str) -> None:
     s.add_argument("--json", action="store_true", help=f"print {what} as JSON")
 
 
-def seed_option(s: argparse.ArgumentParser, what: str) -> None:
-    """`--seed` (default 0)."""
-    s.add_argument("--seed", type=bounded_int("seed", 0, MAX_SEED), default=0, help=f"{what} seed (default 0)")
+def seed_option(s: argparse.ArgumentParser, what: str, default: int | None = 0, default_help: str = "0") -> None:
+    """`--seed` (default `default`, described as `default_help`)."""
+    s.add_argument(
+        "--seed", type=bounded_int("seed", 0, MAX_SEED), default=default, help=f"{what} seed (default {default_help})"
+    )
+
+
+INSTANCE = bounded_int("instance", 0, MAX_INSTANCE)
+"""An instance's number on the command line (`participants.instances`; 0 the shipped problem)."""
+INSTANCES = bounded_int("instances", 1, MAX_INSTANCE)
+"""A count of instances on the command line (1 … n)."""
+
+
+def parse_instances(text: str) -> int | list[int]:
+    """`--instances`: "n", a count (the drawn instances 1 … n); "a-b", instances a … b; "a,b,…", a list
+    (0 the shipped problem). Every number checked as `limits.bounded_int` checks it (argparse names the
+    option and the value)."""
+    text = text.strip()
+    if "," in text:
+        return [INSTANCE(piece) for piece in text.split(",") if piece.strip()]
+    if "-" in text.lstrip("-"):
+        first, _, last = text.partition("-")
+        first, last = INSTANCE(first), INSTANCE(last)
+        if last < first:
+            raise argparse.ArgumentTypeError(f"instances a-b must have a <= b, but got {text!r}")
+        return list(range(first, last + 1))
+    return INSTANCES(text)
+
+
+parse_instances.__name__ = "instances"
+
+
+def instances_option(s: argparse.ArgumentParser) -> None:
+    """`--instances`: problem instances of each participant (`parse_instances`); default none (instance 0)."""
+    s.add_argument(
+        "--instances",
+        type=parse_instances,
+        help="problem instances of each built-in participant, each a hidden truth drawn from the prior with its "
+        "own trials: N (instances 1 .. N), A-B (A .. B) or a list A,B,... (0: the shipped problem); default: "
+        "instance 0 alone. With --instances and no --seeds, a run on instance k uses seed k (COCO's convention)",
+    )
 
 
 def progress_option(s: argparse.ArgumentParser) -> None:

@@ -8,6 +8,8 @@ from collections.abc import Callable
 
 import optimizers
 from wrist_env.cli.options import (
+    INSTANCE,
+    instances_option,
     json_option,
     load_direction_option,
     out_option,
@@ -58,7 +60,14 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
         "--optimizer", default="cmaes", help=f"calibrator: {', '.join(optimizers.available())} (default cmaes)"
     )
     s.add_argument("--budget", type=BUDGET, default=300, help="simulations allowed (default 300)")
-    seed_option(s, "calibrator")
+    s.add_argument(
+        "--instance",
+        type=INSTANCE,
+        default=0,
+        help="problem instance of a built-in participant: 0 (default) its shipped truth and trials, K >= 1 a "
+        "hidden truth drawn from the prior and the trials made from it (made and cached on first use)",
+    )
+    seed_option(s, "calibrator", None, "the instance, as the benchmark seeds a run on instance k")
     s.add_argument("--log", help="run-log folder: log every batch, resume this run if it was cut short")
     s.add_argument("--storage", help="Optuna storage URL for Optuna calibrators (default: in memory)")
     s.add_argument(
@@ -73,7 +82,7 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
 
     s = command(
         "benchmark",
-        description="Cross participants x calibrators x seeds, one cell each, on local processes (default) or a "
+        description="Cross participants x instances x calibrators x seeds, one cell each, on local processes (default) or a "
         "dask.distributed scheduler; every evaluation is logged to Parquet in --out as its batch "
         "finishes. Run the same command again to resume after an interruption: finished cells are "
         "skipped, unfinished ones replay their logged evaluations. Writes the leaderboard at the end.",
@@ -88,9 +97,10 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     s.add_argument(
         "--seeds",
         type=bounded_int("seeds", 1, MAX_SEEDS),
-        default=5,
-        help="seeds 0 .. N-1 per participant and calibrator (default 5)",
+        help="seeds 0 .. N-1 per participant, instance and calibrator (default: 5 without --instances; with "
+        "--instances one run per instance, seeded with the instance)",
     )
+    instances_option(s)
     s.add_argument("--budget", type=BUDGET, default=300, help="simulations per run (default 300)")
     out_option(s, "runs/benchmark", "run-log folder")
     scheduler_option(s, "cell")
@@ -124,7 +134,8 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     s = command(
         "iohanalyzer",
         description="Replays every logged evaluation through ioh's Analyzer logger (nothing is simulated): "
-        "one folder per calibrator, one problem per participant (wrist-<participant>), one run per seed. "
+        "one folder per calibrator, one problem per participant (wrist-<participant>), one run per instance and "
+        "seed, each with its instance id. "
         "Zip the output folder and upload it to IOHanalyzer. Needs the [ioh] extra.",
     )
     _run_log_arguments(s, out="runs/iohanalyzer")

@@ -39,16 +39,20 @@ def trial_digest(trial: Trial) -> str:
     return h.hexdigest()
 
 
-def of_participant(name: str) -> dict:
+def of_participant(name: str, instance: int = 0) -> dict:
     """{"model": the participant's `Model.source_hash`, "trials": {trial name: `trial_digest`}} today
-    (loads the model: from the cache, or built on a miss)."""
-    from wrist_env.participants import registry  # the registry builds on the solver
+    (loads the model: from the cache, or built on a miss). For a problem instance k ≥ 1
+    (`participants.instances`) the trials are the instance's and "instance": k is added, so a log made
+    on one instance differs from another's (instance 0 records no "instance", as logs made before
+    instances do)."""
+    from wrist_env.participants import instances, registry  # the registry builds on the solver
 
-    trials = registry.trials(name)
-    return {
+    trials = registry.trials(name) if instance == 0 else instances.instance(name, instance).trials
+    out = {
         "model": registry.load_model(name).source_hash,
         "trials": {t: trial_digest(trials[t]) for t in sorted(trials)},
     }
+    return out if instance == 0 else {**out, "instance": int(instance)}
 
 
 def differences(recorded: dict | None, current: dict, against: str = "now") -> str:
@@ -57,6 +61,8 @@ def differences(recorded: dict | None, current: dict, against: str = "now") -> s
     if not isinstance(recorded, dict):
         return "it does not record the model and trials it was made with (made by an older wrist-env)"
     out = []
+    if recorded.get("instance", 0) != current.get("instance", 0):
+        out.append(f"instance {recorded.get('instance', 0)} ({against} {current.get('instance', 0)})")
     if recorded.get("model") != current.get("model"):
         out.append(f"model {str(recorded.get('model'))[:12]}… ({against} {str(current.get('model'))[:12]}…)")
     old, new = recorded.get("trials") or {}, current.get("trials") or {}

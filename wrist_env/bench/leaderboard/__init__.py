@@ -18,6 +18,12 @@ only) and writes to the folder `out`:
   dof_improved.csv: the share of DOF whose RMSE calibration lowered (preprint: 66.7 %, 61.1 %);
 - runs.csv: one row per run; README.md: all tables in Markdown with the figures.
 
+Problem instances (`participants.instances`): every table, column and panel "per participant" is per
+problem, a participant's instance, named by the participant for instance 0 (so a log of instance 0
+alone gives the leaderboard it gave before instances) and "<participant>.i<k>" for instance k
+(`tables.problem_label`; the CSVs' `participant` column holds that name, runs.csv also the instance);
+each problem's targets and references are its own population's and hidden truth's costs on its trials.
+
 Nothing here depends on wall-clock time, so an interrupted-and-resumed
 benchmark gives the same CSVs as an uninterrupted one.
 """
@@ -39,7 +45,8 @@ def write_leaderboard(
 ) -> Path:
     """Write the leaderboards of the run log in `runs` into the folder `out`; returns out/README.md.
 
-    references: {participant: `Reference`} already simulated (the others are simulated here)."""
+    references: {problem (the participant for instance 0): `Reference`} already simulated (the others are
+    simulated here)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     board = build(runs, references)

@@ -14,14 +14,16 @@ from wrist_env.bench.leaderboard.tables import (
     _runs_frame,
     _targets,
     best_cost,
+    by_problem,
     calibrator_label,
     curves,
     ecdf_targets,
     evals_to_target,
     load_runs,
+    problem_label,
     unsettled_shares,
 )
-from wrist_env.bench.log import RunLog
+from wrist_env.bench.log import RunLog, summary_instance
 from wrist_env.errors import StoreError
 from wrist_env.runs import provenance
 
@@ -33,7 +35,7 @@ class Leaderboard:
     runs: str
     summaries: list
     unfinished: int
-    participants: list
+    participants: list  # the problems: the participant, "<participant>.i<k>" for instance k ≥ 1
     labels: list
     budgets: set
     refs: dict
@@ -52,20 +54,24 @@ class Leaderboard:
 
 
 def build(runs: str | Path, references: dict[str, Reference] | None = None) -> Leaderboard:
-    """The leaderboard of the finished cells of the run log in `runs` (`references`: {participant:
-    `Reference`} already simulated; the others are simulated here)."""
+    """The leaderboard of the finished cells of the run log in `runs`, a column (or panel) per problem
+    (`tables.by_problem`: the participant for instance 0, "P1.i3" for instance 3; `references`:
+    {problem: `Reference`} already simulated; the others are simulated here)."""
     evals, summaries, unfinished = load_runs(runs)
     if not summaries:
         raise StoreError(f"{runs}: no finished benchmark cell in this run log")
-    participants = sorted({s["participant"] for s in summaries})
-    RunLog(runs).check_made_from({p: provenance.of_participant(p) for p in participants})  # today's models
-    summaries = sorted(summaries, key=lambda s: (s["participant"], s["optimizer"], s["budget"], s["seed"]))
+    problems = sorted({(s["participant"], summary_instance(s)) for s in summaries})
+    RunLog(runs).check_made_from({pk: provenance.of_participant(*pk) for pk in problems})  # today's models
+    evals, summaries = by_problem(evals, summaries)
+    participants = [problem_label(*pk) for pk in problems]
+    order = {p: i for i, p in enumerate(participants)}
+    summaries = sorted(summaries, key=lambda s: (order[s["participant"]], s["optimizer"], s["budget"], s["seed"]))
     budgets = {s["budget"] for s in summaries}
     labels = sorted({calibrator_label(s["optimizer"], s["budget"], budgets) for s in summaries})
     refs = dict(references or {})
-    for p in participants:
-        if p not in refs:
-            refs[p] = reference(p)
+    for (p, k), name in zip(problems, participants):
+        if name not in refs:
+            refs[name] = reference(p, k)
     by_key = curves(evals)
     targets = _targets(participants, refs)
     runs_frame = _runs_frame(summaries, by_key, targets, budgets, unsettled_shares(evals))

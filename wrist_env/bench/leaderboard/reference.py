@@ -10,31 +10,34 @@ from wrist_env import design
 from wrist_env.cost import COST_BONES
 from wrist_env.frames import DOF_NAMES
 from wrist_env.motions import TRIAL_MOTIONS
-from wrist_env.participants import builtin
 from wrist_env.task import task
 
 
 @dataclass
 class Reference:
-    """A participant's population (and, if built in, hidden-truth) design scored on both trials."""
+    """A problem's population (and, if built in, hidden-truth) design scored on both trials: a participant's
+    instance (0: the shipped truth and trials)."""
 
     participant: str
     population: dict  # {"calibrate": score, "validate": score}; score = {"cost", "failed", "rmse"}
     truth: dict | None
+    instance: int = 0
 
 
 def _score(evaluation) -> dict:
     return {"cost": float(evaluation.cost), "failed": bool(evaluation.failed), "rmse": evaluation.info.get("rmse")}
 
 
-def reference(participant: str) -> Reference:
-    """Simulate the population design (and the hidden truth) on the calibration and held-out trials."""
+def reference(participant: str, instance: int = 0) -> Reference:
+    """Simulate the population design (and the instance's hidden truth) on the instance's calibration and
+    held-out trials."""
 
+    tasks = {m: task(participant, m, instance=instance) for m in TRIAL_MOTIONS}
     designs = {"population": design.population()}
-    if participant in builtin.BUILTIN:
-        designs["truth"] = builtin.truth(participant)
-    scores = {name: {m: _score(task(participant, m).evaluate(d)) for m in TRIAL_MOTIONS} for name, d in designs.items()}
-    return Reference(participant, scores["population"], scores.get("truth"))
+    if tasks["calibrate"].truth is not None:
+        designs["truth"] = tasks["calibrate"].truth
+    scores = {name: {m: _score(t.evaluate(d)) for m, t in tasks.items()} for name, d in designs.items()}
+    return Reference(participant, scores["population"], scores.get("truth"), instance)
 
 
 def rmse_array(rmse: dict | None) -> np.ndarray:

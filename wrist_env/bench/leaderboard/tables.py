@@ -12,7 +12,7 @@ import pandas as pd
 from numpy.typing import ArrayLike
 
 from wrist_env.bench.leaderboard.reference import Reference, rmse_array
-from wrist_env.bench.log import RunLog
+from wrist_env.bench.log import RunLog, key_of, summary_instance
 
 TARGETS = (("pop×0.75", "population", 0.75), ("pop×0.5", "population", 0.5), ("truth×1.1", "truth", 1.1))
 """Cost targets (name, reference, factor): a target is factor × the reference design's cost on the
@@ -43,16 +43,35 @@ def calibrator_label(optimizer: str, budget: int, budgets: set) -> str:
     return optimizer if len(budgets) == 1 else f"{optimizer} (budget {budget})"
 
 
+def problem_label(participant: str, instance: int) -> str:
+    """The name a leaderboard gives a problem: the participant's for instance 0 (as before instances), else
+    "<participant>.i<instance>" (as in the cell names, `RunKey.name`)."""
+    return participant if instance == 0 else f"{participant}.i{instance}"
+
+
 def load_runs(runs: str | Path) -> tuple[pd.DataFrame, list[dict], int]:
     """(evaluations of finished cells, their summaries, number of unfinished cells) of a run log."""
     log = RunLog(runs)
     evals = log.read()
     summaries = log.summaries()
-    finished = {(s["participant"], s["optimizer"], s["seed"], s["budget"]) for s in summaries}
-    keys = list(zip(evals.participant, evals.optimizer, evals.seed, evals.budget))
+    fields = ("participant", "optimizer", "seed", "budget", "instance")
+    finished = {tuple(getattr(key_of(s), f) for f in fields) for s in summaries}
+    keys = list(zip(*(evals[f] for f in fields)))
     mask = np.array([k in finished for k in keys], dtype=bool)
     unfinished = len(set(keys) - finished)
     return evals[mask].reset_index(drop=True), summaries, unfinished
+
+
+def by_problem(evals: pd.DataFrame, summaries: list[dict]) -> tuple[pd.DataFrame, list[dict]]:
+    """The evaluations and summaries with "participant" the problem's label (`problem_label`: the participant
+    for instance 0, "P1.i3" for instance 3), the instance kept: the leaderboard's tables are per problem,
+    so a log of instance 0 alone gives the tables it gave before instances."""
+    evals = evals.assign(participant=[problem_label(p, k) for p, k in zip(evals.participant, evals.instance)])
+    summaries = [
+        s | {"participant": problem_label(s["participant"], summary_instance(s)), "instance": summary_instance(s)}
+        for s in summaries
+    ]
+    return evals, summaries
 
 
 def curves(evals: pd.DataFrame) -> dict:
@@ -195,6 +214,7 @@ def _runs_frame(summaries, curves_by_key, targets, budgets, unsettled_by_key) ->
         curve = curves_by_key.get(key, np.array([s["best_cost"]]))
         row = {
             "participant": s["participant"],
+            "instance": summary_instance(s),
             "calibrator": calibrator_label(s["optimizer"], s["budget"], budgets),
             "optimizer": s["optimizer"],
             "seed": s["seed"],

@@ -15,7 +15,7 @@ from wrist_env.bench.calibrate import PRIOR_SUFFIX, accepts_storage, split_prior
 from wrist_env.bench.iohanalyzer import export
 from wrist_env.bench.leaderboard import reference, write_leaderboard
 from wrist_env.bench.log import RunLog
-from wrist_env.bench.runner import NO_STORAGE, make_cells
+from wrist_env.bench.runner import NO_STORAGE, SEED_IS_INSTANCE, make_cells
 from wrist_env.cli.run.outputs import out_file, out_folder
 from wrist_env.design import LIGAMENT_NAMES
 from wrist_env.errors import Interrupted, StoreError, UsageError, WristEnvError
@@ -45,12 +45,15 @@ def calibrate(args) -> int:
         if args.log
         else "nothing was saved (with --log <folder> a run can be resumed)"
     )
+    seed = args.instance if args.seed is None else args.seed  # a run on instance k uses seed k unless told
     try:
-        run = bench.calibrate(args.participant, name, args.budget, args.seed, log=args.log, storage=storage)
+        run = bench.calibrate(
+            args.participant, name, args.budget, seed, log=args.log, storage=storage, instance=args.instance
+        )
     except KeyboardInterrupt:
         raise Interrupted(f"calibration interrupted; {saved}") from None
     wall = time.perf_counter() - start
-    ref = reference(args.participant)
+    ref = reference(args.participant, args.instance)
     out = run.to_dict(history=True)
     out["wall_seconds"] = round(wall, 3)
     out["population"] = {m: ref.population[m]["cost"] for m in TRIAL_MOTIONS}
@@ -63,7 +66,7 @@ def calibrate(args) -> int:
         return 0
     truth = out["truth"]
     print(
-        f"{args.participant}: {name}, seed {args.seed}: {run.result.nfev} evaluations"
+        f"{run.key.problem}: {name}, seed {seed}: {run.result.nfev} evaluations"
         f"{f' ({run.replayed} replayed from the log)' if run.replayed else ''} in {wall:.1f} s; {run.result.message}"
     )
     for motion, name in (("calibrate", "calibration trial"), ("validate", "held-out resisted trial")):
@@ -115,20 +118,22 @@ def benchmark(args) -> int:
     names = args.optimizers or list(optimizers.available())
     if args.prior:
         names = list(dict.fromkeys(names + [n + PRIOR_SUFFIX for n in names if not n.endswith(PRIOR_SUFFIX)]))
-    cells = make_cells(participants, names, args.seeds, args.budget)
+    seeds = benchmark_seeds(args.seeds, args.instances)
+    cells = make_cells(participants, names, seeds, args.budget, args.instances)
     where = f"the dask scheduler {args.scheduler}" if args.scheduler else "local processes"
     print(
-        f"{len(cells)} cells: participants {', '.join(participants)} x calibrators {', '.join(names)} x "
-        f"{args.seeds} seeds, budget {args.budget}; on {where}; run log {args.out}",
+        f"{len(cells)} cells: participants {', '.join(participants)}{_instances_text(cells)} x calibrators "
+        f"{', '.join(names)} x {_seeds_text(seeds)}, budget {args.budget}; on {where}; run log {args.out}",
         flush=True,
     )
     try:
         report = bench.benchmark(
             participants,
             names,
-            args.seeds,
+            seeds,
             args.budget,
             args.out,
+            instances=args.instances,
             workers=args.workers,
             scheduler=args.scheduler,
             progress=not args.no_progress,
@@ -154,6 +159,32 @@ def benchmark(args) -> int:
         path = write_leaderboard(args.out, leaderboard)
         print(f"leaderboard: {path}")
     return 1 if report.failed else 0
+
+
+DEFAULT_SEEDS = 5
+"""`benchmark --seeds` without --instances: seeds 0 … 4 on instance 0 (the benchmark before instances)."""
+
+
+def benchmark_seeds(seeds: int | None, instances: int | list[int] | None) -> int | str:
+    """The seeds of `benchmark`'s cells: --seeds if given; else with --instances one run per instance seeded
+    with it (`SEED_IS_INSTANCE`, COCO's convention), without `DEFAULT_SEEDS`."""
+    if seeds is not None:
+        return seeds
+    return DEFAULT_SEEDS if instances is None else SEED_IS_INSTANCE
+
+
+def _instances_text(cells) -> str:
+    """ " (instances 1, 2, 3)" of the cells, or "" when they are all instance 0."""
+    instances = sorted({k.instance for k in cells})
+    if instances == [0]:
+        return ""
+    if len(instances) > 2 and instances == list(range(instances[0], instances[-1] + 1)):
+        return f" (instances {instances[0]}-{instances[-1]})"
+    return f" (instances {', '.join(str(k) for k in instances)})"
+
+
+def _seeds_text(seeds: int | str) -> str:
+    return "seed = instance" if seeds == SEED_IS_INSTANCE else f"{seeds} seeds"
 
 
 def _benchmark_saved(out: str) -> str:
