@@ -433,6 +433,20 @@ def test_calibrate_on_an_instance_is_seeded_with_it_unless_told(monkeypatch):
     assert seen == [(3, 3), (7, 3), (0, 0)]
 
 
+def _one_calibrator_benchmark(tmp_path) -> list[str]:
+    """`benchmark` of P1 with the random calibrator into tmp_path, without a progress bar (the instance tests')."""
+    return [
+        "benchmark",
+        "--participants",
+        "P1",
+        "--optimizers",
+        "random",
+        "--out",
+        str(tmp_path / "b"),
+        "--no-progress",
+    ]
+
+
 @pytest.mark.parametrize(
     "extra, seeds, instances",
     [
@@ -453,16 +467,7 @@ def test_benchmark_instances_and_seeds(extra, seeds, instances, monkeypatch, tmp
         raise KeyboardInterrupt
 
     monkeypatch.setattr(studies.bench, "benchmark", fake)
-    argv = [
-        "benchmark",
-        "--participants",
-        "P1",
-        "--optimizers",
-        "random",
-        "--out",
-        str(tmp_path / "b"),
-        "--no-progress",
-    ]
+    argv = _one_calibrator_benchmark(tmp_path)
     assert main(argv + extra) == 130
     assert seen == {"seeds": seeds, "instances": instances}
     n_instances = 1 if instances is None else instances if isinstance(instances, int) else len(instances)
@@ -474,16 +479,7 @@ def test_benchmark_names_a_range_of_instances_as_one(monkeypatch, tmp_path, caps
     from wrist_env.cli.run import studies
 
     monkeypatch.setattr(studies.bench, "benchmark", lambda *a, **k: (_ for _ in ()).throw(KeyboardInterrupt))
-    argv = [
-        "benchmark",
-        "--participants",
-        "P1",
-        "--optimizers",
-        "random",
-        "--out",
-        str(tmp_path / "b"),
-        "--no-progress",
-    ]
+    argv = _one_calibrator_benchmark(tmp_path)
     assert main([*argv, "--instances", "500"]) == 130
     assert capsys.readouterr().out.startswith(
         "500 cells: participants P1 (instances 1-500) x calibrators random x seed"

@@ -234,14 +234,20 @@ def _check_distinct_files(files: dict[str, Path], toml_path: Path) -> None:
                 )
 
 
+def _centres_and_radial(bones: dict) -> tuple[dict, np.ndarray]:
+    """Each bone's vertex centroid (mm), and the unit ulna → radius direction across the forearm (RCS y
+    dropped: the shafts' lengths do not count), from the files' own centroids, so either side passes."""
+    centre = {b: np.asarray(v, float).mean(axis=0) for b, (v, _) in bones.items()}
+    radial = centre["radius"] - centre["ulna"]
+    radial[1] = 0.0
+    return centre, radial / max(float(np.linalg.norm(radial)), 1e-12)
+
+
 def _check_arrangement(bones: dict, toml_path: Path) -> None:
     """ParticipantError naming both entries if two carpals look swapped: the scaphoid must lie radial
     of the lunate (along the ulna → radius direction of the files' own centroids, so either side
     passes) and the capitate distal of the lunate (RCS −y)."""
-    centre = {b: np.asarray(v, float).mean(axis=0) for b, (v, _) in bones.items()}
-    radial = centre["radius"] - centre["ulna"]
-    radial[1] = 0.0  # across the forearm: the shafts' lengths do not count
-    radial /= max(float(np.linalg.norm(radial)), 1e-12)
+    centre, radial = _centres_and_radial(bones)
     offset = float((centre["scaphoid"] - centre["lunate"]) @ radial)
     if offset < 0.0:
         raise ParticipantError(
@@ -276,10 +282,7 @@ def _check_given(bones: dict, files: dict, toml_path: Path) -> None:
     """ParticipantError naming the entry and its file if an optional bone does not sit where its anatomy
     puts it: beyond `GIVEN_REACH_MM` of the bone it articulates with, or on the wrong side of it (the
     radial direction from the radius and ulna as listed, as in `_check_arrangement`)."""
-    centre = {b: np.asarray(v, float).mean(axis=0) for b, (v, _) in bones.items()}
-    radial = centre["radius"] - centre["ulna"]
-    radial[1] = 0.0
-    radial /= max(float(np.linalg.norm(radial)), 1e-12)
+    centre, radial = _centres_and_radial(bones)
     for bone, (neighbour, side) in GIVEN_NEIGHBOURS.items():
         if bone not in bones:
             continue
