@@ -3,7 +3,7 @@ and `leaderboards/montecarlo/` (the maintainer's one command after a model chang
 
 Runs, from the repository root, each step as the README documents it and prints its wall time:
 the built-in models shipped with the package (`experiments/authoring/ship_models.py`), the figures (`wrist-bench figure ...`, `wrist-bench validate P1` … `P3`, whose JSON records the docs' validation page renders, the scaling benchmark `experiments/benchmarks/bench_scaling.py`), the full default benchmark
-and its leaderboard (3 participants × 11 calibrators × 5 seeds × 300 evaluations; Nevergrad's four
+and its leaderboard (3 participants × instances 0–4 × 11 calibrators × 300 evaluations, seed = instance; Nevergrad's four
 need the `[nevergrad]` extra) with its IOHanalyzer files (`[ioh]`), and the full
 Monte Carlo study (P1 + P2, 2 × 12,500) with its report and the probe of where each injury moves the load, what a trial identifies (Morris and Sobol
 sensitivity and the Fisher matrix at the hidden truth, P1–P3), the best calibrators with and without

@@ -450,7 +450,8 @@ def _one_calibrator_benchmark(tmp_path) -> list[str]:
 @pytest.mark.parametrize(
     "extra, seeds, instances",
     [
-        ([], 5, None),  # the benchmark before instances: seeds 0 .. 4 on instance 0
+        ([], "instance", [0, 1, 2, 3, 4]),  # the default: instances 0 .. 4, each seeded with its number
+        (["--seeds", "2"], 2, None),  # the benchmark before instances: seeds 0, 1 on instance 0
         (["--instances", "3"], "instance", 3),  # instances 1 .. 3, each seeded with its number
         (["--instances", "3", "--seeds", "2"], 2, 3),
         (["--instances", "2-4"], "instance", [2, 3, 4]),
@@ -473,6 +474,14 @@ def test_benchmark_instances_and_seeds(extra, seeds, instances, monkeypatch, tmp
     n_instances = 1 if instances is None else instances if isinstance(instances, int) else len(instances)
     n_seeds = 1 if seeds == "instance" else seeds
     assert capsys.readouterr().out.startswith(f"{n_instances * n_seeds} cells: participants P1")
+
+
+def test_benchmark_defaults_to_seeds_on_instance_0_with_a_participant_not_built_in():
+    from wrist_env.cli.run.studies import DEFAULT_SEEDS, benchmark_seeds
+
+    assert benchmark_seeds(None, None, ["P1", "U1"]) == (DEFAULT_SEEDS, None)  # U1's task has no instances
+    assert benchmark_seeds(None, None, ["P1", "P3"]) == ("instance", [0, 1, 2, 3, 4])
+    assert benchmark_seeds(3, None, ["U1"]) == (3, None)
 
 
 def test_benchmark_names_a_range_of_instances_as_one(monkeypatch, tmp_path, capsys):

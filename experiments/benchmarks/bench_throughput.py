@@ -7,7 +7,7 @@ the same designs: 64 Monte Carlo designs (Table 2 normals truncated at ±3 SD, e
 torn with probability 0.3, seed 0, as `bench_solver.py`) batched on every core (`simulate_batch`), and
 the population design alone on one core (median of 5), for the idealized sweep (17 frames) and the
 participant's 15-frame calibration trial, and what the trial rate makes of the default benchmark (3
-participants × 11 calibrators × 5 seeds × 300 evaluations, simulation time only). The kernels load from each checkout's warm Numba cache (a
+participants × 5 instances × 11 calibrators × 300 evaluations, simulation time only). The kernels load from each checkout's warm Numba cache (a
 warm-up simulation first). Prints each figure's median over the rounds and, with `--against`, the
 ratio this / that; issue 52 asks the batched rates to reach 3× main's.
 

@@ -77,13 +77,14 @@ parse_instances.__name__ = "instances"
 
 
 def instances_option(s: argparse.ArgumentParser) -> None:
-    """`--instances`: problem instances of each participant (`parse_instances`); default none (instance 0)."""
+    """`--instances`: problem instances of each participant (`parse_instances`); the default is the command's."""
     s.add_argument(
         "--instances",
         type=parse_instances,
         help="problem instances of each built-in participant, each a hidden truth drawn from the prior with its "
-        "own trials: N (instances 1 .. N), A-B (A .. B) or a list A,B,... (0: the shipped problem); default: "
-        "instance 0 alone. With --instances and no --seeds, a run on instance k uses seed k (COCO's convention)",
+        "own trials: N (instances 1 .. N), A-B (A .. B) or a list A,B,... (0: the shipped problem). A run on "
+        "instance k uses seed k unless --seeds is given (COCO's convention). Default: instances 0-4 of built-in "
+        "participants (instance 0 alone with --seeds or another participant)",
     )
 
 

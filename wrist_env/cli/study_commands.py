@@ -97,8 +97,8 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     s.add_argument(
         "--seeds",
         type=bounded_int("seeds", 1, MAX_SEEDS),
-        help="seeds 0 .. N-1 per participant, instance and calibrator (default: 5 without --instances; with "
-        "--instances one run per instance, seeded with the instance)",
+        help="seeds 0 .. N-1 per participant, instance and calibrator (without --instances: on instance 0, the "
+        "shipped problem; default: one run per instance, seeded with the instance)",
     )
     instances_option(s)
     s.add_argument("--budget", type=BUDGET, default=300, help="simulations per run (default 300)")

@@ -7,6 +7,7 @@ import importlib.util
 import json
 import sys
 import time
+from collections.abc import Sequence
 from pathlib import Path
 
 import optimizers
@@ -118,8 +119,8 @@ def benchmark(args) -> int:
     names = args.optimizers or list(optimizers.available())
     if args.prior:
         names = list(dict.fromkeys(names + [n + PRIOR_SUFFIX for n in names if not n.endswith(PRIOR_SUFFIX)]))
-    seeds = benchmark_seeds(args.seeds, args.instances)
-    cells = make_cells(participants, names, seeds, args.budget, args.instances)
+    seeds, instances = benchmark_seeds(args.seeds, args.instances, participants)
+    cells = make_cells(participants, names, seeds, args.budget, instances)
     where = f"the dask scheduler {args.scheduler}" if args.scheduler else "local processes"
     print(
         f"{len(cells)} cells: participants {', '.join(participants)}{_instances_text(cells)} x calibrators "
@@ -133,7 +134,7 @@ def benchmark(args) -> int:
             seeds,
             args.budget,
             args.out,
-            instances=args.instances,
+            instances=instances,
             workers=args.workers,
             scheduler=args.scheduler,
             progress=not args.no_progress,
@@ -162,15 +163,26 @@ def benchmark(args) -> int:
 
 
 DEFAULT_SEEDS = 5
-"""`benchmark --seeds` without --instances: seeds 0 … 4 on instance 0 (the benchmark before instances)."""
+"""`benchmark --seeds` without --instances: seeds 0 … 4 on instance 0 (the benchmark before instances); also the
+default of a benchmark with a participant that is not built in (instances are drawn for built-ins only)."""
+DEFAULT_INSTANCES = (0, 1, 2, 3, 4)
+"""`benchmark` without --seeds and --instances on built-in participants: instances 0 … 4 (0 the shipped problem),
+one run each seeded with its instance (COCO's convention): five problems per participant, the budget of the
+five seeds on instance 0 it replaced."""
 
 
-def benchmark_seeds(seeds: int | None, instances: int | list[int] | None) -> int | str:
-    """The seeds of `benchmark`'s cells: --seeds if given; else with --instances one run per instance seeded
-    with it (`SEED_IS_INSTANCE`, COCO's convention), without `DEFAULT_SEEDS`."""
-    if seeds is not None:
-        return seeds
-    return DEFAULT_SEEDS if instances is None else SEED_IS_INSTANCE
+def benchmark_seeds(
+    seeds: int | None, instances: int | list[int] | None, participants: Sequence[str]
+) -> tuple[int | str, int | list[int] | None]:
+    """(seeds, instances) of `benchmark`'s cells (`make_cells`' arguments). --seeds and --instances as given;
+    --instances alone: one run per instance seeded with it (`SEED_IS_INSTANCE`); --seeds alone: instance 0;
+    neither: `DEFAULT_INSTANCES` seeded with themselves on built-in participants, else `DEFAULT_SEEDS` on
+    instance 0."""
+    if instances is None and seeds is None:
+        if all(p in builtin.BUILTIN for p in participants):
+            return SEED_IS_INSTANCE, list(DEFAULT_INSTANCES)
+        return DEFAULT_SEEDS, None
+    return (SEED_IS_INSTANCE if seeds is None else seeds), instances
 
 
 def _instances_text(cells) -> str:
