@@ -44,3 +44,52 @@ def test_a_bad_instance_is_refused(bad):
 def test_instances_are_built_in_participants_only():
     with pytest.raises(ParticipantError, match="built-in participant's task"):
         instances.truth("U1", 1)
+
+
+@pytest.fixture
+def cheap_maker(tmp_path, monkeypatch):
+    """Instances made into tmp_path without the finer model: `synthetic_trials` stands in with the shipped
+    trials (the calls it gets are counted), and the key without the finer model's hash."""
+    from wrist_env.participants import synthetic
+
+    monkeypatch.setenv("WRIST_ENV_CACHE", str(tmp_path))
+    monkeypatch.setattr(instances, "instance_key", lambda name, k: f"{k:016d}")
+    calls = []
+
+    def trials(name, task, truth, seed):
+        calls.append((name, seed))
+        shipped = builtin.trials(name)
+        return dict(shipped), {t: {"role": shipped[t].role, "load_n": shipped[t].load_n.tolist()} for t in shipped}
+
+    monkeypatch.setattr(synthetic, "synthetic_trials", trials)
+    instances.instance.cache_clear()
+    yield calls
+    instances.instance.cache_clear()
+
+
+def test_an_instance_is_made_once_then_read_from_its_folder(cheap_maker, tmp_path):
+    made = instances.instance("P1", 2)
+    instances.instance.cache_clear()
+    read = instances.instance("P1", 2)
+    assert len(cheap_maker) == 1  # the second call read the folder
+    folder = tmp_path / "instances" / f"P1-2-{2:016d}"
+    assert sorted(p.name for p in folder.iterdir()) == sorted(
+        ["truth.json", "instance.json", *(f"{t}.csv" for t in made.trials)]
+    )
+    assert np.allclose(read.truth.vector, instances.truth("P1", 2).vector, rtol=1e-12)
+    for t, trial in made.trials.items():  # the CSV round trip keeps the poses to its written precision
+        assert np.allclose(read.trials[t].transforms, trial.transforms, atol=1e-6)
+        assert np.array_equal(read.trials[t].load_n, trial.load_n)
+    assert read.trial("calibrate").role == "calibrate" and read.trial("validate").role == "validate"
+
+
+def test_an_instance_whose_truth_cannot_make_a_trial_is_refused_by_name(cheap_maker, tmp_path, monkeypatch):
+    from wrist_env.participants import synthetic
+
+    def refused(name, task, truth, seed):
+        raise synthetic.TrialsRefused(f"{name} calibrate: the high-fidelity run of the truth failed: diverged")
+
+    monkeypatch.setattr(synthetic, "synthetic_trials", refused)
+    with pytest.raises(synthetic.TrialsRefused, match="instance 3 of P2 cannot be made .*diverged"):
+        instances.instance("P2", 3)
+    assert not list((tmp_path / "instances").glob("P2-3-*"))  # nothing half-made left to be read
