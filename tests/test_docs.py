@@ -182,3 +182,32 @@ def test_the_development_notes_are_in_the_site_and_dated():
         pytest.skip("no git history to check the commits against")
     missing = [h for h, line in zip(hashes, done.stdout.splitlines()) if line.endswith("missing")]
     assert not missing, f"docs/history.md names commits this repository does not have: {missing}"
+
+
+def _layout_entries(block: str) -> set[str]:
+    """The paths the layout page's tree names: a line is an entry, indented two spaces a level, a folder
+    ending in "/"."""
+    entries, parents = set(), []
+    for line in block.splitlines():
+        if not line.strip():
+            continue
+        depth = (len(line) - len(line.lstrip(" "))) // 2
+        name = line.split()[0]
+        parents = parents[:depth] + [name.rstrip("/")]
+        if not name.endswith("/"):
+            entries.add("/".join(parents))
+    return entries
+
+
+def test_the_layout_page_names_every_module_and_no_other():
+    """docs/layout.md lists every module of `wrist_env` and `optimizers` (package `__init__`s but the top one
+    aside), and nothing that is not there."""
+    block = (ROOT / "docs" / "layout.md").read_text().split("```")[1]
+    listed = {e for e in _layout_entries(block) if e.split("/")[0] in ("wrist_env", "optimizers")}
+    tree = {
+        p.relative_to(ROOT).as_posix()
+        for package in ("wrist_env", "optimizers")
+        for p in (ROOT / package).rglob("*.py")
+        if p.name != "__init__.py" or p.parent.name == "wrist_env"
+    }
+    assert listed == tree, {"not listed": sorted(tree - listed), "listed, not there": sorted(listed - tree)}
