@@ -92,7 +92,7 @@ def convergence_figure(path: str | os.PathLike, board: Leaderboard, colors: dict
     n = len(subjects)
     fig, axes = _panels(n, min(n, 3), 4.0)
     for ax, p in zip(axes.flat, subjects):
-        problems, lows, runs = _problems(board, p), [], 0
+        problems, lows, runs = _problems(board, p), [], set()
         for label in board.labels:
             cs = [c / _scale(refs[q]) for q in problems for c in _run_curves(board, q, label)]
             if not cs:
@@ -103,7 +103,7 @@ def convergence_figure(path: str | os.PathLike, board: Leaderboard, colors: dict
             q25, med, q75 = np.quantile(stack, [0.25, 0.5, 0.75], axis=0)
             lows.append(float(q25.min()))
             ax.plot(x, med, color=colors[label], lw=1.8, label=label)
-            runs = max(runs, len(cs))
+            runs.add(len(cs))
             ax.fill_between(x, q25, q75, color=colors[label], alpha=0.18, lw=0)
         pop = float(np.median([refs[q].population["calibrate"]["cost"] / _scale(refs[q]) for q in problems]))
         _reference_line(ax, pop, "population (median)", "0.35", "--", right=True)
@@ -114,11 +114,12 @@ def convergence_figure(path: str | os.PathLike, board: Leaderboard, colors: dict
         ax.set_ylim(min([1.0 if truths else np.inf] + lows) * 0.85, 1.6 * pop)  # failed runs (cost 1000) squash it
         _plain_log_ticks(ax.yaxis, subs=(1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 7.0))
         k = len(problems)
-        ax.set_title(f"{p}: calibration trial ({k} instance{'s' if k > 1 else ''}, ≤ {runs} runs per calibrator)")
+        count = f"{max(runs)}" if len(runs) == 1 else f"≤ {max(runs, default=0)}"
+        ax.set_title(f"{p}: {k} instance{'s' if k > 1 else ''}, {count} runs per calibrator")
         ax.set_xlabel("evaluations")
         ax.grid(True, which="both", alpha=0.25)
         ax.set_xlim(1, max(board.budgets))
-    _save(fig, axes, path, "best cost so far / hidden truth's cost\n(median, IQR band over runs)", 4)
+    _save(fig, axes, path, "calibration trial: best cost so far / hidden\ntruth's cost (median, IQR band over runs)", 4)
 
 
 def _plain_log_ticks(axis, subs=(1.0, 2.0, 5.0)) -> None:

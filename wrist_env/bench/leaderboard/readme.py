@@ -7,7 +7,6 @@ import pandas as pd
 
 from wrist_env.bench.leaderboard.board import CSV_FILES, Leaderboard
 from wrist_env.bench.leaderboard.statistics import (
-    AUTORANK_MIN_BLOCKS,
     ERT_PERCENTILES,
     ERT_RESAMPLES,
     Ranking,
@@ -109,8 +108,6 @@ def ranking_section(ranking: Ranking, n_problems: int) -> list[str]:
             "anyway but no difference in it is a finding.",
             "",
         ]
-    else:
-        lines += [f"(The test and its diagram need {AUTORANK_MIN_BLOCKS} or more problems.)", ""]
     return lines
 
 
@@ -168,7 +165,8 @@ def readme(board: Leaderboard, title: str | None = None) -> str:
     table = _median_iqr(pooled, subjects, labels)
     ref_rows = [
         {
-            "calibrator": "*population design* (median over instances)",
+            "calibrator": "*population design*"
+            + (" (median over instances)" if len(participants) > len(subjects) else ""),
             **{p: fmt(pooled[pooled.participant == p].population.iloc[0]) for p in subjects},
         }
     ]
