@@ -38,8 +38,8 @@ Per participant, pooled over its instances (`statistics`):
 
 Over all problems: ranking.csv: the calibrators' mean ranks (a problem is a block, the score its best cost
 relative to the truth's, median over seeds), with Friedman's test and the Nemenyi critical difference
-(`autorank`), ranking.png its critical-difference diagram (only with the test: 5 or more problems,
-3 or more calibrators); README.md: all tables in Markdown with the figures.
+(`autorank`), ranking.png its critical-difference diagram and ranking_report.txt autorank's own report
+(only with the test: 5 or more problems, 3 or more calibrators); README.md: all tables in Markdown with the figures.
 
 Nothing here depends on wall-clock time, so an interrupted-and-resumed
 benchmark gives the same CSVs as an uninterrupted one.
@@ -73,11 +73,13 @@ def write_leaderboard(
     colors = figures.colors(board.labels)
     figures.convergence_figure(out / "convergence.png", board, colors)
     figures.ecdf_figure(out / "ecdf.png", board, colors)
-    diagram = out / "ranking.png"
+    diagram, report = out / "ranking.png", out / "ranking_report.txt"
     if board.ranking.tested:
         figures.ranking_figure(diagram, board.ranking.result, ranking_title(board.ranking))
-    else:
-        diagram.unlink(missing_ok=True)  # a diagram of an earlier log in this folder would be another ranking
+        report.write_text(board.ranking.report + "\n")
+    else:  # those of an earlier log in this folder would be another ranking's
+        diagram.unlink(missing_ok=True)
+        report.unlink(missing_ok=True)
     path = out / "README.md"
     path.write_text(readme(board, title))
     return path

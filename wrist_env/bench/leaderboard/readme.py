@@ -105,7 +105,8 @@ def ranking_section(ranking: Ranking, n_problems: int) -> list[str]:
             "calibrator's name hangs from its mean rank; the segment marked CD above the axis is the critical "
             "difference, and a thick bar joins calibrators whose mean ranks lie within it of each other — the "
             "data cannot separate them. The title gives Friedman's p: when it is above α the diagram is drawn "
-            "anyway but no difference in it is a finding.",
+            "anyway but no difference in it is a finding. `autorank`'s own report of the analysis (its normality "
+            "and homogeneity checks, medians and mean ranks): `ranking_report.txt`.",
             "",
         ]
     return lines
