@@ -37,6 +37,9 @@ LEADERBOARD_FILES = (
     "dof_improved.csv",
     "runs.csv",
     "targets.csv",
+    "best_relative.csv",
+    "recovery_pooled.csv",
+    "ranking.csv",
     "ecdf.png",
     "convergence.png",
 )
@@ -375,10 +378,13 @@ def test_a_calibration_on_instance_1_scores_against_instance_1(p1_instance_1, tm
     assert rows.cost[0] == pytest.approx(on_1, rel=1e-9) and abs(on_1 - on_0) > 1e-3
     assert summary["validate"]["cost"] == pytest.approx(task("P1", "validate", instance=1).evaluate(calibrated).cost)
     assert summary["provenance"] == provenance.of_participant("P1", 1) != provenance.of_participant("P1", 0)
-    # the leaderboard: a column per problem, each with its own references
+    # the leaderboard: a row per problem in the CSVs, each with its own references; pooled per participant
     write_leaderboard(runs, tmp_path / "lb")
     best = pd.read_csv(tmp_path / "lb" / "best_cost.csv")
-    assert best.participant.tolist() == ["P1", "P1.i1"] and best.runs.tolist() == [1, 1]
+    assert best.participant.tolist() == ["P1", "P1"] and best.instance.tolist() == [0, 1]
+    assert best.problem.tolist() == ["P1", "P1.i1"] and best.runs.tolist() == [1, 1]
+    pooled = pd.read_csv(tmp_path / "lb" / "evals_to_target.csv")
+    assert set(pooled.participant) == {"P1"} and (pooled.runs == 2).all() and (pooled.instances == 2).all()
     population = [task("P1", "calibrate", instance=k).evaluate(design.population()).cost for k in (0, 1)]
     np.testing.assert_allclose(best.population, population, rtol=1e-5)  # each problem's own trial
     assert population[0] != population[1]

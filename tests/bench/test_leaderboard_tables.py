@@ -36,6 +36,7 @@ def test_best_cost_counts_runs_whose_calibrated_design_did_not_settle():
     frame = pd.DataFrame(
         {
             "participant": ["P1"] * 5,
+            "problem": ["P1"] * 5,
             "calibrator": ["cmaes"] * 3 + ["random"] * 2,
             "best_cost": [1.0, 1.1, 1.2, 2.0, 2.1],
             "calibrate_unsettled_frames": [0, 3, 1, np.nan, 0],

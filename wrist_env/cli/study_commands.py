@@ -123,9 +123,10 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
 
     s = command(
         "leaderboard",
-        description="Tables (Markdown, CSV) and figures (PNG) from a benchmark run log: best cost "
-        "at the budget, evaluations to cost targets, ECDF and convergence plots, "
-        "parameter recovery, the held-out trial, the preprint's Tables 3-4.",
+        description="Tables (Markdown, CSV) and figures (PNG) from a benchmark run log, per participant "
+        "pooling its instances: best cost at the budget, evaluations to cost targets (ERT with bootstrapped "
+        "90 % intervals), ECDF and convergence plots, the ranking over problems (Friedman test, critical-"
+        "difference diagram), parameter recovery, the held-out trial, the preprint's Tables 3-4.",
     )
     _run_log_arguments(s, out="runs/leaderboard")
     s.add_argument("--title", help="title of the README.md")

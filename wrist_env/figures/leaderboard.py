@@ -1,4 +1,5 @@
-"""The leaderboard's COCO-style figures: convergence (best cost so far) and the ECDF of targets solved."""
+"""The leaderboard's COCO-style figures: convergence (best cost so far) and the ECDF of targets solved, a panel
+per participant pooling its instances; the ranking's critical-difference diagram."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ from collections.abc import Iterable
 import numpy as np
 
 from wrist_env.bench.leaderboard.board import Leaderboard
-from wrist_env.bench.leaderboard.tables import hit, runs_of
+from wrist_env.bench.leaderboard.tables import hit, problem_of, runs_of
 
 _RGBA = tuple[float, float, float, float]
 
@@ -47,13 +48,21 @@ def _panels(n: int, ncols: int, height: float, **kwargs):
     return fig, axes
 
 
-def _run_curves(board: Leaderboard, participant: str, label: str) -> list:
-    """The best-so-far cost curves of one participant's runs with one calibrator (label), in the runs' order."""
-    keys = [
-        (r.participant, r.optimizer, r.seed, r.budget)
-        for r in runs_of(board.runs_frame, participant, label).itertuples()
-    ]
+def _run_curves(board: Leaderboard, problem: str, label: str) -> list:
+    """The best-so-far cost curves of one problem's runs with one calibrator (label), in the runs' order."""
+    keys = [(r.problem, r.optimizer, r.seed, r.budget) for r in runs_of(board.runs_frame, problem, label).itertuples()]
     return [board.curves[k] for k in keys if k in board.curves]
+
+
+def _problems(board: Leaderboard, participant: str) -> list:
+    """The problems (instances) of one participant, in the board's order."""
+    return [q for q in board.participants if problem_of(q)[0] == participant]
+
+
+def _scale(ref) -> float:
+    """What a problem's costs are divided by to pool instances: its hidden truth's cost (the population's
+    without a truth)."""
+    return (ref.truth if ref.truth is not None else ref.population)["calibrate"]["cost"]
 
 
 def _save(fig, axes, path: str | os.PathLike, ylabel: str, legend_columns: int) -> None:
@@ -76,14 +85,16 @@ def _save(fig, axes, path: str | os.PathLike, ylabel: str, legend_columns: int) 
 
 
 def convergence_figure(path: str | os.PathLike, board: Leaderboard, colors: dict[str, _RGBA]) -> None:
-    """Best cost so far against evaluations: median and IQR band per calibrator, a panel per participant."""
-    refs, participants = board.refs, board.participants
-    n = len(participants)
+    """Best cost so far relative to the hidden truth's cost against evaluations: median and IQR band over
+    all runs (instances × seeds) per calibrator, a panel per participant (each run divided by its own
+    instance's truth cost, so instances pool)."""
+    refs, subjects = board.refs, board.subjects
+    n = len(subjects)
     fig, axes = _panels(n, min(n, 3), 4.0)
-    for ax, p in zip(axes.flat, participants):
-        lows = []
+    for ax, p in zip(axes.flat, subjects):
+        problems, lows, runs = _problems(board, p), [], set()
         for label in board.labels:
-            cs = _run_curves(board, p, label)
+            cs = [c / _scale(refs[q]) for q in problems for c in _run_curves(board, q, label)]
             if not cs:
                 continue
             length = max(len(c) for c in cs)
@@ -91,21 +102,24 @@ def convergence_figure(path: str | os.PathLike, board: Leaderboard, colors: dict
             x = np.arange(1, length + 1)
             q25, med, q75 = np.quantile(stack, [0.25, 0.5, 0.75], axis=0)
             lows.append(float(q25.min()))
-            ax.plot(x, med, color=colors[label], lw=1.8, label=f"{label} ({len(cs)} run{'s' if len(cs) > 1 else ''})")
+            ax.plot(x, med, color=colors[label], lw=1.8, label=label)
+            runs.add(len(cs))
             ax.fill_between(x, q25, q75, color=colors[label], alpha=0.18, lw=0)
-        pop = refs[p].population["calibrate"]["cost"]
-        _reference_line(ax, pop, "population", "0.35", "--", right=True)
-        if refs[p].truth is not None:
-            _reference_line(ax, refs[p].truth["calibrate"]["cost"], "hidden truth", "0.1", ":", right=False)
+        pop = float(np.median([refs[q].population["calibrate"]["cost"] / _scale(refs[q]) for q in problems]))
+        _reference_line(ax, pop, "population (median)", "0.35", "--", right=True)
+        truths = all(refs[q].truth is not None for q in problems)
+        if truths:
+            _reference_line(ax, 1.0, "hidden truth", "0.1", ":", right=False)
         ax.set_yscale("log")
-        low = min([refs[p].truth["calibrate"]["cost"] if refs[p].truth is not None else np.inf] + lows) * 0.85
-        ax.set_ylim(low, 1.6 * pop)  # failed runs (cost 1000) would squash the interesting range
+        ax.set_ylim(min([1.0 if truths else np.inf] + lows) * 0.85, 1.6 * pop)  # failed runs (cost 1000) squash it
         _plain_log_ticks(ax.yaxis, subs=(1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 7.0))
-        ax.set_title(f"{p}: calibration trial")
+        k = len(problems)
+        count = f"{max(runs)}" if len(runs) == 1 else f"≤ {max(runs, default=0)}"
+        ax.set_title(f"{p}: {k} instance{'s' if k > 1 else ''}, {count} runs per calibrator")
         ax.set_xlabel("evaluations")
         ax.grid(True, which="both", alpha=0.25)
         ax.set_xlim(1, max(board.budgets))
-    _save(fig, axes, path, "best cost so far (median, IQR band over seeds)", 4)
+    _save(fig, axes, path, "calibration trial: best cost so far / hidden\ntruth's cost (median, IQR band over runs)", 4)
 
 
 def _plain_log_ticks(axis, subs=(1.0, 2.0, 5.0)) -> None:
@@ -118,9 +132,12 @@ def _plain_log_ticks(axis, subs=(1.0, 2.0, 5.0)) -> None:
 
 
 def ecdf_figure(path: str | os.PathLike, board: Leaderboard, colors: dict[str, _RGBA]) -> None:
-    """COCO-style ECDF of (run, target) pairs solved against evaluations (`tables.ECDF_TARGETS` per participant)."""
+    """COCO-style ECDF of (run, target) pairs solved against evaluations (`tables.ECDF_TARGETS` per problem,
+    each instance's its own): a panel of all problems, then one per participant pooling its instances."""
     targets, participants = board.ecdf_targets, board.participants
-    groups = [("all participants", participants)] + ([(p, [p]) for p in participants] if len(participants) > 1 else [])
+    groups = [("all problems", participants)]
+    if len(board.subjects) > 1:
+        groups += [(p, _problems(board, p)) for p in board.subjects]
     n = len(groups)
     fig, axes = _panels(n, n if n <= 3 else 2 if n == 4 else 3, 3.9, sharey=True)
     top = max(board.budgets)
@@ -130,7 +147,7 @@ def ecdf_figure(path: str | os.PathLike, board: Leaderboard, colors: dict[str, _
         for label in board.labels:
             hits, pairs = [], 0
             for p in members:
-                ts = targets[targets.participant == p]
+                ts = targets[targets.problem == p]
                 for curve in _run_curves(board, p, label):
                     for t in ts.itertuples():
                         pairs += 1
@@ -139,7 +156,7 @@ def ecdf_figure(path: str | os.PathLike, board: Leaderboard, colors: dict[str, _
                             hits.append(h)
             if not pairs:
                 continue
-            n_targets = max(n_targets, len(targets[targets.participant.isin(members)]))
+            n_targets = max(n_targets, len(targets[targets.problem.isin(members)]))
             hits = np.sort(np.array(hits))
             frac = np.searchsorted(hits, grid, side="right") / pairs
             ax.step(grid, frac, where="post", color=colors[label], lw=1.8, label=label)
@@ -153,3 +170,21 @@ def ecdf_figure(path: str | os.PathLike, board: Leaderboard, colors: dict[str, _
     for row in axes:
         row[0].tick_params(labelleft=True)
     _save(fig, axes, path, "fraction of (run, target) pairs solved", 5)
+
+
+def ranking_figure(path: str | os.PathLike, result, title: str) -> None:
+    """The critical-difference diagram of a ranking (`autorank.plot_stats` of its `RankResult`, drawn even when
+    Friedman's test does not reject: the title says so): mean ranks on the axis, bars joining calibrators the
+    Nemenyi test cannot separate."""
+    import warnings
+
+    import autorank
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7.5, 0.6 + 0.32 * len(result.rankdf)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        autorank.plot_stats(result, allow_insignificant=True, ax=ax)
+    ax.set_title(title, fontsize=9)
+    fig.savefig(path, dpi=110, bbox_inches="tight")
+    plt.close(fig)

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 
 from wrist_env.bench.leaderboard.reference import Reference, rmse_array
-from wrist_env.bench.leaderboard.tables import calibrator_label, quantile, runs_of, spread
+from wrist_env.bench.leaderboard.tables import calibrator_label, problem_columns, quantile, runs_of, spread
 from wrist_env.cost import COST_BONES
 from wrist_env.frames import DOF_NAMES, DOF_UNITS
 from wrist_env.motions import TRIAL_MOTIONS
@@ -23,6 +23,8 @@ PREPRINT_SHARE_IMPROVED = {"calibrate": 66.7, "validate": 61.1}
 def recovery(
     runs_frame: pd.DataFrame, summaries: Iterable[dict], participants: Iterable[str], labels: Sequence[str]
 ) -> pd.DataFrame:
+    """Parameter-recovery error per problem (`participants`: the problems' names) and calibrator: median and IQR
+    over seeds of `recovery_z`; `population`: the population design's error on that problem (its baseline)."""
     population = {s["participant"]: s["recovery_z_population"] for s in summaries}
     rows = []
     for p in participants:
@@ -33,13 +35,42 @@ def recovery(
                 continue
             rows.append(
                 {
-                    "participant": p,
+                    **problem_columns(p),
                     "calibrator": label,
                     "runs": len(v),
                     **spread(v),
                     "population": population.get(p),
                 }
             )
+    return pd.DataFrame(rows)
+
+
+def pooled_recovery(runs_frame: pd.DataFrame, summaries: Iterable[dict], labels: Sequence[str]) -> pd.DataFrame:
+    """Parameter-recovery error per participant and calibrator pooled over its instances: median and IQR over all
+    its runs (instances × seeds) of `recovery_z` (z-scores are in Table 2 SD units, the same scale on every
+    instance); `population`: the median over its instances of the population design's error."""
+    baseline = {}
+    for s in summaries:
+        baseline.setdefault(problem_columns(s["participant"])["participant"], {})[s["participant"]] = s[
+            "recovery_z_population"
+        ]
+    rows = []
+    for p in dict.fromkeys(runs_frame.participant):
+        for label in labels:
+            sub = runs_frame[(runs_frame.participant == p) & (runs_frame.calibrator == label)]
+            v = [x for x in sub.recovery_z if x is not None and np.isfinite(x)]
+            if v:
+                pops = [b for b in baseline.get(p, {}).values() if b is not None]
+                rows.append(
+                    {
+                        "participant": p,
+                        "calibrator": label,
+                        "instances": sub.instance.nunique(),
+                        "runs": len(v),
+                        **spread(v),
+                        "population": float(np.median(pops)) if pops else np.nan,
+                    }
+                )
     return pd.DataFrame(rows)
 
 
@@ -55,7 +86,7 @@ def heldout(
             val = rmse_array(score["validate"]["rmse"])
             rows.append(
                 {
-                    "participant": p,
+                    **problem_columns(p),
                     "calibrator": name,
                     "runs": 0,
                     "cost_median": score["validate"]["cost"],
@@ -73,7 +104,7 @@ def heldout(
             v = sub.validate_cost.to_numpy()
             rows.append(
                 {
-                    "participant": p,
+                    **problem_columns(p),
                     "calibrator": label,
                     "runs": len(v),
                     **spread(v, "cost_"),
@@ -110,7 +141,7 @@ def rmse_table(
         for b, bone in enumerate(COST_BONES):
             for material, rmse, run in materials:
                 a = rmse_array(rmse)
-                row = {"participant": p, "bone": bone.capitalize(), "material": material}
+                row = {**problem_columns(p), "bone": bone.capitalize(), "material": material}
                 row.update({f"{dof} ({unit})": a[b, d] for d, (dof, unit) in enumerate(zip(DOF_NAMES, DOF_UNITS))})
                 row["run"] = run
                 rows.append(row)

@@ -8,8 +8,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from wrist_env.bench.leaderboard.accuracy import best_runs, dof_improved, heldout, recovery, rmse_table
+from wrist_env.bench.leaderboard.accuracy import best_runs, dof_improved, heldout, pooled_recovery, recovery, rmse_table
 from wrist_env.bench.leaderboard.reference import Reference, reference
+from wrist_env.bench.leaderboard.statistics import Ranking, rank
 from wrist_env.bench.leaderboard.tables import (
     _runs_frame,
     _targets,
@@ -20,6 +21,7 @@ from wrist_env.bench.leaderboard.tables import (
     ecdf_targets,
     evals_to_target,
     load_runs,
+    pooled_best_cost,
     problem_label,
     unsettled_shares,
 )
@@ -30,12 +32,16 @@ from wrist_env.runs import provenance
 
 @dataclass(frozen=True)
 class Leaderboard:
-    """Everything a leaderboard shows, computed once from a run log (`build`)."""
+    """Everything a leaderboard shows, computed once from a run log (`build`). Per problem (a participant's
+    instance): targets, ecdf_targets, best, recovery, heldout, table3, table4 (columns participant, instance,
+    problem); per participant, pooled over its instances: best_pooled, ert, recovery_pooled; over all
+    problems: ranking."""
 
     runs: str
     summaries: list
     unfinished: int
     participants: list  # the problems: the participant, "<participant>.i<k>" for instance k ≥ 1
+    subjects: list  # the participants (the functions whose instances the problems are), in the problems' order
     labels: list
     budgets: set
     refs: dict
@@ -51,12 +57,16 @@ class Leaderboard:
     table3: pd.DataFrame
     table4: pd.DataFrame
     improved: pd.DataFrame
+    best_pooled: pd.DataFrame
+    recovery_pooled: pd.DataFrame
+    ranking: Ranking
 
 
 def build(runs: str | Path, references: dict[str, Reference] | None = None) -> Leaderboard:
-    """The leaderboard of the finished cells of the run log in `runs`, a column (or panel) per problem
-    (`tables.by_problem`: the participant for instance 0, "P1.i3" for instance 3; `references`:
-    {problem: `Reference`} already simulated; the others are simulated here)."""
+    """The leaderboard of the finished cells of the run log in `runs`: tables per problem (`tables.by_problem`:
+    named by the participant for instance 0, "P1.i3" for instance 3), per participant pooled over its
+    instances, and the ranking over problems (`references`: {problem: `Reference`} already simulated; the
+    others are simulated here)."""
     evals, summaries, unfinished = load_runs(runs)
     if not summaries:
         raise StoreError(f"{runs}: no finished benchmark cell in this run log")
@@ -74,13 +84,15 @@ def build(runs: str | Path, references: dict[str, Reference] | None = None) -> L
             refs[name] = reference(p, k)
     by_key = curves(evals)
     targets = _targets(participants, refs)
-    runs_frame = _runs_frame(summaries, by_key, targets, budgets, unsettled_shares(evals))
+    runs_frame = _runs_frame(summaries, by_key, targets, budgets, unsettled_shares(evals), refs)
     chosen = best_runs(summaries)
+    subjects = list(dict.fromkeys(p for p, _ in problems))
     return Leaderboard(
         str(runs),
         summaries,
         unfinished,
         participants,
+        subjects,
         labels,
         budgets,
         refs,
@@ -89,31 +101,40 @@ def build(runs: str | Path, references: dict[str, Reference] | None = None) -> L
         ecdf_targets(participants, refs, by_key),
         runs_frame,
         best_cost(runs_frame, refs, participants, labels),
-        evals_to_target(runs_frame, targets, participants, labels, by_key),
+        evals_to_target(runs_frame, targets, subjects, labels),
         recovery(runs_frame, summaries, participants, labels),
         heldout(runs_frame, refs, participants, labels),
         chosen,
         rmse_table(chosen, refs, participants, "calibrate"),
         rmse_table(chosen, refs, participants, "validate"),
         dof_improved(summaries, chosen, refs, participants, labels, budgets),
+        pooled_best_cost(runs_frame, labels),
+        pooled_recovery(runs_frame, summaries, labels),
+        rank(runs_frame, labels),
     )
 
 
 CSV_FILES = {
     "best_cost.csv": ("best", "%.6g"),
+    "best_relative.csv": ("best_pooled", "%.6g"),
     "targets.csv": ("targets", "%.6g"),
     "ecdf_targets.csv": ("ecdf_targets", "%.6g"),
     "evals_to_target.csv": ("ert", "%.6g"),
     "recovery.csv": ("recovery", "%.6g"),
+    "recovery_pooled.csv": ("recovery_pooled", "%.6g"),
     "heldout.csv": ("heldout", "%.6g"),
     "table3_rmse_calibrate.csv": ("table3", "%.4g"),
     "table4_rmse_validate.csv": ("table4", "%.4g"),
     "dof_improved.csv": ("improved", "%.4g"),
     "runs.csv": ("runs_frame", "%.6g"),
+    "ranking.csv": ("ranking.table", "%.6g"),
 }
 """The CSV files of a leaderboard: {file name: (Leaderboard field, float format)}."""
 
 
 def write_csvs(board: Leaderboard, out: Path) -> None:
     for name, (field, float_format) in CSV_FILES.items():
-        getattr(board, field).to_csv(out / name, index=False, float_format=float_format)
+        frame = board
+        for part in field.split("."):
+            frame = getattr(frame, part)
+        frame.to_csv(out / name, index=False, float_format=float_format)

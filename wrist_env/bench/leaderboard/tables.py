@@ -12,6 +12,7 @@ import pandas as pd
 from numpy.typing import ArrayLike
 
 from wrist_env.bench.leaderboard.reference import Reference, rmse_array
+from wrist_env.bench.leaderboard.statistics import ert, ert_interval
 from wrist_env.bench.log import RunLog, key_of, summary_instance
 
 TARGETS = (("pop×0.75", "population", 0.75), ("pop×0.5", "population", 0.5), ("truth×1.1", "truth", 1.1))
@@ -34,9 +35,9 @@ def quantile(values: Iterable[float | None], q: float) -> float:
     return float(np.quantile(values, q)) if len(values) else np.nan
 
 
-def runs_of(runs_frame: pd.DataFrame, participant: str, calibrator: str) -> pd.DataFrame:
-    """The rows of `runs_frame` (one per run) of one participant and calibrator label."""
-    return runs_frame[(runs_frame.participant == participant) & (runs_frame.calibrator == calibrator)]
+def runs_of(runs_frame: pd.DataFrame, problem: str, calibrator: str) -> pd.DataFrame:
+    """The rows of `runs_frame` (one per run) of one problem (`problem_label`) and calibrator label."""
+    return runs_frame[(runs_frame.problem == problem) & (runs_frame.calibrator == calibrator)]
 
 
 def calibrator_label(optimizer: str, budget: int, budgets: set) -> str:
@@ -47,6 +48,18 @@ def problem_label(participant: str, instance: int) -> str:
     """The name a leaderboard gives a problem: the participant's for instance 0 (as before instances), else
     "<participant>.i<instance>" (as in the cell names, `RunKey.name`)."""
     return participant if instance == 0 else f"{participant}.i{instance}"
+
+
+def problem_of(problem: str) -> tuple[str, int]:
+    """(participant, instance) of a problem's name (`problem_label`'s inverse)."""
+    head, dot, tail = problem.rpartition(".i")
+    return (head, int(tail)) if dot and tail.isdigit() else (problem, 0)
+
+
+def problem_columns(problem: str) -> dict:
+    """The columns naming a problem in a per-problem table: participant, instance and problem (its label)."""
+    participant, instance = problem_of(problem)
+    return {"participant": participant, "instance": instance, "problem": problem}
 
 
 def load_runs(runs: str | Path) -> tuple[pd.DataFrame, list[dict], int]:
@@ -117,7 +130,7 @@ def best_cost(
             unsettled = sub.calibrate_unsettled_frames.to_numpy(dtype=float)
             rows.append(
                 {
-                    "participant": p,
+                    **problem_columns(p),
                     "calibrator": label,
                     "runs": len(v),
                     **spread(v),
@@ -134,39 +147,66 @@ def best_cost(
     return pd.DataFrame(rows)
 
 
-def evals_to_target(
-    runs_frame: pd.DataFrame,
-    targets: pd.DataFrame,
-    participants: Sequence[str],
-    labels: Sequence[str],
-    curves: dict[tuple[str, str, int, int], np.ndarray],
-) -> pd.DataFrame:
-    """COCO's expected running time: evaluations spent over all runs (nfev for an unsolved run,
-    the hitting count for a solved one) divided by the number of solved runs."""
+def pooled_best_cost(runs_frame: pd.DataFrame, labels: Sequence[str]) -> pd.DataFrame:
+    """The best cost at the budget per participant and calibrator pooled over its instances, as the scale-free
+    `relative_cost` (best / the instance's hidden-truth cost): median and IQR over all its runs (instances ×
+    seeds); `population`: the median over its instances of the population design's cost relative to the truth."""
     rows = []
-    for t in targets.itertuples():
+    for p in dict.fromkeys(runs_frame.participant):
+        mine = runs_frame[runs_frame.participant == p]
+        per_problem = mine.groupby("problem", sort=False)[["population_cost", "truth_cost"]].first()
+        population = quantile(per_problem.population_cost / per_problem.truth_cost, 0.5)
         for label in labels:
-            sub = runs_of(runs_frame, t.participant, label)
-            if sub.empty:
-                continue
-            hits = [
-                hit(curves.get((r.participant, r.optimizer, r.seed, r.budget), np.array([r.best_cost])), t.value)
-                for r in sub.itertuples()
-            ]
-            solved = [h for h in hits if h is not None]
-            spent = sum(h if h is not None else r.nfev for h, r in zip(hits, sub.itertuples()))
-            rows.append(
-                {
-                    "participant": t.participant,
-                    "target": t.target,
-                    "target_value": t.value,
-                    "calibrator": label,
-                    "solved": len(solved),
-                    "runs": len(hits),
-                    "ert": spent / len(solved) if solved else np.inf,
-                    "median_evals_solved": float(np.median(solved)) if solved else np.nan,
-                }
-            )
+            sub = mine[mine.calibrator == label]
+            if not sub.empty:
+                rows.append(
+                    {
+                        "participant": p,
+                        "calibrator": label,
+                        "instances": sub.instance.nunique(),
+                        "runs": len(sub),
+                        **spread(sub.relative_cost),
+                        "population": population,
+                    }
+                )
+    return pd.DataFrame(rows)
+
+
+def evals_to_target(
+    runs_frame: pd.DataFrame, targets: pd.DataFrame, participants: Sequence[str], labels: Sequence[str]
+) -> pd.DataFrame:
+    """COCO's expected running time (`statistics.ert`) per participant, target and calibrator over all the
+    participant's runs — its instances × seeds, each instance's target its own (`targets`, per problem) —
+    with the bootstrapped 90 % interval (`statistics.ert_interval`); `instances`: how many were pooled."""
+    rows = []
+    for p in participants:
+        mine = targets[targets.problem.isin(runs_frame.problem[runs_frame.participant == p])]
+        for name in dict.fromkeys(mine.target):
+            problems = set(mine.problem[mine.target == name])
+            for label in labels:
+                sub = runs_frame[
+                    (runs_frame.participant == p) & (runs_frame.calibrator == label) & runs_frame.problem.isin(problems)
+                ]
+                if sub.empty:
+                    continue
+                hits = sub[f"evals_to_{name}"].to_numpy(dtype=np.float64)  # NaN: never reached
+                solved = np.isfinite(hits)
+                spent = np.where(solved, hits, sub.nfev.to_numpy(dtype=np.float64))
+                low, high = ert_interval(spent, solved)
+                rows.append(
+                    {
+                        "participant": p,
+                        "target": name,
+                        "calibrator": label,
+                        "instances": sub.instance.nunique(),
+                        "solved": int(solved.sum()),
+                        "runs": len(sub),
+                        "ert": ert(spent, solved),
+                        "ert_low": low,
+                        "ert_high": high,
+                        "median_evals_solved": float(np.median(hits[solved])) if solved.any() else np.nan,
+                    }
+                )
     return pd.DataFrame(rows)
 
 
@@ -179,7 +219,7 @@ def _targets(participants, refs) -> pd.DataFrame:
             if score is not None:
                 rows.append(
                     {
-                        "participant": p,
+                        **problem_columns(p),
                         "target": name,
                         "reference": base,
                         "factor": factor,
@@ -191,7 +231,8 @@ def _targets(participants, refs) -> pd.DataFrame:
 
 
 def ecdf_targets(participants: Iterable[str], refs: dict[str, Reference], curves_by_key: dict) -> pd.DataFrame:
-    """`ECDF_TARGETS` log-spaced cost targets per participant (see `ECDF_TARGETS`): participant, k, value."""
+    """`ECDF_TARGETS` log-spaced cost targets per problem (see `ECDF_TARGETS`): participant, instance, problem,
+    k, value; `participants`: the problems' names."""
     rows = []
     for p in participants:
         ends = [float(np.min(c)) for key, c in curves_by_key.items() if key[0] == p and len(c)]
@@ -201,26 +242,32 @@ def ecdf_targets(participants: Iterable[str], refs: dict[str, Reference], curves
         best = min(ends)
         for k in range(ECDF_TARGETS):
             precision = 10.0 ** (-ECDF_DECADES * k / (ECDF_TARGETS - 1))
-            rows.append({"participant": p, "k": k, "value": best + (start - best) * precision})
-    return pd.DataFrame(rows, columns=["participant", "k", "value"])
+            rows.append({**problem_columns(p), "k": k, "value": best + (start - best) * precision})
+    return pd.DataFrame(rows, columns=["participant", "instance", "problem", "k", "value"])
 
 
-def _runs_frame(summaries, curves_by_key, targets, budgets, unsettled_by_key) -> pd.DataFrame:
-    """One row per run: its key, costs, recovery, held-out RMSE and evaluations to each target;
-    unsettled_by_key: `unsettled_shares` of the run log."""
+def _runs_frame(summaries, curves_by_key, targets, budgets, unsettled_by_key, refs) -> pd.DataFrame:
+    """One row per run: its key (participant, instance and the problem's name), costs — `relative_cost` the
+    best cost over the problem's hidden-truth cost (NaN without a truth), the scale-free quantity that pools
+    over instances —, recovery, held-out RMSE and evaluations to each target; unsettled_by_key:
+    `unsettled_shares` of the run log; refs: {problem: `Reference`}."""
     rows = []
     for s in summaries:
         key = (s["participant"], s["optimizer"], s["seed"], s["budget"])
         curve = curves_by_key.get(key, np.array([s["best_cost"]]))
+        truth = refs[s["participant"]].truth
+        truth_cost = truth["calibrate"]["cost"] if truth is not None else np.nan
         row = {
-            "participant": s["participant"],
-            "instance": summary_instance(s),
+            **problem_columns(s["participant"]),
             "calibrator": calibrator_label(s["optimizer"], s["budget"], budgets),
             "optimizer": s["optimizer"],
             "seed": s["seed"],
             "budget": s["budget"],
             "nfev": s["nfev"],
             "best_cost": s["best_cost"],
+            "population_cost": refs[s["participant"]].population["calibrate"]["cost"],
+            "truth_cost": truth_cost,
+            "relative_cost": s["best_cost"] / truth_cost,
             "best_eval": s["best_eval"],
             "calibrate_cost": s["calibrate"]["cost"],
             # NaN in summaries logged before it was recorded; a failed design counts none
@@ -235,7 +282,7 @@ def _runs_frame(summaries, curves_by_key, targets, budgets, unsettled_by_key) ->
         val = rmse_array(s["validate"]["rmse"])
         row["validate_rmse_translation_mm"] = float(np.nanmean(val[:, :3])) if np.isfinite(val).any() else np.nan
         row["validate_rmse_rotation_deg"] = float(np.nanmean(val[:, 3:])) if np.isfinite(val).any() else np.nan
-        for t in targets[targets.participant == s["participant"]].itertuples():
+        for t in targets[targets.problem == s["participant"]].itertuples():
             row[f"evals_to_{t.target}"] = hit(curve, t.value)
         rows.append(row)
     return pd.DataFrame(rows)
