@@ -1,6 +1,7 @@
 """The checks as a table (`validation.chain.CHECKS`): every row complete, the committed records in its order,
 and the chain's handling of failed runs; fast (no simulation; `tests/test_validation.py` runs the checks)."""
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -9,6 +10,7 @@ import pytest
 
 from wrist_env import validation
 from wrist_env.validation import CHECKS, LOAD_MODES, CheckSpec, run_chain
+from wrist_env.validation.simulations import RUNS, Simulations
 
 RECORDS = Path(__file__).resolve().parents[2] / "experiments" / "figures"
 WORDS = {"neutral": "100 N (the jig)", "ulnar_variance": ", ulnar variance +0.26 mm"}
@@ -16,6 +18,8 @@ WORDS = {"neutral": "100 N (the jig)", "ulnar_variance": ", ulnar variance +0.26
 
 def test_every_check_has_a_unique_id_a_band_a_unit_a_source_and_a_load_mode():
     ids = [c.id for c in CHECKS]
+    fields = {f.name for f in dataclasses.fields(Simulations)}
+    assert set(RUNS) == set(LOAD_MODES) and all(set(runs) <= fields for runs in RUNS.values()), RUNS
     assert len(ids) == len(set(ids)), ids
     for c in CHECKS:
         low, high = c.band
@@ -69,3 +73,17 @@ def test_a_check_names_a_known_load_mode_and_a_band_that_runs_upwards():
     with pytest.raises(ValueError, match="runs backwards"):
         CheckSpec("x", "x", (2.0, 1.0), "mm", "src", "sweep", lambda s: 0.0)
     assert validation.SOURCES == {c.id: c.source for c in CHECKS}
+
+
+def test_a_load_mode_fails_with_the_first_of_its_runs_that_failed():
+    """As `validate` said before the chain: the torn sweep's check names the intact sweep's failure first."""
+    from types import SimpleNamespace
+
+    ran, nan = SimpleNamespace(ok=True, message="ok"), SimpleNamespace(ok=False, message="failed: NaN in the state")
+    arrays = dict(flexion_deg=None, sl_gap_intact_mm=None, sl_gap_torn_mm=None, slil_force_n=None, shares_pct={})
+    torn_only = Simulations(None, ran, nan, ran, "jig", **arrays)
+    assert torn_only.failure("sweep") is None and torn_only.failure("jig") is None
+    assert torn_only.failure("torn sweep") == "SLIL-torn sweep run failed: NaN in the state"
+    both = Simulations(None, nan, nan, nan, "jig", **arrays)
+    assert both.failure("torn sweep") == "intact sweep run failed: NaN in the state"
+    assert both.failure("jig") == "neutral run failed: NaN in the state"

@@ -3,7 +3,7 @@ of the runs it reads and the pure function of the shared runs (`simulations.Simu
 
 `validate` simulates once and runs the chain (`run_chain`) in the table's order, which is the record's and the
 printed table's. A check is added by a function here and a row in `CHECKS` (docs/validation.md, "The checks
-as a table"); `tests/validation/test_chain.py` holds every row to a band, a unit, a source and a load mode.
+are a table"); `tests/validation/test_chain.py` holds every row to a band, a unit, a source and a load mode.
 """
 
 from __future__ import annotations
@@ -17,24 +17,13 @@ import numpy as np
 from wrist_env.model import MIDCARPAL
 from wrist_env.validation.bands import (
     EXTENSION_30_DEG,
-    NEUTRAL_LOAD_N,
     SL_DISSOCIATION_MM,
     ULNAR_SHARE_PCT,
     VIEGAS_1993,
 )
 from wrist_env.validation.measures import at_angle, column_rotation_deg, hamate_rotation_deg, slope
 from wrist_env.validation.report import Check
-from wrist_env.validation.simulations import RL, RS, Simulations
-
-LOAD_MODES = {
-    "sweep": "the idealized +-40 deg flexion-extension sweep, intact, under the sweeps' load (`validate(load_n=..., "
-    "load_direction=...)`; by default `drivers.IDEALIZED_LOAD_N` along `settings.DEFAULT_LOADS`)",
-    "torn sweep": "the same sweep intact and with all three SLIL bundles torn (one batched call)",
-    "jig": f"the capitate held at neutral under {NEUTRAL_LOAD_N:g} N, the hand loaded axially as in the jigs of "
-    "Palmer & Werner 1984, Tencer 1988, Hara 1992 and Viegas 1993 (`anatomy.jig`; `validate(neutral_load=...)` "
-    "loads it otherwise)",
-}
-"""The runs a check reads (`Simulations.failure`: which must have run for it to be measured)."""
+from wrist_env.validation.simulations import LOAD_MODES, RL, RS, Simulations
 
 
 @dataclass(frozen=True)
@@ -43,8 +32,9 @@ class CheckSpec:
 
     description: what the value is, as the record and the table say it; "{neutral}" and "{ulnar_variance}"
         are filled in from the runs (`Simulations.words`). band: (low, high), low <= value <= high passes
-        (inf: unbounded). load: a key of `LOAD_MODES`. value: the measure, a pure function of the runs;
-        not called when they failed (the check then fails, NaN, with the solver's status).
+        (inf: unbounded). load: a key of `simulations.LOAD_MODES`, the runs it reads. value: the measure, a
+        pure function of the runs; not called when they failed (the check then fails, NaN, with the
+        solver's status).
     """
 
     id: str

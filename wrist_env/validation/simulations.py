@@ -20,6 +20,18 @@ from wrist_env.validation.measures import load_shares_pct, sl_gap_mm, with_tears
 
 RS, RL = PAIRS.index("radioscaphoid"), PAIRS.index("radiolunate")
 
+LOAD_MODES = {
+    "sweep": "the idealized +-40 deg flexion-extension sweep, intact, under the sweeps' load (`validate(load_n=..., "
+    "load_direction=...)`; by default `drivers.IDEALIZED_LOAD_N` along `settings.DEFAULT_LOADS`)",
+    "torn sweep": "the same sweep intact and with all three SLIL bundles torn (one batched call)",
+    "jig": f"the capitate held at neutral under {NEUTRAL_LOAD_N:g} N, the hand loaded axially as in the jigs of "
+    "Palmer & Werner 1984, Tencer 1988, Hara 1992 and Viegas 1993 (`anatomy.jig`; `validate(neutral_load=...)` "
+    "loads it otherwise)",
+}
+"""The load modes of the checks, in words: which runs a check reads (`RUNS`)."""
+RUNS = {"sweep": ("intact",), "torn sweep": ("intact", "torn"), "jig": ("neutral",)}
+"""The runs (`Simulations` fields) of each load mode: all must have run for its checks to be measured."""
+
 
 @dataclass(frozen=True, eq=False)
 class Simulations:
@@ -46,10 +58,9 @@ class Simulations:
     shares_pct: dict
 
     def failure(self, load: str) -> str | None:
-        """Why the runs of a load mode (`chain.LOAD_MODES`) cannot be measured, or None when they ran."""
-        runs = {"sweep": ("intact",), "torn sweep": ("intact", "torn"), "jig": ("neutral",)}[load]
+        """Why the runs of a load mode (`LOAD_MODES`) cannot be measured (the first that failed), or None."""
         labels = {"intact": "intact sweep", "torn": "SLIL-torn sweep", "neutral": "neutral"}
-        failed = (f"{labels[r]} run {getattr(self, r).message}" for r in runs if not getattr(self, r).ok)
+        failed = (f"{labels[r]} run {getattr(self, r).message}" for r in RUNS[load] if not getattr(self, r).ok)
         return next(failed, None)
 
     @property
