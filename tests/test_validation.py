@@ -103,7 +103,7 @@ def test_cli_validate_json_has_the_fourteen_checks(capsys, built, tmp_path):
     built("P1")
     code = main(["validate", "P1", "--json", "--out", str(tmp_path)])
     out = json.loads(capsys.readouterr().out)
-    assert tuple(c["id"] for c in out["checks"]) == CHECK_IDS
+    assert tuple(c["id"] for c in out["checks"]) == CHECK_IDS == tuple(c.id for c in validation.CHECKS)
     for c in out["checks"]:
         assert len(c["band"]) == 2 and c["band"][0] is not None, c
         assert c["source"] and c["unit"] and isinstance(c["passed"], bool), c

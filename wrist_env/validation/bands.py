@@ -1,4 +1,5 @@
-"""The published bands the model is checked against, and where each comes from."""
+"""The published numbers the checks, their figure and the research scripts share; each check's band and its
+source are a row of `validation.chain.CHECKS`."""
 
 from __future__ import annotations
 
@@ -12,53 +13,3 @@ NEUTRAL_LOAD_N = 100.0  # axial load of the load-share check: Hara 1992 loaded n
 VIEGAS_1993 = {"stt": 23, "sc": 28, "lc": 29, "th": 20}
 """Midcarpal load shares (%), Viegas 1993, in `model.MIDCARPAL` order."""
 ULNAR_SHARE_PCT = (10.0, 25.0)  # Palmer & Werner 1984 (18.4 %), Hara 1992 (15 %)
-
-RAINBOW = (
-    "Rainbow et al. 2013, J Hand Surg Am 38:278-288 (in vivo CT, 12 wrists, extreme loaded flexion and "
-    "extension: {} of the capitate's flexion / extension)"
-)
-SOURCES = {
-    "scaphoid_slope": RAINBOW.format("scaphoid 70 % / 74 %"),
-    "lunate_slope": RAINBOW.format("lunate 46 % / 42 %"),
-    "scaphoid_above_lunate": RAINBOW.format("scaphoid 70-74 % against lunate 42-46 %"),
-    "rs_rl_force_ratio": (
-        "Hara et al. 1992, J Hand Surg Am 17:339-347 (neutral wrist: 50 % of the load through the "
-        "scaphoid fossa, 35 % through the lunate fossa, ratio 1.43); Viegas, Tencer et al. "
-        "(load transfer characteristics of the wrist): scaphoid/lunate fossa contact-area "
-        "ratio 1.47"
-    ),
-    "sl_gap_growth_mm": (
-        "Haug et al. 2021, Arch Orthop Trauma Surg 141:341-347 (8 axially loaded cadaver wrists: "
-        "SL gap 6.6 +- 1.6 mm after SLIL transection); a gap > 3 mm is clinical SL dissociation"
-    ),
-    "rs_mean_pressure_mpa": (
-        "Andreassen et al. preprint, Figure 3 / Table 5 scale (a no-regression band: Table 5's "
-        "normalizer, mean RS pressure 0.65 MPa; cadaveric radiocarpal pressures of a few MPa, "
-        "Hara 1992: peak 2.4 MPa on the scaphoid fossa under 10 kg)"
-    ),
-    **{
-        f"midcarpal_{key}_share_pct": (
-            f"Viegas, Patterson, Todd & McCarty 1993, J Hand Surg Am 18:14-18 (pressure-sensitive film, "
-            f"cadaver wrists loaded axially in neutral: STT 23 %, SC 28 %, LC 29 %, TH 20 % of the midcarpal "
-            f"load; {key.upper()} {pct} %, band +-10 points)"
-        )
-        for key, pct in VIEGAS_1993.items()
-    },
-    "ulnar_share_pct": (
-        "Palmer & Werner 1984, Clin Orthop 187:26-35 (neutral ulnar variance: 18.4 % of the axial load "
-        "through the ulna); Hara et al. 1992, J Hand Surg Am 17:339-347 (TFC 15 %)"
-    ),
-    "column_rotation_deg": (
-        "Akhbari et al. 2019, J Orthop Res 37:2661-2670 (in-vivo CT, the distal row moves as one rigid "
-        "body within 3 deg)"
-    ),
-    "hamate_rotation_deg": (
-        "Akhbari et al. 2019, J Orthop Res 37:2661-2670 (in-vivo CT, the distal row moves as one rigid "
-        "body within 3 deg); the capitohamate joint rotates ~9 deg under 0.5 N m with its ligaments "
-        "intact (Ritt et al. 1996, J Hand Surg Br 21:451)"
-    ),
-    "slil_force_30ext_n": (
-        "Dimitris et al. 2015, J Hand Surg Am 40:1525-1533 (total SLIL force in active wrist "
-        "motion ~20 N, 20.0 +- 3.3 N at 30 deg extension; the preprint's ref. 63)"
-    ),
-}

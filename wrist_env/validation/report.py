@@ -7,8 +7,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from wrist_env.validation.bands import SOURCES
-
 
 @dataclass(frozen=True)
 class Check:
@@ -72,15 +70,6 @@ def _num(x):
 
 def _list(a):
     return [_num(x) for x in np.asarray(a, dtype=np.float64).ravel()]
-
-
-def _row(check_id, description, value, band, unit, failed=None) -> Check:
-    if failed:
-        description = f"{description} [not measured: {failed}]"
-        value = float("nan")
-    value = float(value)
-    passed = math.isfinite(value) and band[0] <= value <= band[1]
-    return Check(check_id, description, value, (float(band[0]), float(band[1])), unit, SOURCES[check_id], passed)
 
 
 def _fmt(x: float) -> str:
