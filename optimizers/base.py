@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from wrist_env.design import SPAN_SD
+from wrist_env.design import SPAN_SD, material_prior
 from wrist_env.errors import InputError
 
 
@@ -165,9 +165,7 @@ def prior_draw(rng: np.random.Generator, lower: np.ndarray, upper: np.ndarray) -
     as `design.sample_materials` draws them, whose ±SPAN_SD SD span the box. On the benchmark's box of 22
     normalized materials, [-1, 1]^22, and a fresh `np.random.default_rng(seed)` it is exactly
     `design.sample_materials(1, seed)[0]`."""
-    from scipy.stats import truncnorm  # here: scipy.stats takes 0.5 s to import
-
-    z = truncnorm.rvs(-SPAN_SD, SPAN_SD, size=(1, len(lower)), random_state=rng)[0]
+    z = material_prior().rvs(size=(1, len(lower)), random_state=rng)[0]
     return 0.5 * (lower + upper) + 0.5 * (upper - lower) * z / SPAN_SD
 
 

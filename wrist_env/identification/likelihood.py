@@ -68,13 +68,6 @@ def in_box(z: ArrayLike) -> np.ndarray:
     return np.all(np.abs(np.asarray(z, dtype=np.float64)) <= BOUND_Z, axis=-1)
 
 
-def material_prior():
-    """One material's prior as a frozen SciPy distribution: N(0, 1) truncated to |z| ≤ 3 (normalized)."""
-    from scipy.stats import truncnorm
-
-    return truncnorm(-BOUND_Z, BOUND_Z)
-
-
 def log_prior(z: ArrayLike) -> np.ndarray:
     """Log density (..., ) of z (..., 22) under the population prior, up to a constant; −inf outside |z| ≤ 3."""
     z = np.asarray(z, dtype=np.float64)

@@ -57,7 +57,7 @@ def prior_refresh(coords: np.ndarray, random) -> tuple[np.ndarray, np.ndarray]:
     n, dim = coords.shape
     rows, which = np.arange(n), random.randint(dim, size=n)
     old = coords[rows, which]
-    new = likelihood.material_prior().rvs(size=n, random_state=random)
+    new = design.material_prior(likelihood.BOUND_Z).rvs(size=n, random_state=random)
     factors = np.where(np.abs(old) <= likelihood.BOUND_Z, 0.5 * (new**2 - old**2), -np.inf)
     out = coords.copy()
     out[rows, which] = new

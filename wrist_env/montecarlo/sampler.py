@@ -38,7 +38,7 @@ import pyarrow as pa
 from numpy.typing import ArrayLike
 
 from wrist_env import design
-from wrist_env.design import INJURABLE, LIGAMENT_NAMES, N_DESIGN, N_MATERIAL, NAMES, SPAN_SD
+from wrist_env.design import INJURABLE, LIGAMENT_NAMES, N_DESIGN, N_MATERIAL, NAMES, SPAN_SD, material_prior
 from wrist_env.errors import DesignError
 from wrist_env.montecarlo.config import EXCLUDE_ABOVE_MPA, TEAR_PROBABILITY
 from wrist_env.participants import registry
@@ -62,8 +62,6 @@ def monte_carlo_from_unit(
     inverse CDF, in action units (z / SPAN_SD). Injury scalars (the last 5): torn
     (`TORN_ACTION`) where u < `tear_probability`, else intact (`INTACT_ACTION`).
     """
-    from scipy.stats import truncnorm
-
     u = np.asarray(u, dtype=np.float64)
     if u.ndim != 2 or u.shape[1] != N_DESIGN:
         raise DesignError(f"unit points must have shape (n, {N_DESIGN}), but got {u.shape}.")
@@ -72,7 +70,7 @@ def monte_carlo_from_unit(
     if not 0.0 <= tear_probability <= 1.0:
         raise DesignError(f"tear_probability must be in [0, 1], but got {tear_probability!r}.")
     a = np.empty_like(u)
-    a[:, :N_MATERIAL] = truncnorm.ppf(u[:, :N_MATERIAL], -truncate_sd, truncate_sd) / SPAN_SD
+    a[:, :N_MATERIAL] = material_prior(truncate_sd).ppf(u[:, :N_MATERIAL]) / SPAN_SD
     a[:, N_MATERIAL:] = np.where(u[:, N_MATERIAL:] < tear_probability, TORN_ACTION, INTACT_ACTION)
     return np.clip(a, -1.0, 1.0)
 
