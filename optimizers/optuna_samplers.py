@@ -42,30 +42,17 @@ from __future__ import annotations
 
 import importlib.util
 import math
-import os
 import warnings
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from optimizers.base import Optimizer
+from optimizers.optuna_storage import open_storage
 from optimizers.registry import register, unavailable
 
 if TYPE_CHECKING:
     import optuna
-
-
-def _storage(storage):
-    """None (in memory), an Optuna storage or URL as they are; a plain path → a journal file."""
-    import optuna
-
-    if isinstance(storage, (str, os.PathLike)) and "://" not in str(storage):
-        try:
-            from optuna.storages.journal import JournalFileBackend
-        except ImportError:  # Optuna < 4
-            from optuna.storages import JournalFileStorage as JournalFileBackend
-        return optuna.storages.JournalStorage(JournalFileBackend(os.fspath(storage)))
-    return storage
 
 
 class OptunaOptimizer(Optimizer):
@@ -94,7 +81,7 @@ class OptunaOptimizer(Optimizer):
         self.study = optuna.create_study(
             direction="minimize",
             sampler=sampler,
-            storage=_storage(self.options.get("storage")),
+            storage=open_storage(self.options.get("storage")),
             study_name=self.options.get("study_name"),
             load_if_exists=True,
         )

@@ -31,18 +31,19 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 import optimizers
+from optimizers.optuna_storage import open_storage
 from wrist_env import design as design_vars
 from wrist_env.bench.log import X_COLUMNS, RunKey, RunLog
 from wrist_env.cost import COST_BONES
 from wrist_env.design import N_MATERIAL, Design
-from wrist_env.errors import InputError, WristEnvError
+from wrist_env.errors import WristEnvError
 from wrist_env.frames import DOF_NAMES
 from wrist_env.identification.likelihood import map_objective
 from wrist_env.runs import provenance
 from wrist_env.task import task
 
 if TYPE_CHECKING:
-    from optuna.storages import BaseStorage, RDBStorage
+    from optuna.storages import BaseStorage
 
 PRIOR_SUFFIX = "+prior"
 """Appended to a calibrator's name: the same calibrator on the MAP objective (kinematic misfit + prior)."""
@@ -84,44 +85,6 @@ def split_prior(name: str) -> tuple[str, bool]:
 def accepts_storage(cls) -> bool:
     """Whether a calibrator class takes an Optuna `storage` option (its `accepts_storage` attribute)."""
     return bool(getattr(cls, "accepts_storage", False))
-
-
-def open_storage(url: str) -> str | RDBStorage:
-    """An Optuna storage for a URL; SQLite files get WAL journaling and no fsync per commit.
-
-    Each commit of Optuna's SQLite storage is otherwise fsynced, which made a
-    300-trial TPE study ~10× slower than in memory (43 s vs 4 s; CMA-ES 107 s
-    vs 0.8 s) on this machine; with these pragmas 14 s and 19 s. The storage
-    is a convenience copy (Optuna's tools read it): the Parquet log is the
-    record a run resumes from, so a storage lost in a power cut costs nothing.
-
-    Opened here, before any simulation: an `InputError` naming the URL if Optuna cannot open it (not a
-    URL, an unknown database or driver, a SQLite file in a folder that is missing or not writable).
-    """
-    import optuna
-
-    try:
-        if not url.startswith("sqlite:"):
-            return optuna.storages.RDBStorage(url)
-        storage = optuna.storages.RDBStorage(url, engine_kwargs={"connect_args": {"timeout": 120}})
-    except Exception as e:  # noqa: BLE001  (SQLAlchemy's and the drivers' errors share no base class)
-        reason = str(e).strip().splitlines()[0][:200] if str(e).strip() else "no reason given"
-        raise InputError(
-            f"the Optuna storage {url!r} cannot be opened ({type(e).__name__}: {reason}); give a URL such as "
-            "sqlite:///runs/optuna.db (its folder existing and writable), or none (--storage memory) to keep the study "
-            "in memory"
-        ) from None
-    import sqlalchemy
-
-    def pragmas(dbapi_connection, _record):
-        cursor = dbapi_connection.cursor()
-        cursor.execute("PRAGMA journal_mode=WAL")
-        cursor.execute("PRAGMA synchronous=OFF")
-        cursor.close()
-
-    sqlalchemy.event.listen(storage.engine, "connect", pragmas)
-    storage.engine.dispose()  # connections made from now on get the pragmas
-    return storage
 
 
 @dataclass
@@ -244,7 +207,7 @@ def calibrate(
     if storage is not None and accepts_storage(cls):
         import optuna
 
-        storage_obj = open_storage(storage) if isinstance(storage, str) else storage
+        storage_obj = open_storage(storage)
         try:  # the log is the record: rebuild the study by replay
             optuna.delete_study(study_name=key.name, storage=storage_obj)
         except KeyError:

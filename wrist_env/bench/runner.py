@@ -33,7 +33,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import optimizers
-from wrist_env.bench.calibrate import accepts_storage, calibrate, open_storage, split_prior
+from optimizers.optuna_storage import open_storage
+from wrist_env.bench.calibrate import accepts_storage, calibrate, split_prior
 from wrist_env.bench.log import RunKey, RunLog
 from wrist_env.errors import InputError, ParticipantError
 from wrist_env.limits import MAX_INSTANCE, MAX_SEEDS, MAX_THREADS, MAX_WORKERS, check_int, check_unique
