@@ -123,3 +123,113 @@ def test_a_shipped_model_loads_without_the_builder():
         "print(' '.join(m for m in ('wrist_env.builder.pipeline', 'sklearn') if m in sys.modules))"
     )
     assert loaded == "", loaded
+
+
+ROOT = Path(__file__).resolve().parents[1]
+STUDIES = (
+    "wrist_env.bench",
+    "wrist_env.montecarlo",
+    "wrist_env.identification",
+    "wrist_env.validation",
+    "wrist_env.participants",
+    "wrist_env.envs",
+    "wrist_env.cli",
+    "wrist_env.task",
+    "wrist_env.runs",
+    "wrist_env.anatomy",
+    "wrist_env.builder",
+    "wrist_env.solver",
+)
+"""What a figure may not import: the studies, the participants, the environments, the shell, and the floors that
+load, build or simulate a model (anatomy, builder, solver). Everything below them (the vocabulary: `design`,
+`frames`, `cost`, `trial`, `model`, `motions`, `io`, `errors`, `limits`), `wrist_env.figures` itself and
+third-party libraries are allowed."""
+FIGURE_EXCEPTIONS = {"wrist_env.figures.validation": ("wrist_env.validation",)}  # until the validation chain lands
+
+
+def _module_name(path: Path) -> str:
+    parts = path.relative_to(ROOT).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+MODULES = {_module_name(p): p for p in sorted((ROOT / "wrist_env").rglob("*.py"))}
+
+
+def _imported(node: ast.Import | ast.ImportFrom, module: str) -> list[str]:
+    """The project modules an import statement runs: each named module (a `from` name that is a module, else
+    the package it is taken from) and the packages above it."""
+    if isinstance(node, ast.Import):
+        names = [a.name for a in node.names]
+    else:
+        base = node.module or ""
+        if node.level:
+            package = module.split(".")[: -1 if MODULES[module].name != "__init__.py" else None]
+            base = ".".join(package[: len(package) - node.level + 1] + ([base] if base else []))
+        names = [f"{base}.{a.name}" if f"{base}.{a.name}" in MODULES else base for a in node.names]
+    parts = [n.split(".") for n in names if n.split(".")[0] == "wrist_env"]
+    return sorted({".".join(p[:i]) for p in parts for i in range(1, len(p) + 1)} & set(MODULES))
+
+
+def _imports(module: str) -> tuple[set[str], list[tuple[str, int, list[str]]]]:
+    """(the project modules `module` imports when it loads: at top level, outside `if TYPE_CHECKING:`, and its
+    own packages; [(function, line, modules)] of the imports inside its functions)."""
+    top, local = {".".join(module.split(".")[:i]) for i in range(1, module.count(".") + 1)}, []
+
+    def walk(body, function):
+        for node in body:
+            if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
+                continue
+            if isinstance(node, (ast.Import, ast.ImportFrom)):
+                found = _imported(node, module)
+                if function is None:
+                    top.update(found)
+                elif found:
+                    local.append((function, node.lineno, found))
+            inner = node.name if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) else function
+            for field in ("body", "orelse", "finalbody", "handlers"):
+                if isinstance(getattr(node, field, None), list):
+                    walk(getattr(node, field), inner)
+
+    walk(ast.parse(MODULES[module].read_text()).body, None)
+    return top - {module}, local
+
+
+def test_no_figure_imports_a_study():
+    """Pictures take data (issue 56): a module of `wrist_env.figures` imports none of `STUDIES`, at top level or
+    inside a function; what it draws is computed by the study or command that asks for it and handed over as
+    arrays, frames or frozen dataclasses of them. The one exception is named in `FIGURE_EXCEPTIONS`."""
+    found = []
+    for module, path in MODULES.items():
+        if module != "wrist_env.figures" and not module.startswith("wrist_env.figures."):
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, (ast.Import, ast.ImportFrom)):
+                for name in _imported(node, module):
+                    study = next((s for s in STUDIES if name == s or name.startswith(s + ".")), None)
+                    if study and study not in FIGURE_EXCEPTIONS.get(module, ()):
+                        found.append(f"{module}:{node.lineno} imports {name}")
+    assert not found, found
+
+
+def test_no_function_local_import_hides_a_cycle():
+    """A project import inside a function is allowed for lazy loading (Numba, the solver, a command's work), not to
+    hide a cycle: it fails when the module it imports already imports, transitively at top level, the importing
+    module (a package importing its own submodule lazily is not a cycle: the package always loads first)."""
+    graph = {m: _imports(m) for m in MODULES}
+
+    def reach(start: str) -> set[str]:
+        seen, todo = set(), [start]
+        while todo:
+            for m in graph[todo.pop()][0] - seen:
+                seen.add(m)
+                todo.append(m)
+        return seen
+
+    cycles = [
+        f"{module}:{line} ({function}) imports {target}, which imports {module}"
+        for module, (_, local) in graph.items()
+        for function, line, targets in local
+        for target in targets
+        if not target.startswith(module + ".") and target != module and module in reach(target)
+    ]
+    assert not cycles, cycles

@@ -1,6 +1,6 @@
 """The leaderboard's figures from a synthetic board (no simulation): one panel per participant pooling its instances
-(convergence) and per participant plus all problems (ECDF); runs without a curve are left out; the ranking's
-critical-difference diagram."""
+(convergence) and per participant plus all problems (ECDF), computed by `bench.leaderboard.curves`; runs without a
+curve are left out; the ranking's critical-difference diagram."""
 
 from types import SimpleNamespace
 
@@ -8,9 +8,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from wrist_env.bench.leaderboard.curves import convergence_panels, ecdf_panels, problems
 from wrist_env.bench.leaderboard.statistics import rank
 from wrist_env.bench.leaderboard.tables import problem_of
-from wrist_env.figures.leaderboard import _problems, colors, convergence_figure, ecdf_figure, ranking_figure
+from wrist_env.figures.leaderboard import colors, convergence_figure, ecdf_figure, ranking_figure
 
 
 def _board(participants, calibrators=("cmaes", "random"), seeds=(0, 1), budget=30, missing=()):
@@ -46,8 +47,8 @@ def _board(participants, calibrators=("cmaes", "random"), seeds=(0, 1), budget=3
 def test_the_figures_are_written(participants, tmp_path):
     board = _board(participants, missing={("P1", "random", 1)})
     palette = colors(board.labels)
-    convergence_figure(tmp_path / "convergence.png", board, palette)
-    ecdf_figure(tmp_path / "ecdf.png", board, palette)
+    convergence_figure(tmp_path / "convergence.png", convergence_panels(board), palette, max(board.budgets))
+    ecdf_figure(tmp_path / "ecdf.png", ecdf_panels(board), palette, max(board.budgets))
     for name in ("convergence.png", "ecdf.png"):
         assert (tmp_path / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and (tmp_path / name).stat().st_size > 10_000
 
@@ -60,7 +61,16 @@ def test_colours_are_distinct_for_21_labels_then_cycle():
 def test_a_participants_panel_pools_its_instances():
     board = _board(("P1", "P1.i1", "P1.i2", "P2", "P2.i1"))
     assert board.subjects == ["P1", "P2"]
-    assert _problems(board, "P1") == ["P1", "P1.i1", "P1.i2"] and _problems(board, "P2") == ["P2", "P2.i1"]
+    assert problems(board, "P1") == ["P1", "P1.i1", "P1.i2"] and problems(board, "P2") == ["P2", "P2.i1"]
+    assert [(p.participant, p.instances) for p in convergence_panels(board)] == [("P1", 3), ("P2", 2)]
+    assert [p.name for p in ecdf_panels(board)] == ["all problems", "P1", "P2"]
+
+
+def test_a_run_without_a_curve_is_left_out_of_the_panels():
+    board = _board(("P1",), missing={("P1", "random", 1)})
+    (convergence,), (ecdf,) = convergence_panels(board), ecdf_panels(board)
+    assert [len(convergence.curves[c]) for c in ("cmaes", "random")] == [2, 1]
+    assert ecdf.solved["random"][1] == 11 and ecdf.targets == 11
 
 
 def test_the_critical_difference_diagram_is_written(tmp_path):

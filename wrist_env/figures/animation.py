@@ -1,7 +1,11 @@
-"""An animated idealized sweep (GIF): bones, ligament fibres coloured by force, radiocarpal pressure."""
+"""An animated idealized sweep (GIF): bones, ligament fibres coloured by force, radiocarpal pressure.
+
+Pictures take data: a `SweepFrames` holds the simulated sweep (`cli.run.figure_data.sweep_frames` simulates
+it); nothing here loads a participant or runs the solver."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import matplotlib.pyplot as plt
@@ -10,16 +14,29 @@ from matplotlib.animation import FuncAnimation, PillowWriter
 from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.colors import to_rgb
 
-from wrist_env import design
 from wrist_env.figures import draw
 from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model
-from wrist_env.participants.registry import load_model
-from wrist_env.solver import drivers
-from wrist_env.solver import simulate as sim
-from wrist_env.solver.outputs import pair_slice, pressure_map
 
 _LIGHT = np.array([0.3, 0.5, 1.0]) / np.linalg.norm([0.3, 0.5, 1.0])  # from the radial side, above
 RADIOCARPAL = ("radioscaphoid", "radiolunate")
+
+
+@dataclass(frozen=True)
+class SweepFrames:
+    """The population design's idealized sweep of a participant's model, as the animation draws it.
+
+    name: the participant; angle_deg (n_frames,): the capitate's angle (deg, flexion +); poses (n_frames,
+    n_bodies, 4, 4): each body's pose (RCS, mm); bundle_force (n_frames, n_ligaments): each ligament
+    bundle's force (N); pressure_mpa (n_frames, n_radiocarpal): the pressure (MPa) of the `RADIOCARPAL`
+    pairs' samples, in `model.sample_points` order, pair after pair; samples: those pairs' slices of
+    `model.sample_points`."""
+
+    name: str
+    angle_deg: np.ndarray
+    poses: np.ndarray
+    bundle_force: np.ndarray
+    pressure_mpa: np.ndarray
+    samples: tuple[slice, ...]
 
 
 def _bone_surfaces(model: Model) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
@@ -50,23 +67,20 @@ def _bone_polygons(surfaces: list, poses_frame: np.ndarray) -> tuple[np.ndarray,
     return np.concatenate(tris)[order], np.concatenate(colours)[order]
 
 
-def animation_figure(name: str, out: Path | None = None, *, n_frames: int = 17, fps: float = 4.0) -> Path:
-    """Write a GIF of the population design's idealized sweep of `name` (radial view): returns its path."""
-    model = load_model(name)
-    driver = drivers.idealized(model, n_frames=n_frames)
-    result = sim.simulate(model, design.population(), driver)
-    if not result.ok:
-        raise RuntimeError(f"{name}: the population design's sweep failed ({result.message})")
+def animation_figure(model: Model, sweep: SweepFrames, out: Path | None = None, *, fps: float = 4.0) -> Path:
+    """Write a GIF of `sweep`, the population design's idealized sweep of `model` (radial view): returns its
+    path."""
+    name, n_frames = sweep.name, len(sweep.angle_deg)
     out = Path(out) if out else draw.FIGURES / f"animation_{name}.gif"
     out.parent.mkdir(parents=True, exist_ok=True)
-    slices = [pair_slice(model, p) for p in RADIOCARPAL]
+    slices = list(sweep.samples)
     radiocarpal = np.r_[tuple(slices)]
     samples = model.sample_points[radiocarpal]
     # the bone each sample lies on: its pair's sample body
     sample_body = np.repeat([PAIR_BONES[PAIRS.index(p)][0] for p in RADIOCARPAL], [s.stop - s.start for s in slices])
-    pressures = [pressure_map(model, result.poses[f])[radiocarpal] for f in range(n_frames)]
+    pressures = list(sweep.pressure_mpa)
     p_max = max(float(np.percentile(p[p > 0], 99)) if (p > 0).any() else 1.0 for p in pressures)
-    f_max = max(float(np.nanmax(result.bundle_force)), 1.0)
+    f_max = max(float(np.nanmax(sweep.bundle_force)), 1.0)
     force_map, pressure_cmap = plt.get_cmap("viridis"), plt.get_cmap("inferno")
     surfaces = _bone_surfaces(model)
 
@@ -87,7 +101,7 @@ def animation_figure(name: str, out: Path | None = None, *, n_frames: int = 17, 
     title = ax.set_title("")
 
     def show(f: int):
-        poses = result.poses[f]
+        poses = sweep.poses[f]
         polygons, colours = _bone_polygons(surfaces, poses)
         bones.set_verts(polygons)
         bones.set_facecolor(colours)
@@ -96,12 +110,12 @@ def animation_figure(name: str, out: Path | None = None, *, n_frames: int = 17, 
         b = np.einsum("nij,nj->ni", poses[model.fibre_bones[:, 1], :3, :3], model.fibre_insertion)
         b += poses[model.fibre_bones[:, 1], :3, 3]
         fibres.set_segments(np.stack([a[:, :2], b[:, :2]], axis=1))
-        fibres.set_array(result.bundle_force[f][model.fibre_ligament])
+        fibres.set_array(sweep.bundle_force[f][model.fibre_ligament])
         world = np.einsum("nij,nj->ni", poses[sample_body, :3, :3], samples) + poses[sample_body, :3, 3]
         on = pressures[f] > 0
         contact.set_offsets(world[on, :2])
         contact.set_array(pressures[f][on])
-        angle = driver.angle_deg[f]
+        angle = sweep.angle_deg[f]
         title.set_text(
             f"{name}, population design, radial view\ncapitate {abs(angle):.0f}° "
             f"{'flexion' if angle >= 0 else 'extension'} (frame {f + 1}/{n_frames})"

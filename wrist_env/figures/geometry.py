@@ -1,4 +1,7 @@
-"""Figures of the model's geometry: bones, cartilage, ligaments (model) and the template's annotations."""
+"""Figures of the model's geometry: bones, cartilage, ligaments (model) and the template's annotations.
+
+Pictures take data: a `Model` and the template's bone surfaces and annotations, loaded by the command
+(`cli.run.figure_data`); nothing here loads a participant or builds the template."""
 
 from __future__ import annotations
 
@@ -9,13 +12,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
-from wrist_env.anatomy.annotations import ARTICULATIONS, template_annotations
-from wrist_env.anatomy.template import load_template
-from wrist_env.builder.params import BuildParams
 from wrist_env.design import ALL_LIGAMENT_NAMES
 from wrist_env.figures import draw
-from wrist_env.model import BONES
-from wrist_env.participants.registry import load_model
+from wrist_env.model import BONES, PAIRS, Model
 
 MODEL_PANELS = (("volar view", 0, 0), ("radial view", 0, 90), ("dorsal view", 0, 180))
 
@@ -32,10 +31,10 @@ def _display_faces(bone: str, vertices, faces, thickness):
     return faces
 
 
-def model_figure(name: str, out: Path | None = None) -> Path:
-    """Bones, cartilage coloured by thickness, ligament fibres and the RSC membrane of a model."""
+def model_figure(model: Model, name: str, out: Path | None = None) -> Path:
+    """Bones, cartilage coloured by thickness, ligament fibres and the RSC membrane of `model`, participant
+    `name`'s."""
 
-    model = load_model(name)
     out = out or draw.FIGURES / f"model_{name}.png"
     norm = matplotlib.colors.Normalize(0.0, 1.1)
     cmap = plt.get_cmap("viridis")
@@ -100,21 +99,25 @@ ANNOTATION_PANELS = (
 
 ARTICULATION_COLOURS = dict(
     zip(
-        ARTICULATIONS,
+        PAIRS,
         ("#f4a6a0", "#9fc3e0", "#b9e3ae", "#d3bde0", "#fdd49e", "#a6dcd0", "#e0c39f", "#c9c9f2")
         + ("#f2c6de", "#c7e9b4", "#fbb4ae", "#b3cde3"),
         strict=False,
     )
 )
-"""One colour per annotated articulation (`annotations.ARTICULATIONS`) of the annotations figure."""
+"""One colour per annotated articulation (`anatomy.annotations.ARTICULATIONS`, the contact `PAIRS`) of the
+annotations figure."""
 
 
-def annotations_figure(out: Path | None = None) -> Path:
-    """The template with its cartilage coverage and ligament attachment sites, for review."""
+def annotations_figure(bones: dict, annotations, out: Path | None = None) -> Path:
+    """The template with its cartilage coverage and ligament attachment sites, for review.
 
-    anatomy = BuildParams().anatomy  # the default build's template: swept fossae, distal row
-    bones = load_template(*anatomy).bones
-    ann = template_annotations(*anatomy)
+    bones: bone name -> its surface (`anatomy.template.BoneSurface`: vertices (n, 3) mm, faces (m, 3), the
+    radius's `solid` vertex indices); annotations: the template's (`anatomy.annotations.Annotations`:
+    `coverage`, articulation -> (bone a, bone b, vertex mask of a, of b); `sites`, ligament -> sites with
+    `bone` and vertex `mask`)."""
+
+    ann = annotations
     out = out or draw.FIGURES / "template_annotations.png"
     art_colours = ARTICULATION_COLOURS
     fig = plt.figure(figsize=(18, 5.6))

@@ -1,17 +1,48 @@
 """The leaderboard's COCO-style figures: convergence (best cost so far) and the ECDF of targets solved, a panel
-per participant pooling its instances; the ranking's critical-difference diagram."""
+per participant pooling its instances; the ranking's critical-difference diagram.
+
+Pictures take data: each panel is a `ConvergencePanel` or an `EcdfPanel` of arrays and labels, computed by the
+leaderboard (`bench.leaderboard.curves`) from its board; nothing here reads a run log or a board."""
 
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
-from wrist_env.bench.leaderboard.board import Leaderboard
-from wrist_env.bench.leaderboard.tables import hit, problem_of, runs_of
-
 _RGBA = tuple[float, float, float, float]
+
+
+@dataclass(frozen=True)
+class ConvergencePanel:
+    """One participant's panel of the convergence figure.
+
+    participant: its name (the panel's title); instances: how many of its problems the panel pools;
+    curves: calibrator label -> the best-so-far cost curves of its runs, each (evaluations,) divided by its
+    instance's hidden-truth cost (the population's without a truth), in the runs' order; labels without a
+    run are absent; population: the population design's cost over the same scale, median over the
+    instances; truths: whether every instance has a hidden truth (its line is drawn at 1)."""
+
+    participant: str
+    instances: int
+    curves: dict[str, tuple[np.ndarray, ...]]
+    population: float
+    truths: bool
+
+
+@dataclass(frozen=True)
+class EcdfPanel:
+    """One panel of the ECDF figure: a group of problems (all of them, or one participant's instances).
+
+    name: the panel's title; targets: how many targets its problems have (0 when no calibrator ran on
+    them); solved: calibrator label -> (sorted evaluations at which each solved (run, target) pair was
+    first reached, (solved,); the number of (run, target) pairs); labels without a pair are absent."""
+
+    name: str
+    targets: int
+    solved: dict[str, tuple[np.ndarray, int]]
 
 
 def colors(labels: Iterable[str]) -> dict[str, _RGBA]:
@@ -48,23 +79,6 @@ def _panels(n: int, ncols: int, height: float, **kwargs):
     return fig, axes
 
 
-def _run_curves(board: Leaderboard, problem: str, label: str) -> list:
-    """The best-so-far cost curves of one problem's runs with one calibrator (label), in the runs' order."""
-    keys = [(r.problem, r.optimizer, r.seed, r.budget) for r in runs_of(board.runs_frame, problem, label).itertuples()]
-    return [board.curves[k] for k in keys if k in board.curves]
-
-
-def _problems(board: Leaderboard, participant: str) -> list:
-    """The problems (instances) of one participant, in the board's order."""
-    return [q for q in board.participants if problem_of(q)[0] == participant]
-
-
-def _scale(ref) -> float:
-    """What a problem's costs are divided by to pool instances: its hidden truth's cost (the population's
-    without a truth)."""
-    return (ref.truth if ref.truth is not None else ref.population)["calibrate"]["cost"]
-
-
 def _save(fig, axes, path: str | os.PathLike, ylabel: str, legend_columns: int) -> None:
     """`ylabel` on each row's first panel, the first panel's legend below the panels; written to `path`, closed."""
     import matplotlib.pyplot as plt
@@ -84,19 +98,17 @@ def _save(fig, axes, path: str | os.PathLike, ylabel: str, legend_columns: int) 
     plt.close(fig)
 
 
-def convergence_figure(path: str | os.PathLike, board: Leaderboard, colors: dict[str, _RGBA]) -> None:
-    """Best cost so far relative to the hidden truth's cost against evaluations: median and IQR band over
-    all runs (instances × seeds) per calibrator, a panel per participant (each run divided by its own
-    instance's truth cost, so instances pool)."""
-    refs, subjects = board.refs, board.subjects
-    n = len(subjects)
+def convergence_figure(
+    path: str | os.PathLike, panels: Sequence[ConvergencePanel], colors: dict[str, _RGBA], budget: int
+) -> None:
+    """Best cost so far relative to the hidden truth's cost against evaluations (1 .. `budget`): median and
+    IQR band over all runs (instances × seeds) per calibrator, a panel per participant (each run divided by
+    its own instance's truth cost, so instances pool)."""
+    n = len(panels)
     fig, axes = _panels(n, min(n, 3), 4.0)
-    for ax, p in zip(axes.flat, subjects):
-        problems, lows, runs = _problems(board, p), [], set()
-        for label in board.labels:
-            cs = [c / _scale(refs[q]) for q in problems for c in _run_curves(board, q, label)]
-            if not cs:
-                continue
+    for ax, panel in zip(axes.flat, panels):
+        lows, runs = [], set()
+        for label, cs in panel.curves.items():
             length = max(len(c) for c in cs)
             stack = np.array([np.concatenate([c, np.full(length - len(c), c[-1])]) for c in cs])
             x = np.arange(1, length + 1)
@@ -105,20 +117,20 @@ def convergence_figure(path: str | os.PathLike, board: Leaderboard, colors: dict
             ax.plot(x, med, color=colors[label], lw=1.8, label=label)
             runs.add(len(cs))
             ax.fill_between(x, q25, q75, color=colors[label], alpha=0.18, lw=0)
-        pop = float(np.median([refs[q].population["calibrate"]["cost"] / _scale(refs[q]) for q in problems]))
+        pop = panel.population
         _reference_line(ax, pop, "population (median)", "0.35", "--", right=True)
-        truths = all(refs[q].truth is not None for q in problems)
+        truths = panel.truths
         if truths:
             _reference_line(ax, 1.0, "hidden truth", "0.1", ":", right=False)
         ax.set_yscale("log")
         ax.set_ylim(min([1.0 if truths else np.inf] + lows) * 0.85, 1.6 * pop)  # failed runs (cost 1000) squash it
         _plain_log_ticks(ax.yaxis, subs=(1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 7.0))
-        k = len(problems)
+        k = panel.instances
         count = f"{max(runs)}" if len(runs) == 1 else f"≤ {max(runs, default=0)}"
-        ax.set_title(f"{p}: {k} instance{'s' if k > 1 else ''}, {count} runs per calibrator")
+        ax.set_title(f"{panel.participant}: {k} instance{'s' if k > 1 else ''}, {count} runs per calibrator")
         ax.set_xlabel("evaluations")
         ax.grid(True, which="both", alpha=0.25)
-        ax.set_xlim(1, max(board.budgets))
+        ax.set_xlim(1, budget)
     _save(fig, axes, path, "calibration trial: best cost so far / hidden\ntruth's cost (median, IQR band over runs)", 4)
 
 
@@ -131,33 +143,15 @@ def _plain_log_ticks(axis, subs=(1.0, 2.0, 5.0)) -> None:
     axis.set_minor_formatter(NullFormatter())
 
 
-def ecdf_figure(path: str | os.PathLike, board: Leaderboard, colors: dict[str, _RGBA]) -> None:
-    """COCO-style ECDF of (run, target) pairs solved against evaluations (`tables.ECDF_TARGETS` per problem,
-    each instance's its own): a panel of all problems, then one per participant pooling its instances."""
-    targets, participants = board.ecdf_targets, board.participants
-    groups = [("all problems", participants)]
-    if len(board.subjects) > 1:
-        groups += [(p, _problems(board, p)) for p in board.subjects]
-    n = len(groups)
+def ecdf_figure(path: str | os.PathLike, panels: Sequence[EcdfPanel], colors: dict[str, _RGBA], budget: int) -> None:
+    """COCO-style ECDF of (run, target) pairs solved against evaluations (1 .. `budget`, log): a panel of all
+    problems, then one per participant pooling its instances (`EcdfPanel`)."""
+    n = len(panels)
     fig, axes = _panels(n, n if n <= 3 else 2 if n == 4 else 3, 3.9, sharey=True)
-    top = max(board.budgets)
+    top = budget
     grid = np.unique(np.round(np.geomspace(1, top, 200)).astype(int))
-    for ax, (name, members) in zip(axes.flat, groups):
-        n_targets = 0
-        for label in board.labels:
-            hits, pairs = [], 0
-            for p in members:
-                ts = targets[targets.problem == p]
-                for curve in _run_curves(board, p, label):
-                    for t in ts.itertuples():
-                        pairs += 1
-                        h = hit(curve, t.value)
-                        if h is not None:
-                            hits.append(h)
-            if not pairs:
-                continue
-            n_targets = max(n_targets, len(targets[targets.problem.isin(members)]))
-            hits = np.sort(np.array(hits))
+    for ax, panel in zip(axes.flat, panels):
+        for label, (hits, pairs) in panel.solved.items():
             frac = np.searchsorted(hits, grid, side="right") / pairs
             ax.step(grid, frac, where="post", color=colors[label], lw=1.8, label=label)
         ax.set_xscale("log")
@@ -165,7 +159,7 @@ def ecdf_figure(path: str | os.PathLike, board: Leaderboard, colors: dict[str, _
         _plain_log_ticks(ax.xaxis)
         ax.set_ylim(0, 1.02)
         ax.set_xlabel("evaluations")
-        ax.set_title(f"{name} ({n_targets} targets)")
+        ax.set_title(f"{panel.name} ({panel.targets} targets)")
         ax.grid(True, which="both", alpha=0.25)
     for row in axes:
         row[0].tick_params(labelleft=True)

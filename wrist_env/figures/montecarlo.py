@@ -1,4 +1,5 @@
-"""Figures 8–10 of the Monte Carlo study (PNG, matplotlib), from `stats.frame_table` rows.
+"""Figures 8–10 of the Monte Carlo study (PNG, matplotlib), from `montecarlo.stats.frame_table` rows and
+what the report computes from its fits (`TearEstimates`); nothing here fits or imports the study.
 
 figure8: radioscaphoid mean pressure against the wrist angle — (A) every run
     as dots (a seeded subset when there are many), the per-angle medians of
@@ -15,6 +16,7 @@ figure10: SLIL bundle forces against the wrist angle in intact runs: dots and
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import matplotlib.pyplot as plt
@@ -22,12 +24,25 @@ import numpy as np
 import pandas as pd
 
 from wrist_env.design import INJURABLE
-from wrist_env.montecarlo import stats
 
 INTACT_COLOR, INJURED_COLOR = "#d6609a", "#3b6fb6"  # the preprint's pink and blue
 BUNDLE_COLORS = {"SLIL_v": "#2a9d8f", "SLIL_p": "#e9a23b", "SLIL_d": "#6a4c93"}
 ANGLE_LABEL = "wrist angle (°): extension − / flexion +"
 MAX_DOT_RUNS = 300
+
+
+@dataclass(frozen=True)
+class TearEstimates:
+    """Figure 8 (B)'s estimates: Table 5's sweep-average radioscaphoid pressure intact and with each ligament
+    torn alone (`montecarlo.report.tear_estimates`).
+
+    tears: None (intact), then the tear columns of the frame table (`design.INJURABLE`), one per estimate;
+    labels: their tick labels; estimate_mpa, se_mpa (len(tears),): the estimate and its standard error, MPa."""
+
+    tears: tuple[str | None, ...]
+    labels: tuple[str, ...]
+    estimate_mpa: tuple[float, ...]
+    se_mpa: tuple[float, ...]
 
 
 def _dot_runs(frames: pd.DataFrame, limit: int = MAX_DOT_RUNS, seed: int = 0) -> pd.DataFrame:
@@ -48,7 +63,9 @@ def _angle_axis(ax):
     ax.grid(True, axis="y", color="0.92")
 
 
-def figure8(frames: pd.DataFrame, fit: stats.Fit, out: str | Path) -> Path:
+def figure8(frames: pd.DataFrame, tears: TearEstimates, out: str | Path) -> Path:
+    """(A) per participant: every run's radioscaphoid pressure against the angle and the per-angle medians,
+    intact and injured; (B) `tears`' estimates ± 95 % CI over the sweep averages of the runs with each tear."""
     participants = sorted(frames["participant"].unique())
     fig, axes = plt.subplots(
         1,
@@ -74,20 +91,15 @@ def figure8(frames: pd.DataFrame, fit: stats.Fit, out: str | Path) -> Path:
         ax.legend(fontsize=8, loc="upper right")
 
     ax = axes[-1]
-    angles = np.sort(frames["angle"].unique())
-    base = float(np.mean(stats.pressure_curve(fit, angles)))
-    table = fit.table.set_index("term")
     run_mean = frames.groupby("group").agg(
         rs=("rs_mean_mpa", "mean"), any=("any_injury", "max"), **{lig: (lig, "max") for lig in INJURABLE}
     )
-    labels = ["Intact"] + [stats.BUNDLE_LABELS[l] for l in INJURABLE]
-    for i, key in enumerate([None] + list(INJURABLE)):
+    labels = list(tears.labels)
+    for i, (key, est, se) in enumerate(zip(tears.tears, tears.estimate_mpa, tears.se_mpa)):
         runs = run_mean[run_mean["any"] == 0] if key is None else run_mean[run_mean[key] == 1]
         runs = runs.sample(min(len(runs), MAX_DOT_RUNS), random_state=i) if len(runs) else runs
         color = INTACT_COLOR if key is None else INJURED_COLOR
         ax.scatter(_jitter(np.full(len(runs), i), 0.22, i), runs["rs"], s=5, color=color, alpha=0.35, lw=0)
-        est = base if key is None else base + float(table.loc[key, "estimate"])
-        se = float(table.loc["Intercept", "se"]) if key is None else float(table.loc[key, "se"])
         ax.errorbar([i], [est], yerr=[1.96 * se], fmt="o", color="k", ms=6, capsize=5, lw=1.6, zorder=5)
         ax.annotate(f"{est:.2f}", (i, est), xytext=(9, -3), textcoords="offset points", fontsize=8)
     ax.set_xticks(range(len(labels)), labels, rotation=30, ha="right")
@@ -103,29 +115,10 @@ def figure8(frames: pd.DataFrame, fit: stats.Fit, out: str | Path) -> Path:
     return _save(fig, out)
 
 
-def injury_category(run_flags: pd.DataFrame) -> pd.Series:
-    """Per run: "Intact", "Partial SLIL", "Full SLIL" (RSC and LRL intact) or other; see figure9."""
-    slil = run_flags[list(stats.SLIL)].sum(axis=1)
-    extrinsic = run_flags[["RSC", "LRL"]].sum(axis=1)
-    cat = pd.Series("Other", index=run_flags.index)
-    cat[(slil == 0) & (extrinsic == 0)] = "Intact"
-    cat[(slil > 0) & (slil < 3) & (extrinsic == 0)] = "Partial SLIL"
-    cat[(slil == 3) & (extrinsic == 0)] = "Full SLIL"
-    return cat
-
-
-FIG9_GROUPS = ("Intact", "Partial SLIL", "Full SLIL", "Any injury")
-
-
-def full_extension(frames: pd.DataFrame) -> pd.DataFrame:
-    """The runs' rows at full extension (the smallest angle), with their figure-9 category."""
-    at = frames[np.isclose(frames["angle"], frames["angle"].min())].copy()
-    at["category"] = injury_category(at).to_numpy()
-    return at
-
-
-def figure9(frames: pd.DataFrame, out: str | Path) -> Path:
-    at = full_extension(frames)
+def figure9(at: pd.DataFrame, groups: tuple[str, ...], out: str | Path) -> Path:
+    """Radioscaphoid pressure at full extension per injury group (`groups`: the `category` values of `at`,
+    then "Any injury", runs with any tear), a box per participant: `at` is the runs' rows at full
+    extension with their category (`montecarlo.stats.full_extension`)."""
     participants = sorted(at["participant"].unique())
     colors = ["#3b6fb6", "#e07b39", "#4f9d69"]
     fig, ax = plt.subplots(figsize=(7.6, 4.6))
@@ -136,9 +129,9 @@ def figure9(frames: pd.DataFrame, out: str | Path) -> Path:
             part.loc[part["category"] == g, "rs_mean_mpa"].to_numpy()
             if g != "Any injury"
             else part.loc[part["any_injury"] == 1, "rs_mean_mpa"].to_numpy()
-            for g in FIG9_GROUPS
+            for g in groups
         ]
-        pos = np.arange(len(FIG9_GROUPS)) + (j - (len(participants) - 1) / 2) * width
+        pos = np.arange(len(groups)) + (j - (len(participants) - 1) / 2) * width
         keep = [k for k, d in enumerate(data) if len(d)]
         bp = ax.boxplot(
             [data[k] for k in keep],
@@ -162,12 +155,12 @@ def figure9(frames: pd.DataFrame, out: str | Path) -> Path:
             f"{n}: {int(((at['participant'] == n) & ((at['category'] == g) if g != 'Any injury' else (at['any_injury'] == 1))).sum())}"
             for n in participants
         )
-        for g in FIG9_GROUPS
+        for g in groups
     ]
-    ax.set_xticks(range(len(FIG9_GROUPS)), [f"{g}\n({c})" for g, c in zip(FIG9_GROUPS, counts)], fontsize=8)
+    ax.set_xticks(range(len(groups)), [f"{g}\n({c})" for g, c in zip(groups, counts)], fontsize=8)
     ax.set_ylabel("mean radioscaphoid pressure (MPa)")
     ax.set_title(
-        f"Radioscaphoid pressure at full extension ({-frames['angle'].min():.0f}°); boxes 25–75 %, whiskers 1.5 IQR",
+        f"Radioscaphoid pressure at full extension ({-at['angle'].min():.0f}°); boxes 25–75 %, whiskers 1.5 IQR",
         fontsize=9,
     )
     ax.set_ylim(0.0, float(np.nanpercentile(at["rs_mean_mpa"], 99.5)) * 1.1)
@@ -177,15 +170,17 @@ def figure9(frames: pd.DataFrame, out: str | Path) -> Path:
     return _save(fig, out)
 
 
-def figure10(frames: pd.DataFrame, out: str | Path) -> Path:
+def figure10(frames: pd.DataFrame, bundles: dict[str, str], out: str | Path) -> Path:
+    """SLIL bundle forces against the angle in intact runs, dots and per-angle medians, a panel per
+    participant; bundles: the bundles drawn, column stem ("SLIL_v", its `<stem>.force_n`) -> label."""
     intact = frames[frames["any_injury"] == 0]
     participants = sorted(intact["participant"].unique())
     fig, axes = plt.subplots(1, len(participants), figsize=(4.8 * len(participants), 4.2), sharey=True, squeeze=False)
-    top = max(float(np.nanpercentile(intact[[f"{l}.force_n" for l in stats.SLIL]].to_numpy(), 99.5)) * 1.08, 1.0)
+    top = max(float(np.nanpercentile(intact[[f"{l}.force_n" for l in bundles]].to_numpy(), 99.5)) * 1.08, 1.0)
     for ax, name in zip(axes[0], participants):
         part = intact[intact["participant"] == name]
         dots = _dot_runs(part)
-        for k, lig in enumerate(stats.SLIL):
+        for k, lig in enumerate(bundles):
             ax.scatter(
                 _jitter(dots["angle"] + (k - 1) * 1.2, 0.5, k),
                 dots[f"{lig}.force_n"],
@@ -194,11 +189,9 @@ def figure10(frames: pd.DataFrame, out: str | Path) -> Path:
                 alpha=0.3,
                 lw=0,
             )
-        for lig in stats.SLIL:
+        for lig in bundles:
             med = part.groupby("angle")[f"{lig}.force_n"].median()
-            ax.plot(
-                med.index, med.to_numpy(), color=BUNDLE_COLORS[lig], lw=2.4, label=f"{stats.BUNDLE_LABELS[lig]} median"
-            )
+            ax.plot(med.index, med.to_numpy(), color=BUNDLE_COLORS[lig], lw=2.4, label=f"{bundles[lig]} median")
         ax.set_title(f"{name}: SLIL bundle forces, intact runs (n = {part['group'].nunique()})", fontsize=10)
         _angle_axis(ax)
         ax.set_ylim(0.0, top)

@@ -1,20 +1,51 @@
-"""Figures of simulations: contact pressure at neutral (preprint Figure 3) and the row's kinematics."""
+"""Figures of simulations: contact pressure at neutral (preprint Figure 3) and the row's kinematics.
+
+Pictures take data: a `PressureFrame` and `RowKinematics` hold what was simulated (`cli.run.figure_data`
+simulates it); nothing here loads a participant or runs the solver."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
 
-from wrist_env import design
 from wrist_env.figures import draw
-from wrist_env.model import BONES, PAIR_BONES, PAIRS
-from wrist_env.participants import builtin
-from wrist_env.participants.registry import load_model
-from wrist_env.solver import drivers, simulate
-from wrist_env.solver.outputs import cardan_deg, pair_slice, pressure_map
+from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model
+
+
+@dataclass(frozen=True)
+class PressureFrame:
+    """One simulated frame of a participant's model, as the pressure figure draws it.
+
+    name: the participant; poses (n_bodies, 4, 4): each body's pose (RCS, mm); pressure_mpa (n_samples,):
+    each contact sample's pressure, MPa, in `model.sample_points` order (0 out of contact); contact
+    (n_pairs, 4): per pair (`PAIRS`) mean and peak pressure (MPa), area (mm²) and force (N); samples: each
+    drawn pair's slice of the samples; how: the frame's driver and load, in words (the subtitle)."""
+
+    name: str
+    poses: np.ndarray
+    pressure_mpa: np.ndarray
+    contact: np.ndarray
+    samples: dict[str, slice]
+    how: str
+
+
+@dataclass(frozen=True)
+class RowKinematics:
+    """One design's run through a sweep, as the kinematics figure draws it.
+
+    label: the design ("population", "hidden truth"); style: its line style; angles_deg (n_frames, n_bodies,
+    3): each body's Cardan Z-X-Y angles (deg) at each frame, None when the run failed; message: why it
+    failed ("" when it did not)."""
+
+    label: str
+    style: str
+    angles_deg: np.ndarray | None
+    message: str = ""
 
 
 def _silhouette(ax, points_2d, colour, *, spacing=0.2, radius=1.0, filled=False, **kw):
@@ -60,39 +91,21 @@ PRESSURE_PANELS = (
 _BONE_FILL, _CARTILAGE_FILL, _OUTLINE = "#e6e1d8", "#c9d3de", "#4d4d4d"
 
 
-def pressure_figure(name: str, out: Path | None = None, *, static: bool = False) -> Path:
+def pressure_figure(model: Model, frame: PressureFrame, out: Path | None = None) -> Path:
     """Contact pressure at the neutral pose, viewed from distal (preprint Figure 3's pressure plot).
 
-    Population design. Default: the 0° frame of the idealized ±40° sweep (capitate
-    rotation prescribed, translations free under the 10 N compressive load);
-    static=True: the capitate held at neutral (experimental driver, identity poses, no load).
-    Samples are drawn at their world positions projected on the RCS x–z plane
-    (radial to the right, volar down: the view from distal, not mirrored).
+    `frame`: the population design's frame at neutral, simulated (`cli.run.figure_data.pressure_frame`:
+    the 0° frame of the idealized ±40° sweep, or the capitate held at neutral). Samples are drawn at
+    their world positions projected on the RCS x–z plane (radial to the right, volar down: the view from
+    distal, not mirrored).
     """
     from scipy.spatial import cKDTree
 
-    model = load_model(name)
+    name = frame.name
     out = out or draw.FIGURES / f"pressure_{name}.png"
-    if static:
-        driver = drivers.static(model)
-        frame = len(driver.rotation) - 1
-        how = "capitate held at neutral (all 6 DOF), no external load"
-    else:
-        driver = drivers.idealized(model)
-        frame = int(np.argmin(np.abs(driver.angle_deg)))
-        load = getattr(driver, "load_n", None)
-        how = (
-            f"the {driver.angle_deg[frame]:.0f}° frame of the idealized sweep "
-            f"(+{driver.angle_deg[0]:.0f}° → {driver.angle_deg[-1]:.0f}°; capitate rotation prescribed, "
-            f"translations free under a {10.0 if load is None else float(load[frame]):g} N compressive load)"
-        )
-    result = simulate.simulate(model, design.population(), driver)
-    if not result.ok:
-        raise RuntimeError(f"{name}: simulation failed: {result.message}")
-    poses = result.poses[frame]
-    pressure = pressure_map(model, poses)
+    poses, pressure, how = frame.poses, frame.pressure_mpa, frame.how
     shown = [p for _, pairs, _, _ in PRESSURE_PANELS for p in pairs]
-    peak = max(float(pressure[pair_slice(model, p)].max()) for p in shown)
+    peak = max(float(pressure[frame.samples[p]].max()) for p in shown)
     norm = matplotlib.colors.Normalize(0.0, max(peak, 1e-3))
     cmap = plt.get_cmap("turbo")
 
@@ -122,7 +135,7 @@ def pressure_figure(name: str, out: Path | None = None, *, static: bool = False)
             keep = w[:, 1] < draw.DISTAL_CROP_MM if bone in ("radius", "ulna") else np.ones(len(w), bool)
             _silhouette(ax, xz(w[keep]), _BONE_FILL, filled=True, zorder=0)
             drawn.append((bone, xz(w[keep])))
-            met = [pair_slice(model, p) for p in pairs if PAIR_BONES[PAIRS.index(p)][1] == b]
+            met = [frame.samples[p] for p in pairs if PAIR_BONES[PAIRS.index(p)][1] == b]
             if met:  # cartilage vertices within 3 mm of the samples that meet this bone (neutral pose, RCS)
                 near, _ = cKDTree(np.concatenate([model.sample_points[s] for s in met])).query(
                     v, distance_upper_bound=3.0
@@ -144,7 +157,7 @@ def pressure_figure(name: str, out: Path | None = None, *, static: bool = False)
         lines = []
         for pair in pairs:
             k = PAIRS.index(pair)
-            s = pair_slice(model, pair)
+            s = frame.samples[pair]
             w = xz(_world(poses, PAIR_BONES[k][0], model.sample_points[s]))
             p = pressure[s]
             on = p > 0
@@ -161,7 +174,7 @@ def pressure_figure(name: str, out: Path | None = None, *, static: bool = False)
                 linewidths=0.35,
                 zorder=4,
             )
-            c = result.contact[frame, k]
+            c = frame.contact[k]
             lines.append(f"{pair}: mean {_mpa(c[0])}, peak {_mpa(c[1])}, {c[2]:.0f} mm², {c[3]:.2g} N")
         ax.set_title(title + "\n" + "\n".join(lines), fontsize=10)
         ax.set_aspect("equal")
@@ -197,7 +210,7 @@ def pressure_figure(name: str, out: Path | None = None, *, static: bool = False)
         matplotlib.patches.Patch(color=_CARTILAGE_FILL, label="its articular cartilage"),
     ]
     fig.legend(handles=handles, loc="lower center", ncol=5, frameon=False)
-    rs = result.contact[frame, PAIRS.index("radioscaphoid")]
+    rs = frame.contact[PAIRS.index("radioscaphoid")]
     fig.suptitle(
         f"{name}, population design: contact pressure at the neutral pose, viewed from distal "
         f"(radioscaphoid mean {_mpa(rs[0])}, peak {_mpa(rs[1])})\n{how}",
@@ -213,16 +226,12 @@ KINEMATIC_ANGLES = (
 )
 
 
-def kinematics_figure(name: str, out: Path | None = None, *, n_frames: int = 17) -> Path:
-    """Scaphoid and lunate rotations (Cardan Z-X-Y) against the capitate angle over the idealized
-    ±40° sweep: population design, and for built-in participants also the hidden truth."""
+def kinematics_figure(name: str, angle_deg: np.ndarray, runs: Sequence[RowKinematics], out: Path | None = None) -> Path:
+    """Scaphoid and lunate rotations (Cardan Z-X-Y) against the capitate angle `angle_deg` (n_frames,) over
+    the idealized ±40° sweep of participant `name`: one line style per run (`cli.run.figure_data.row_kinematics`:
+    the population design, and for built-in participants also the hidden truth)."""
 
-    model = load_model(name)
     out = out or draw.FIGURES / f"kinematics_{name}.png"
-    driver = drivers.idealized(model, n_frames=n_frames)
-    runs = [("population", design.population(), "-")]
-    if name in builtin.BUILTIN:
-        runs.append(("hidden truth", builtin.truth(name), "--"))
     colours = {"scaphoid": "#1f77b4", "lunate": "#d62728"}
     fig = plt.figure(figsize=(13, 6.6))
     gs = fig.add_gridspec(
@@ -230,25 +239,24 @@ def kinematics_figure(name: str, out: Path | None = None, *, n_frames: int = 17)
     )
     main = fig.add_subplot(gs[:, 0])
     small = [fig.add_subplot(gs[0, 1]), fig.add_subplot(gs[1, 1])]
-    lim = float(np.abs(driver.angle_deg).max())
+    lim = float(np.abs(angle_deg).max())
     main.plot([-lim, lim], [-lim, lim], color="0.6", lw=1, ls=":", label="identity (moves with the capitate)")
     notes, ends = [], []
-    for label, d, style in runs:
-        result = simulate.simulate(model, d, driver)
-        if not result.ok:
-            notes.append(f"{label}: {result.message}")
+    for run in runs:
+        label, style, angles = run.label, run.style, run.angles_deg
+        if angles is None:
+            notes.append(f"{label}: {run.message}")
             continue
-        angles = cardan_deg(result.poses)
         for bone in ("scaphoid", "lunate"):
             a = angles[:, BONES.index(bone)]
             kw = dict(color=colours[bone], ls=style, marker="o", ms=3.5)
-            main.plot(driver.angle_deg, a[:, 0], label=f"{bone}, {label}", **kw)
+            main.plot(angle_deg, a[:, 0], label=f"{bone}, {label}", **kw)
             ends.append(
-                f"{bone[:8]:<8} {label:<12} {a[0, 0]:+6.1f}° at {driver.angle_deg[0]:+.0f}°, "
-                f"{a[-1, 0]:+6.1f}° at {driver.angle_deg[-1]:+.0f}°"
+                f"{bone[:8]:<8} {label:<12} {a[0, 0]:+6.1f}° at {angle_deg[0]:+.0f}°, "
+                f"{a[-1, 0]:+6.1f}° at {angle_deg[-1]:+.0f}°"
             )
             for ax, k in zip(small, (1, 2)):
-                ax.plot(driver.angle_deg, a[:, k], **kw)
+                ax.plot(angle_deg, a[:, k], **kw)
     main.axhline(0, color="0.85", lw=0.8, zorder=0)
     main.axvline(0, color="0.85", lw=0.8, zorder=0)
     main.set_xlabel("capitate angle (deg): extension −  /  flexion +")

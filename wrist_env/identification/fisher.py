@@ -18,7 +18,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from wrist_env import design
-from wrist_env.figures.identifiability import plot
 from wrist_env.identification.likelihood import residuals
 from wrist_env.motions import TRIAL_MOTIONS
 from wrist_env.participants import builtin
@@ -96,8 +95,8 @@ def posterior_sd(fisher: np.ndarray) -> np.ndarray:
 def study(participants, out=None):
     """Per participant, the Fisher matrices of the calibration and held-out trials at the truth:
     (materials table: participant, trials, material, posterior_sd; spectrum table: participant,
-    trials, direction, eigenvalue, sd, leading materials); written as CSV with a figure per
-    participant when `out` is given."""
+    trials, direction, eigenvalue, sd, leading materials); written as CSV when `out` is given (the
+    command draws them: `wrist_env.figures.identifiability.plot`, a figure per participant)."""
     import pandas as pd
 
     materials, spectra = [], []
@@ -128,6 +127,4 @@ def study(participants, out=None):
         out.mkdir(parents=True, exist_ok=True)
         tables[0].to_csv(out / "identifiability_materials.csv", index=False)
         tables[1].to_csv(out / "identifiability_spectrum.csv", index=False)
-        for participant in participants:
-            plot(tables[0], tables[1], participant, out / f"identifiability_{participant}.png")
     return tables

@@ -26,7 +26,6 @@ from wrist_env import design
 from wrist_env.cost import COST_BONES, DOF_NAMES
 from wrist_env.design import full_action
 from wrist_env.errors import InputError
-from wrist_env.figures.sensitivity import plot
 from wrist_env.limits import MAX_SEED, MAX_SENSITIVITY_N, MIN_SENSITIVITY_N, check_int
 from wrist_env.motions import MOTIONS
 from wrist_env.task import require_reference, task
@@ -115,7 +114,7 @@ def study(
 ) -> pd.DataFrame:
     """Indices of every output to every material for each motion: one row per (motion, output,
     material), with the motion's failed share; written to `out`/sensitivity_<participant>_<method>.csv
-    with a figure (.png) when `out` is given. The method, n and seed are checked before anything runs
+    when `out` is given (the command draws it beside, .png: `wrist_env.figures.sensitivity.plot`). The method, n and seed are checked before anything runs
     (`sample`'s `check_size`); ParticipantError, before anything is simulated, if a motion has no reference
     kinematics (a folder participant's idealized sweep): its outputs would be undefined."""
     for motion in motions:
@@ -138,6 +137,4 @@ def study(
         out.mkdir(parents=True, exist_ok=True)
         stem = out / f"sensitivity_{participant}_{method}"
         result.to_csv(stem.with_suffix(".csv"), index=False)
-
-        plot(result, method, stem.with_suffix(".png"))
     return result

@@ -305,6 +305,29 @@ def pressure_curve(fit: Fit, angles: ArrayLike, torn: Iterable[str] = ()) -> np.
     return est["Intercept"] + b[:, 0] * est["s1"] + b[:, 1] * est["s2"] + sum(est[lig] for lig in torn)
 
 
+def injury_category(run_flags: pd.DataFrame) -> pd.Series:
+    """Per run: "Intact", "Partial SLIL" (one or two SLIL bundles), "Full SLIL" (all three; RSC and LRL
+    intact in both) or "Other": Figure 9's groups."""
+    slil = run_flags[list(SLIL)].sum(axis=1)
+    extrinsic = run_flags[["RSC", "LRL"]].sum(axis=1)
+    cat = pd.Series("Other", index=run_flags.index)
+    cat[(slil == 0) & (extrinsic == 0)] = "Intact"
+    cat[(slil > 0) & (slil < 3) & (extrinsic == 0)] = "Partial SLIL"
+    cat[(slil == 3) & (extrinsic == 0)] = "Full SLIL"
+    return cat
+
+
+FIG9_GROUPS = ("Intact", "Partial SLIL", "Full SLIL", "Any injury")
+"""Figure 9's boxes: three `injury_category` values, then every run with any tear."""
+
+
+def full_extension(frames: pd.DataFrame) -> pd.DataFrame:
+    """The runs' rows at full extension (the smallest angle), with their `injury_category` as `category`."""
+    at = frames[np.isclose(frames["angle"], frames["angle"].min())].copy()
+    at["category"] = injury_category(at).to_numpy()
+    return at
+
+
 def summary_numbers(frames: pd.DataFrame, angle: float = -30.0) -> dict:
     """Numbers beside the preprint's: mean radioscaphoid pressure over all included frames (Table 5's
     normalizer; preprint 0.65 MPa), and at `angle` (default 30° extension) the mean pressure of all and

@@ -50,9 +50,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from wrist_env.bench.leaderboard.board import Leaderboard, build, write_csvs
+from wrist_env.bench.leaderboard.curves import convergence_panels, ecdf_panels
 from wrist_env.bench.leaderboard.readme import ranking_title, readme
 from wrist_env.bench.leaderboard.reference import Reference, reference
 from wrist_env.bench.leaderboard.tables import TARGETS, load_runs
+from wrist_env.figures import leaderboard as figures
 
 __all__ = ["TARGETS", "Leaderboard", "Reference", "build", "load_runs", "reference", "write_leaderboard"]
 
@@ -68,11 +70,9 @@ def write_leaderboard(
     out.mkdir(parents=True, exist_ok=True)
     board = build(runs, references)
     write_csvs(board, out)
-    from wrist_env.figures import leaderboard as figures  # here, not above: it imports this package
-
-    colors = figures.colors(board.labels)
-    figures.convergence_figure(out / "convergence.png", board, colors)
-    figures.ecdf_figure(out / "ecdf.png", board, colors)
+    colors, budget = figures.colors(board.labels), max(board.budgets)
+    figures.convergence_figure(out / "convergence.png", convergence_panels(board), colors, budget)
+    figures.ecdf_figure(out / "ecdf.png", ecdf_panels(board), colors, budget)
     diagram, report = out / "ranking.png", out / "ranking_report.txt"
     if board.ranking.tested:
         figures.ranking_figure(diagram, board.ranking.result, ranking_title(board.ranking))

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from wrist_env import figures, validation
 from wrist_env.builder.params import BuildParams, anatomy_params
+from wrist_env.cli.run import figure_data
 from wrist_env.errors import UsageError
 from wrist_env.figures.draw import FIGURES as figures_dir
 from wrist_env.figures.validation import validation_figure
@@ -50,17 +51,21 @@ def validate(args) -> int:
 def figure(args) -> int:
 
     out = Path(args.out) if args.out else None
-    if args.kind == "model":
-        path = figures.model_figure(args.participant or "P1", out)
-    elif args.kind == "annotations":
-        path = figures.annotations_figure(out)
-    elif args.kind == "pressure":
-        path = figures.pressure_figure(args.participant or "P1", out, static=args.static)
-    elif args.kind == "kinematics":
-        path = figures.kinematics_figure(args.participant or "P1", out)
-    elif args.kind == "animation":
-        path = figures.animation_figure(args.participant or "P1", out)
-    else:
+    name = args.participant or "P1"
+    if args.kind not in ("model", "annotations", "pressure", "kinematics", "animation"):
         raise UsageError(f"unknown figure {args.kind!r}")
+    if args.kind == "annotations":
+        path = figures.annotations_figure(*figure_data.template(), out)
+        print(path)
+        return 0
+    model = registry.load_model(name)
+    if args.kind == "model":
+        path = figures.model_figure(model, name, out)
+    elif args.kind == "pressure":
+        path = figures.pressure_figure(model, figure_data.pressure_frame(model, name, static=args.static), out)
+    elif args.kind == "kinematics":
+        path = figures.kinematics_figure(name, *figure_data.row_kinematics(model, name), out)
+    else:
+        path = figures.animation_figure(model, figure_data.sweep_frames(model, name), out)
     print(path)
     return 0

@@ -10,6 +10,8 @@ import numpy as np
 
 from wrist_env.cli.run.outputs import out_folder
 from wrist_env.errors import Interrupted, UsageError
+from wrist_env.figures import identifiability as identifiability_figure
+from wrist_env.figures import sensitivity as sensitivity_figure
 from wrist_env.identification import fisher
 from wrist_env.identification import sensitivity as global_sensitivity
 from wrist_env.identification.settings import SamplerSettings
@@ -23,6 +25,7 @@ def sensitivity(args) -> int:
     for participant in args.participants:
         start = time.perf_counter()
         table = global_sensitivity.study(participant, args.method, args.n, tuple(args.motions), args.seed, args.out)
+        sensitivity_figure.plot(table, args.method, Path(args.out) / f"sensitivity_{participant}_{args.method}.png")
         key = "mu_star" if args.method == "morris" else "ST"
         for motion, rows in table[table["output"] == "cost"].groupby("motion", sort=False):
             top = rows.nlargest(5, key)
@@ -42,6 +45,10 @@ def identifiability(args) -> int:
     if unknown:
         raise UsageError(f"{unknown} have no hidden truth; built-ins: {list(builtin.BUILTIN)}")
     materials, spectra = fisher.study(args.participants, args.out)
+    for participant in args.participants:
+        identifiability_figure.plot(
+            materials, spectra, participant, Path(args.out) / f"identifiability_{participant}.png"
+        )
     for (participant, trials), rows in materials.groupby(["participant", "trials"], sort=False):
         s = spectra[(spectra["participant"] == participant) & (spectra["trials"] == trials)]
         pinned = rows[rows["posterior_sd"] < 0.5]["material"].tolist()
