@@ -144,7 +144,6 @@ STUDIES = (
 load, build or simulate a model (anatomy, builder, solver). Everything below them (the vocabulary: `design`,
 `frames`, `cost`, `trial`, `model`, `motions`, `io`, `errors`, `limits`), `wrist_env.figures` itself and
 third-party libraries are allowed."""
-FIGURE_EXCEPTIONS = {"wrist_env.figures.validation": ("wrist_env.validation",)}  # until the validation chain lands
 
 
 def _module_name(path: Path) -> str:
@@ -197,7 +196,7 @@ def _imports(module: str) -> tuple[set[str], list[tuple[str, int, list[str]]]]:
 def test_no_figure_imports_a_study():
     """Pictures take data (issue 56): a module of `wrist_env.figures` imports none of `STUDIES`, at top level or
     inside a function; what it draws is computed by the study or command that asks for it and handed over as
-    arrays, frames or frozen dataclasses of them. The one exception is named in `FIGURE_EXCEPTIONS`."""
+    arrays, frames or frozen dataclasses of them."""
     found = []
     for module, path in MODULES.items():
         if module != "wrist_env.figures" and not module.startswith("wrist_env.figures."):
@@ -206,7 +205,7 @@ def test_no_figure_imports_a_study():
             if isinstance(node, (ast.Import, ast.ImportFrom)):
                 for name in _imported(node, module):
                     study = next((s for s in STUDIES if name == s or name.startswith(s + ".")), None)
-                    if study and study not in FIGURE_EXCEPTIONS.get(module, ()):
+                    if study:
                         found.append(f"{module}:{node.lineno} imports {name}")
     assert not found, found
 

@@ -7,6 +7,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from wrist_env.figures.validation import ValidationPanels
+from wrist_env.validation.bands import HAUG_2021_GAP_MM, RAINBOW_LUNATE, RAINBOW_SCAPHOID, SL_DISSOCIATION_MM
+
 
 @dataclass(frozen=True)
 class Check:
@@ -106,3 +109,26 @@ def format_table(report: Report) -> str:
     n = sum(r.passed for r in report.rows)
     lines.append(f"{n}/{len(report.rows)} checks pass; {report.wall_seconds:.1f} s")
     return "\n".join(lines)
+
+
+def figure_panels(report: Report) -> ValidationPanels:
+    """What the validation figure draws of `report`: its sweep series, the model's slopes against Rainbow 2013's
+    ratios, the SL gap lines and the note on the gap-growth check (and on runs that did not finish)."""
+    growth = report.row("sl_gap_growth_mm")
+    notes = [
+        f"check: torn − intact at full extension {_fmt(growth.value)} mm "
+        f"(band > {_fmt(growth.band[0])} mm): {'pass' if growth.passed else 'FAIL'}"
+    ]
+    s = report.series
+    notes += [f"{k}: {s[k]}" for k in ("intact_status", "slil_torn_status") if s.get(k) != "ok"]
+    return ValidationPanels(
+        report.participant,
+        s,
+        {"scaphoid": report.row("scaphoid_slope").value, "lunate": report.row("lunate_slope").value},
+        {"scaphoid": RAINBOW_SCAPHOID, "lunate": RAINBOW_LUNATE},
+        SL_DISSOCIATION_MM,
+        HAUG_2021_GAP_MM,
+        notes,
+        sum(r.passed for r in report.rows),
+        len(report.rows),
+    )

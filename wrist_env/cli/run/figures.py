@@ -38,7 +38,7 @@ def validate(args) -> int:
     variant = "" if default else "_variant"
 
     out = Path(args.out or figures_dir) / f"validation_{report.participant}{variant}.png"
-    figure = validation_figure(report, out)
+    figure = validation_figure(validation.report.figure_panels(report), out)
     write_json(out.with_suffix(".json"), report.to_dict())  # the record the docs' validation page renders
     if args.json:
         print(json.dumps(dict(report.to_dict(), figure=str(figure)), indent=1, allow_nan=False))
