@@ -18,7 +18,7 @@ import wrist_env
 from wrist_env.bench import DuplicateEvaluationError, ResumeError, RunKey, RunLog, benchmark, calibrate
 from wrist_env.bench.calibrate import accepts_storage
 from wrist_env.bench.leaderboard import write_leaderboard
-from wrist_env.bench.log import KEY_FIELDS
+from wrist_env.bench.schema import KEY_FIELDS
 from wrist_env.cli import main
 from wrist_env.errors import StoreError
 
@@ -354,7 +354,7 @@ def test_a_calibration_on_instance_1_scores_against_instance_1(p1_instance_1, tm
     recovery against instance 1's truth; its log and summary say instance 1 and its provenance binds it."""
     from wrist_env import design
     from wrist_env.bench.calibrate import action, recovery_error
-    from wrist_env.bench.log import X_COLUMNS
+    from wrist_env.bench.schema import X_COLUMNS
     from wrist_env.participants import instances
     from wrist_env.runs import provenance
     from wrist_env.task import task

@@ -8,7 +8,7 @@ import pytest
 
 import wrist_env
 from wrist_env.bench import RunKey, RunLog, benchmark
-from wrist_env.bench.log import X_COLUMNS
+from wrist_env.bench.schema import X_COLUMNS
 from wrist_env.cli import main
 
 ioh = pytest.importorskip("ioh")

@@ -67,7 +67,8 @@ def test_the_run_log_keeps_each_evaluations_unsettled_frames(tmp_path):
 
     from wrist_env.bench.calibrate import unsettled_frames
     from wrist_env.bench.leaderboard.tables import unsettled_shares
-    from wrist_env.bench.log import SCHEMA, RunKey, RunLog
+    from wrist_env.bench.log import RunLog
+    from wrist_env.bench.schema import SCHEMA, RunKey
     from wrist_env.runs.store import add_checksums
 
     log, key = RunLog(tmp_path), RunKey("P1", "random", 0, 4)

@@ -83,7 +83,8 @@ def test_close_stops_cobylas_thread():
 def test_calibrates_a_participant_and_resumes(tmp_path):
     """A benchmark cell with TwoPointsDE on P1, cut short after its first batch, resumes by replay to the same run."""
     from wrist_env.bench.calibrate import calibrate
-    from wrist_env.bench.log import RunKey, RunLog
+    from wrist_env.bench.log import RunLog
+    from wrist_env.bench.schema import RunKey
     from wrist_env.runs import provenance
 
     options = {"batch_size": 3}

@@ -9,8 +9,9 @@ from typing import Any
 
 from wrist_env.bench.calibrate import CalibrationRun, ResumeError, calibrate
 from wrist_env.bench.leaderboard import write_leaderboard as write
-from wrist_env.bench.log import DuplicateEvaluationError, RunKey, RunLog
+from wrist_env.bench.log import DuplicateEvaluationError, RunLog
 from wrist_env.bench.runner import SEED_IS_INSTANCE, BenchmarkReport, benchmark, make_cells
+from wrist_env.bench.schema import RunKey
 
 
 def write_leaderboard(runs: str | Path, out: str | Path, **kwargs: Any) -> Path:

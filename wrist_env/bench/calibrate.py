@@ -33,7 +33,8 @@ from numpy.typing import ArrayLike
 import optimizers
 from optimizers.optuna_storage import open_storage
 from wrist_env import design as design_vars
-from wrist_env.bench.log import X_COLUMNS, RunKey, RunLog
+from wrist_env.bench.log import RunLog
+from wrist_env.bench.schema import X_COLUMNS, RunKey
 from wrist_env.cost import COST_BONES
 from wrist_env.design import N_MATERIAL, Design
 from wrist_env.errors import WristEnvError

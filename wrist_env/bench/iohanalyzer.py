@@ -29,7 +29,8 @@ import numpy as np
 
 from wrist_env import design
 from wrist_env.bench.calibrate import action
-from wrist_env.bench.log import X_COLUMNS, RunLog
+from wrist_env.bench.log import RunLog
+from wrist_env.bench.schema import X_COLUMNS
 from wrist_env.design import N_MATERIAL
 from wrist_env.errors import InputError
 from wrist_env.task import task

@@ -11,14 +11,8 @@ Layout of a run directory (`RunLog(root)`)::
 
 It is a `wrist_env.runs.store.RunStore` (parts in `evals/`, records in
 `cells/`): every file is written whole or not at all (temporary name, fsync,
-`os.replace`), and a damaged file is a `StoreError` naming it. A row is one evaluation: the run key (participant, optimizer, seed,
-budget, instance: the problem instance, `participants.instances`; a log written before instances reads as
-instance 0), its index in the run (`eval`, 0-based, the optimizer's order) and
-batch (`batch`), the 22 normalized material variables (`x.<name>`), the
-kinematic cost on the calibration trial, `failed`, the RMSE of the 12
-scaphoid and lunate DOF (`rmse.<bone>.<DOF>`, mm and deg; NaN if failed),
-the `objective` the calibrator minimized (the cost, or the MAP objective), and
-`unsettled`, the frames whose hold ran out before equilibrium (null if failed).
+`os.replace`), and a damaged file is a `StoreError` naming it. A row is one evaluation, its columns
+`bench.schema.SCHEMA`.
 
 Every evaluation file and summary records the participant's model and trials it was made on
 (`wrist_env.runs.provenance`): a resume moves aside a cell made on others (`move_aside_stale`), the
@@ -38,69 +32,33 @@ import os
 import re
 import time
 from contextlib import AbstractContextManager
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 import pyarrow as pa
-import pyarrow.compute as pc
 from numpy.typing import ArrayLike
 
-from wrist_env.cost import COST_BONES
-from wrist_env.design import N_MATERIAL, NAMES
+from wrist_env.bench.schema import (
+    KEY_FIELDS,
+    RERUN,
+    RMSE_COLUMNS,
+    SCHEMA,
+    X_COLUMNS,
+    RunKey,
+    check_summary,
+    describe_problem,
+    summary_cell,
+    summary_instance,
+    with_instance,
+)
 from wrist_env.errors import StoreError, WristEnvError
-from wrist_env.frames import DOF_NAMES
 from wrist_env.io import read_json
-from wrist_env.limits import MAX_BUDGET, MAX_INSTANCE, MAX_SEED, check_int
-from wrist_env.motions import TRIAL_MOTIONS
 from wrist_env.runs import provenance
 from wrist_env.runs.store import RunStore, read_parquet, remove_file, write_parquet
 
 if TYPE_CHECKING:
     import pandas as pd
-
-KEY_FIELDS = ("participant", "optimizer", "seed", "budget", "instance")
-X_COLUMNS = tuple(f"x.{n}" for n in NAMES[:N_MATERIAL])
-RMSE_COLUMNS = tuple(f"rmse.{bone}.{dof}" for bone in COST_BONES for dof in DOF_NAMES)
-SCHEMA = pa.schema(
-    [
-        ("participant", pa.string()),
-        ("optimizer", pa.string()),
-        ("seed", pa.int64()),
-        ("budget", pa.int64()),
-        ("instance", pa.int64()),
-        ("eval", pa.int64()),
-        ("batch", pa.int64()),
-        ("time", pa.float64()),
-    ]
-    + [(c, pa.float64()) for c in X_COLUMNS]
-    + [("cost", pa.float64()), ("failed", pa.bool_())]
-    + [(c, pa.float64()) for c in RMSE_COLUMNS]
-    + [("objective", pa.float64()), ("unsettled", pa.int64())]
-)
-"""Columns of the evaluation log; `time` is the Unix time the batch finished; `objective` is the value
-the calibrator was told (the cost, or a `+prior` calibrator's MAP objective); `unsettled` the frames of
-the run whose hold ran out before equilibrium (its outputs are where the bones were then; null if the
-run failed). Both are null in logs older than them. `instance` is the problem instance (`RunKey.instance`);
-`RunLog` reads it as 0 in logs older than it."""
-
-SUMMARY_KEYS = (
-    "participant",
-    "optimizer",
-    "seed",
-    "budget",
-    "nfev",
-    "best_cost",
-    "best_eval",
-    "calibrate",
-    "validate",
-    "recovery_z",
-    "recovery_z_population",
-)
-"""Fields of a cell summary the leaderboard reads; `calibrate` and `validate` hold `SCORE_KEYS`. A summary also
-records its `instance`, read as 0 where it does not (`summary_instance`: written before instances)."""
-SCORE_KEYS = ("cost", "failed", "rmse")
 
 _PART = re.compile(r"^part-(?P<cell>.+)-b(?P<batch>\d+)-e(?P<start>\d+)-(?P<end>\d+)\.parquet$")
 _CELL = re.compile(r"^cell-(?P<cell>.+)-n(?P<n>\d+)\.parquet$")
@@ -115,106 +73,12 @@ def _span(m: re.Match) -> tuple[int, int]:
     return (int(m["start"]), int(m["end"])) if "start" in m.groupdict() else (0, int(m["n"]))
 
 
-def _check_summary(path: Path, summary) -> None:
-    """`StoreError` naming `path` if `summary` lacks a field the leaderboard reads."""
-    if not isinstance(summary, dict):
-        raise StoreError(f"{path}: not a cell summary (a JSON {type(summary).__name__}); {RERUN}")
-    missing = [k for k in SUMMARY_KEYS if k not in summary]
-    for t in TRIAL_MOTIONS:
-        if t in summary:
-            missing += [f"{t}.{k}" for k in SCORE_KEYS if not isinstance(summary[t], dict) or k not in summary[t]]
-    nfev = summary.get("nfev")
-    if not isinstance(nfev, int) or isinstance(nfev, bool):
-        missing.append("an integer nfev")
-    if missing:
-        raise StoreError(f"{path}: not a whole cell summary (no {', '.join(missing)}); {RERUN}")
-
-
-def describe_problem(participant: str, instance: int) -> str:
-    """A problem in words: "P1" for instance 0, "P1 instance 3" for instance 3."""
-    return participant if instance == 0 else f"{participant} instance {instance}"
-
-
-def summary_instance(summary: dict) -> int:
-    """The problem instance a cell summary (or a row) records; 0 for one written before instances."""
-    instance = summary.get("instance")
-    return 0 if instance is None else instance
-
-
-def key_of(summary: dict) -> RunKey:
-    """The `RunKey` of a cell summary or a row (instance 0 where it records none); `WristEnvError`,
-    `KeyError` or `TypeError` if its fields are not a key."""
-    return RunKey(**{k: summary[k] for k in KEY_FIELDS if k != "instance"}, instance=summary_instance(summary))
-
-
-def _summary_cell(summary: dict) -> str:
-    """The cell name the key fields of a summary (or a row) give (`RunKey.name`), or a description if they
-    are not a key."""
-    try:
-        return key_of(summary).name
-    except (WristEnvError, KeyError, TypeError, ValueError):
-        return f"{[summary.get(k) for k in KEY_FIELDS]} (not a cell key)"
-
-
-def _with_instance(table: pa.Table) -> pa.Table:
-    """`table` with its null `instance` (a file written before instances: pyarrow reads a missing column as
-    nulls) as instance 0."""
-    column = table.column("instance")
-    if column.null_count == 0:
-        return table
-    filled = pc.fill_null(column, 0)
-    return table.set_column(table.schema.get_field_index("instance"), "instance", filled)
-
-
 class DuplicateEvaluationError(WristEnvError, RuntimeError):
     """An attempt to log an evaluation that is already in the log."""
 
 
-@dataclass(frozen=True, order=True)
-class RunKey:
-    """One benchmark cell: a calibrator run on a problem instance of a participant (`participants.instances`;
-    0, the default, its shipped truth and trials) with a seed and a budget."""
-
-    participant: str
-    optimizer: str
-    seed: int
-    budget: int
-    instance: int = 0
-
-    def __post_init__(self):
-        check_int("seed", self.seed, 0, MAX_SEED)
-        check_int("budget", self.budget, 1, MAX_BUDGET)
-        check_int("instance", self.instance, 0, MAX_INSTANCE)
-
-    @property
-    def name(self) -> str:
-        """A file-name-safe identifier, also the Optuna study name: `P1.cmaes.seed3.budget300` on instance 0
-        (as before instances, so older logs and studies keep their names), `P1.i3.cmaes.seed3.budget300`
-        on instance 3."""
-        problem = self.participant if self.instance == 0 else f"{self.participant}.i{self.instance}"
-        safe = re.sub(r"[^A-Za-z0-9_.+-]", "_", f"{problem}.{self.optimizer}")
-        return f"{safe}.seed{self.seed}.budget{self.budget}"
-
-    @property
-    def problem(self) -> str:
-        """The problem in words: the participant, and its instance unless 0 (`describe_problem`)."""
-        return describe_problem(self.participant, self.instance)
-
-    def as_dict(self) -> dict:
-        return {
-            "participant": self.participant,
-            "instance": self.instance,
-            "optimizer": self.optimizer,
-            "seed": self.seed,
-            "budget": self.budget,
-        }
-
-
 class IncompleteCellError(StoreError):
     """A cell whose summary says it finished, but whose evaluations are not all in the log."""
-
-
-RERUN = "rerun the benchmark command (same arguments) to redo it"
 
 
 class RunLog:
@@ -392,7 +256,7 @@ class RunLog:
             cols = read_parquet(path, SCHEMA, columns=[*KEY_FIELDS, "eval"], advice=RERUN).to_pydict()
         except StoreError:
             return ""
-        cells = {_summary_cell(dict(zip(KEY_FIELDS, k))) for k in zip(*(cols[f] for f in KEY_FIELDS))}
+        cells = {summary_cell(dict(zip(KEY_FIELDS, k))) for k in zip(*(cols[f] for f in KEY_FIELDS))}
         first, end = _span(m)
         if cells != {m["cell"]}:
             return f"holds evaluations of {', '.join(sorted(cells)) or 'no cell'}, not of {m['cell']} (a copy?), re-simulated"
@@ -447,7 +311,7 @@ class RunLog:
 
     def _table(self, files) -> pa.Table:
         """The rows of `files` (`SCHEMA`; the instance of a file written before instances is 0)."""
-        return pa.concat_tables([_with_instance(read_parquet(p, SCHEMA, advice=RERUN)) for p in files])
+        return pa.concat_tables([with_instance(read_parquet(p, SCHEMA, advice=RERUN)) for p in files])
 
     def read(self, *, dedupe: bool = True) -> pd.DataFrame:
         """Every logged evaluation as a pandas DataFrame (sorted by run key and eval), duplicates dropped."""
@@ -514,8 +378,8 @@ class RunLog:
         summary = self.store.read_record(name, advice=RERUN)
         if summary is None:
             return None
-        _check_summary(self.store.record_path(name), summary)
-        named = _summary_cell(summary)
+        check_summary(self.store.record_path(name), summary)
+        named = summary_cell(summary)
         if named != name:
             raise StoreError(
                 f"{self.store.record_path(name)}: holds the summary of cell {named}, not of {name} (a copy under "

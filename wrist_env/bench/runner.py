@@ -35,7 +35,8 @@ from typing import TYPE_CHECKING
 import optimizers
 from optimizers.optuna_storage import open_storage
 from wrist_env.bench.calibrate import accepts_storage, calibrate, split_prior
-from wrist_env.bench.log import RunKey, RunLog
+from wrist_env.bench.log import RunLog
+from wrist_env.bench.schema import RunKey
 from wrist_env.errors import InputError, ParticipantError
 from wrist_env.limits import MAX_INSTANCE, MAX_SEEDS, MAX_THREADS, MAX_WORKERS, check_int, check_unique
 from wrist_env.participants import builtin, registry

@@ -25,7 +25,8 @@ from wrist_env.bench.leaderboard.tables import (
     problem_label,
     unsettled_shares,
 )
-from wrist_env.bench.log import RunLog, summary_instance
+from wrist_env.bench.log import RunLog
+from wrist_env.bench.schema import summary_instance
 from wrist_env.errors import StoreError
 from wrist_env.runs import provenance
 

@@ -13,7 +13,8 @@ from numpy.typing import ArrayLike
 
 from wrist_env.bench.leaderboard.reference import Reference, rmse_array
 from wrist_env.bench.leaderboard.statistics import ert, ert_interval
-from wrist_env.bench.log import RunLog, key_of, summary_instance
+from wrist_env.bench.log import RunLog
+from wrist_env.bench.schema import key_of, summary_instance
 
 TARGETS = (("pop×0.75", "population", 0.75), ("pop×0.5", "population", 0.5), ("truth×1.1", "truth", 1.1))
 """Cost targets (name, reference, factor): a target is factor × the reference design's cost on the
