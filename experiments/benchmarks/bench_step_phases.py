@@ -1,9 +1,9 @@
 """Benchmark: what one explicit step spends its time on, phase by phase, for both solvers.
 
 At a settled frame of the participant's calibration trial (frame 8 of the population design's
-default run: the bones in contact, the ligaments taut), each phase of `kernel._step` is called
+default run: the bones in contact, the ligaments taut), each phase of `step.explicit_step` is called
 `--repeats` times in a compiled loop at that state and timed (median of 5 loops, µs per call):
-- the force pass (`kernel.net_forces`: contact, fibres, the RSC membrane, the driver's lines), and
+- the force pass (`step.net_forces`: contact, fibres, the RSC membrane, the driver's lines), and
   its three parts alone (`contact_forces`, `fibre_forces`, `membrane_forces`);
 - the block mass's rebuild (`tangent.tangent` + `preconditioner.block_mass`), done every
   block_refresh_steps steps and at each stage;
@@ -26,7 +26,7 @@ from numba import njit
 
 from wrist_env import design
 from wrist_env.participants import registry
-from wrist_env.solver import kernel
+from wrist_env.solver import step
 from wrist_env.solver.drivers import trial_driver
 from wrist_env.solver.forces import contact_forces, fibre_forces
 from wrist_env.solver.integrator import move_blocks, move_diagonal
@@ -44,7 +44,7 @@ SOLVERS = {"diagonal mass": SolverSettings().diagonal(), "block mass (default)":
 @njit(cache=True, error_model="numpy")
 def _force_pass(n, state, work, system, design_arrays, load):
     for _ in range(n):
-        kernel.net_forces(state, work, system, design_arrays, load, np.bool_(False), np.bool_(False), True)
+        step.net_forces(state, work, system, design_arrays, load, np.bool_(False), np.bool_(False), True)
 
 
 @njit(cache=True, error_model="numpy")
@@ -121,12 +121,12 @@ def phases(name: str, settings: SolverSettings, n: int) -> dict[str, float]:
     d = stiffness(p, pop)
     R, x = pose_state(run.poses[FRAME], model.com)
     nodes = np.ascontiguousarray(run.membrane_nodes[FRAME])
-    state = kernel.State(R, x, np.zeros_like(x), np.zeros_like(x), nodes, np.zeros_like(nodes))
-    work = kernel.new_work(p.grids, nodes)
+    state = step.State(R, x, np.zeros_like(x), np.zeros_like(x), nodes, np.zeros_like(nodes))
+    work = step.new_work(p.grids, nodes)
     body, point, direction, tension = driver.kernel_load()
-    load = kernel.Load(body, point, direction, np.ascontiguousarray(tension[FRAME]))
+    load = step.Load(body, point, direction, np.ascontiguousarray(tension[FRAME]))
     system = p.system
-    kernel.net_forces(state, work, system, d, load, True, False, True)  # fill the active sets
+    step.net_forces(state, work, system, d, load, True, False, True)  # fill the active sets
     m = metric()
     out = {
         "force pass (net_forces)": median_us(lambda k: _force_pass(k, state, work, system, d, load), n),
@@ -143,7 +143,7 @@ def phases(name: str, settings: SolverSettings, n: int) -> dict[str, float]:
         out[f"membrane substeps ({settings.membrane_substeps} a step)"] = median_us(
             lambda k: _substeps(k, state._replace(nodes=nodes.copy()), system, d, scratch), n
         )
-    kernel.net_forces(state, work, system, d, load, True, False, True)
+    step.net_forces(state, work, system, d, load, True, False, True)
     if settings.block_mass:
         _rebuild(1, state, work, system, d, m)
     out["update (move_blocks)" if settings.block_mass else "update (move_diagonal)"] = median_us(

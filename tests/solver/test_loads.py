@@ -7,7 +7,7 @@ import pytest
 from wrist_env import design
 from wrist_env.anatomy.tendons import load_tendons, model_lines
 from wrist_env.model import BODY_PARTS, BONES, LUNATE
-from wrist_env.solver import kernel
+from wrist_env.solver import step
 from wrist_env.solver.drivers import Loads, loaded, loads
 from wrist_env.solver.simulate import prepare, stiffness
 
@@ -46,10 +46,10 @@ def test_a_line_adds_its_force_and_its_moment_about_the_centre_of_mass(p1):
 
     def forces(tension):
         nodes = np.array(p1.membrane_nodes, dtype=np.float64)
-        state = kernel.State(R.copy(), x.copy(), np.zeros_like(x), np.zeros_like(x), nodes, np.zeros_like(nodes))
-        work = kernel.new_work(p.grids, nodes)
+        state = step.State(R.copy(), x.copy(), np.zeros_like(x), np.zeros_like(x), nodes, np.zeros_like(nodes))
+        work = step.new_work(p.grids, nodes)
         load = with_line.kernel_load(0)._replace(tension=np.array([tension]))
-        kernel.net_forces(state, work, p.system, design_arrays, load, True, True, p.settings.smooth_normals)
+        step.net_forces(state, work, p.system, design_arrays, load, True, True, p.settings.smooth_normals)
         return work.F.copy(), work.T.copy()
 
     F0, T0 = forces(0.0)

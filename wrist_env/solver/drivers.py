@@ -21,7 +21,7 @@ from wrist_env.anatomy.tendons import model_lines
 from wrist_env.errors import InputError
 from wrist_env.limits import MAX_FRAMES, MAX_SWEEP_DEG, check_float, check_int
 from wrist_env.model import CAPITATE, Model
-from wrist_env.solver import arrays, kernel
+from wrist_env.solver import arrays, step
 from wrist_env.solver.settings import DEFAULT_LOADS, JIG, LOAD_DIRECTIONS
 
 if TYPE_CHECKING:
@@ -64,10 +64,10 @@ class Driver:
             return np.ascontiguousarray(self.load_n[:, None] * self.loads.share)
         return self.load_n[frame] * self.loads.share
 
-    def kernel_load(self, frame: int | None = None) -> kernel.Load:
-        """The lines of action as the kernel takes them (`kernel.Load`), tensions as `load(frame)`."""
+    def kernel_load(self, frame: int | None = None) -> step.Load:
+        """The lines of action as the kernel takes them (`step.Load`), tensions as `load(frame)`."""
         lines = self.loads
-        return kernel.Load(
+        return step.Load(
             np.ascontiguousarray(lines.body, dtype=np.int64),
             np.ascontiguousarray(lines.point, dtype=np.float64),
             np.ascontiguousarray(lines.direction, dtype=np.float64),

@@ -19,7 +19,7 @@ from scipy.optimize import least_squares
 
 from wrist_env.design import Design
 from wrist_env.model import CAPITATE, FREE, Model
-from wrist_env.solver import arrays, kernel, preconditioner
+from wrist_env.solver import arrays, preconditioner, step
 from wrist_env.solver.rigid import LEVER_MM, pose_state, pose_translation, rotate_in_place
 from wrist_env.solver.settings import SolverSettings
 from wrist_env.solver.simulate import prepare, stiffness
@@ -60,9 +60,9 @@ def _residual(q, R0, x0, nodes0, free_nodes, system, stiffness, load, out):
     loaded = system.settings.driver == arrays.LOADED
     R, x, nodes = moved_state(q, R0, x0, nodes0, free_nodes, loaded)
     n_bones = R.shape[0]
-    state = kernel.State(R, x, np.zeros((n_bones, 3)), np.zeros((n_bones, 3)), nodes, np.zeros_like(nodes))
-    work = kernel.new_work(system.grids, nodes)
-    kernel.net_forces(state, work, system, stiffness, load, True, True, system.settings.smooth_normals)
+    state = step.State(R, x, np.zeros((n_bones, 3)), np.zeros((n_bones, 3)), nodes, np.zeros_like(nodes))
+    work = step.new_work(system.grids, nodes)
+    step.net_forces(state, work, system, stiffness, load, True, True, system.settings.smooth_normals)
     F, T, node_force = work.F, work.T, work.node_force
     k = 0
     for b in FREE:
@@ -264,12 +264,10 @@ def block_mass(
     R0, x0, nodes0 = _frame_args(p, st, free_nodes, driver, result, frame)[:3]
     n_bones = n_unknown - 3 * len(free_nodes)
     g = p.grids
-    state = kernel.State(
-        R0.copy(), x0.copy(), np.zeros_like(x0), np.zeros_like(x0), nodes0.copy(), np.zeros_like(nodes0)
-    )
-    work = kernel.new_work(g, nodes0)
+    state = step.State(R0.copy(), x0.copy(), np.zeros_like(x0), np.zeros_like(x0), nodes0.copy(), np.zeros_like(nodes0))
+    work = step.new_work(g, nodes0)
     load = driver.kernel_load(frame)
-    kernel.net_forces(state, work, p.system, st, load, True, True, p.settings.smooth_normals)
+    step.net_forces(state, work, p.system, st, load, True, True, p.settings.smooth_normals)
     m = preconditioner.metric()
     tangent(state.R, state.x, state.nodes, p.system, st, work.active, work.n_active, m, p.settings.smooth_normals)
     preconditioner.block_mass(state.R, p.bodies, p.settings, m)

@@ -29,7 +29,7 @@ from numba import njit
 
 from wrist_env.design import ALL_LIGAMENT_NAMES, RSC_INDEX
 from wrist_env.model import BONES, CAPITATE, FREE, PAIRS
-from wrist_env.solver.arrays import EXPERIMENTAL, LOADED, System
+from wrist_env.solver.arrays import LOADED, System
 from wrist_env.solver.forces import (
     C_AREA,
     C_FORCE,
@@ -38,19 +38,14 @@ from wrist_env.solver.forces import (
     R_FORCE,
     R_MEAN,
     R_PEAK,
-    apply_force,
-    contact_forces,
-    fibre_forces,
-    joint_forces,
-    to_world,
 )
-from wrist_env.solver.integrator import fire_step, kinetic_energy, move_blocks, move_diagonal
-from wrist_env.solver.membrane import membrane_forces, new_scratch, place_nodes, substep
-from wrist_env.solver.preconditioner import SOLVED, block_mass, metric
-from wrist_env.solver.predictor import capitate_move, history, predict, record
-from wrist_env.solver.rigid import copy_into, interpolate_pose, orthonormalize, rotvec_between, smoothstep
-from wrist_env.solver.stopping import converged, displacement, residual
-from wrist_env.solver.tangent import tangent
+from wrist_env.solver.integrator import kinetic_energy
+from wrist_env.solver.membrane import new_scratch
+from wrist_env.solver.preconditioner import SOLVED, metric
+from wrist_env.solver.predictor import capitate_move, history, record
+from wrist_env.solver.rigid import copy_into, interpolate_pose, rotvec_between, smoothstep
+from wrist_env.solver.step import Load, State, explicit_step, net_forces, new_work, predicted_start
+from wrist_env.solver.stopping import converged, displacement
 
 N_BONES, N_PAIRS = len(BONES), len(PAIRS)
 N_LIGAMENTS = len(ALL_LIGAMENT_NAMES)
@@ -58,165 +53,6 @@ RSC = RSC_INDEX
 OK, FAILED_NAN, FAILED_DIVERGED = 0, 1, 2
 
 
-@njit(cache=True, error_model="numpy")
-def net_forces(state, work, system, stiffness, load, rebuild, want_energy, smooth):
-    """Forces F (N), torques T (N·mm), contact stats and bundle forces (all in `work`) at `state`
-    (`State`) of `system` (`arrays.System`) under a design's `stiffness` and the driver's `load`; with
-    `rebuild`, every pair's active contact samples are refilled first (otherwise a pair refills when
-    its samples may have moved half the band); returns internal energy (N·mm; 0 unless `want_energy`)."""
-    bod, grids, law, fib, mem, st = system
-    R, x, v, w, nodes, _ = state
-    active, n_active, ref, F, T, node_force, stats, bundle = work
-    f_l0, f_K, m_l0, m_K, _ = stiffness
-    com0 = bod.com0
-    if rebuild:
-        ref[:] = np.nan
-    place_nodes(R, x, com0, mem, nodes)
-    F[:] = 0.0
-    T[:] = 0.0
-    bundle[:] = 0.0
-    band = st.active_band_mm
-    energy = contact_forces(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, want_energy, smooth)
-    energy += fibre_forces(R, x, v, w, com0, fib, f_l0, f_K, st.fibre_damping_s, F, T, bundle, want_energy)
-    energy += joint_forces(R, x, com0, bod, F, T, want_energy)
-    k_mem = st.membrane_contact_stiffness
-    e_mem, rsc = membrane_forces(R, x, com0, mem, nodes, m_l0, m_K, k_mem, F, T, node_force, want_energy, smooth)
-    energy += e_mem
-    bundle[RSC] += rsc
-    tension = load.tension
-    for i in range(tension.shape[0]):  # the driver's lines of action (`Load`)
-        if tension[i] != 0.0:
-            b = load.body[i]
-            p, u = load.point[i], load.direction[i]
-            px, py, pz = to_world(R, x, com0, b, p[0], p[1], p[2])
-            apply_force(F, T, x, b, tension[i] * u[0], tension[i] * u[1], tension[i] * u[2], px, py, pz)
-    return energy
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def _step(
-    state, work, system, stiffness, capR, capx, load, step_index, fire, m, refresh, scratch, smooth, preconditioned
-):
-    """One explicit step with the capitate at target (capR, capx), or, for the loaded
-    driver, at rotation capR; `load` (`Load`) the driver's lines of action at this step's tensions; with st.block_mass and
-    `refresh`, the block mass m (`preconditioner.Metric`) is rebuilt at this state first; with
-    st.membrane_substeps the membrane's free nodes then take that many more steps of their own
-    (`membrane.substep`; scratch its arrays)."""
-    bod, _, _, _, mem, st = system
-    R, x, v, w, nodes, nv = state
-    active, n_active, _, F, T, node_force, _, _ = work
-    copy_into(R[CAPITATE], capR)
-    if st.driver == EXPERIMENTAL:
-        x[CAPITATE, 0], x[CAPITATE, 1], x[CAPITATE, 2] = capx
-        v[CAPITATE] = 0.0
-    w[CAPITATE] = 0.0
-    net_forces(state, work, system, stiffness, load, np.bool_(False), np.bool_(False), smooth)
-    blocks = False
-    if preconditioned:  # a compile-time constant: see `_run`
-        blocks = st.block_mass
-        if blocks and refresh:
-            tangent(R, x, nodes, system, stiffness, active, n_active, m, smooth)
-            block_mass(R, bod, st, m)
-    if st.fire_alpha0 > 0.0:
-        fire_step(v, w, nv, F, T, node_force, mem, st, fire, m, preconditioned)
-    dt = st.dt
-    lin = 1.0 / (1.0 + st.damping * dt)
-    if blocks:
-        move_blocks(R, x, v, w, F, T, st, m)
-    else:
-        move_diagonal(R, x, v, w, F, T, bod, st)
-    if stiffness.node_mass > 0.0:
-        for i in range(nodes.shape[0]):
-            if mem.bone[i] < 0:
-                for k in range(3):
-                    nv[i, k] = (nv[i, k] + dt / stiffness.node_mass * node_force[i, k]) * lin
-                    nodes[i, k] += dt * nv[i, k]
-        if preconditioned:
-            if st.membrane_substeps > 0:
-                place_nodes(R, x, bod.com0, mem, nodes)
-                substep(
-                    R,
-                    x,
-                    bod.com0,
-                    mem,
-                    nodes,
-                    nv,
-                    stiffness.m_l0,
-                    stiffness.m_K,
-                    stiffness.node_mass,
-                    st,
-                    scratch,
-                    smooth,
-                )
-    if step_index % 100 == 0:
-        for b in FREE:
-            orthonormalize(R[b])
-
-
-@njit(cache=True, error_model="numpy")
-def _predicted(state, work, system, stiffness, hist, capR, capx, load, move, smooth):
-    """Start the next stage, whose capitate pose is (capR, capx) under `load`, from the secant
-    predictor's state (`predictor.predict`) if the free bodies' residual there, with the capitate
-    already at that pose, is below their residual left where they are; True if so (the state is
-    the prediction), False if not (the positions are restored; the velocities, ~0 at the end of a
-    hold, stay zeroed)."""
-    mem, st = system.membrane, system.settings
-    R, x, v, w, nodes, nv = state
-    keep_R, keep_x, keep_nodes = R.copy(), x.copy(), nodes.copy()
-    copy_into(R[CAPITATE], capR)
-    if st.driver == EXPERIMENTAL:
-        copy_into(x[CAPITATE], capx)
-    net_forces(state, work, system, stiffness, load, np.bool_(False), np.bool_(False), smooth)
-    before = residual(work.F, work.T, st)
-    if not predict(hist, R, x, v, w, nodes, nv, mem, st, move):
-        _restore(R, x, nodes, keep_R, keep_x, keep_nodes)
-        return False
-    net_forces(state, work, system, stiffness, load, np.bool_(False), np.bool_(False), smooth)
-    if residual(work.F, work.T, st) < before:
-        return True
-    _restore(R, x, nodes, keep_R, keep_x, keep_nodes)
-    return False
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def _restore(R, x, nodes, keep_R, keep_x, keep_nodes):
-    copy_into(R, keep_R)
-    copy_into(x, keep_x)
-    copy_into(nodes, keep_nodes)
-
-
-State = namedtuple("State", ["R", "x", "v", "w", "nodes", "nv"])
-"""A run's mutable state: rotations (5, 3, 3), centres of mass (5, 3) mm, velocities (5, 3) mm/s and
-angular velocities (5, 3) rad/s of the bodies; RSC membrane node positions (M, 3) mm and velocities."""
-Work = namedtuple("Work", ["active", "n_active", "ref", "F", "T", "node_force", "stats", "bundle"])
-"""A run's scratch: active contact samples, their count per pair and the pair transforms when they
-were filled (n_pairs, 12; NaN to refill), forces (5, 3) N and torques
-(5, 3) N·mm on the bodies, membrane node forces (M, 3) N, per-pair contact stats, bundle forces (N)."""
-
-
-@njit(cache=True)
-def new_work(grids, nodes):
-    """A zeroed `Work` for the contact grids and a membrane of nodes (M, 3)."""
-    n_pairs = grids.pair_bones.shape[0]
-    return Work(
-        np.zeros(grids.points.shape[0], np.int64),
-        np.zeros(n_pairs, np.int64),
-        np.full((n_pairs, 12), np.nan),
-        np.zeros((N_BONES, 3)),
-        np.zeros((N_BONES, 3)),
-        np.zeros_like(nodes),
-        np.zeros((n_pairs, 3)),
-        np.zeros(N_LIGAMENTS),
-    )
-
-
-Stiffness = namedtuple("Stiffness", ["f_l0", "f_K", "m_l0", "m_K", "node_mass"])
-"""A design's zero-load lengths (mm) and stiffnesses of the fibres and the membrane connectors, and the
-membrane's free-node mass (t) its connectors need (`arrays.node_mass`)."""
-Load = namedtuple("Load", ["body", "point", "direction", "tension"])
-"""The driver's loads as lines of action (the tendons where they enter, `drivers.Loads`): each line's
-body (n_lines,) int64, point (n_lines, 3) mm fixed in the body (RCS at neutral), direction (n_lines, 3)
-unit, RCS, and tension N: (n_lines,) at one state, (n_frames, n_lines) per frame in `Frames`."""
 Frames = namedtuple("Frames", ["rotation", "com", "tension", "body", "point", "direction"])
 """The capitate's targets per frame: rotation (n_frames, 3, 3), centre of mass (n_frames, 3) mm (for the
 loaded driver only the start: the centre is free); the loads per frame, tension (n_frames, n_lines) N on
@@ -331,7 +167,7 @@ def _run(system, stiffness, frames, out, R, x, nodes, first, smooth, preconditio
                 st.predict
                 and st.driver == LOADED
                 and f > 0
-                and _predicted(state, work, system, stiffness, hist, Rb, xb, at_end, move, smooth)
+                and predicted_start(state, work, system, stiffness, hist, Rb, xb, at_end, move, smooth)
             ):
                 ramp = st.predict_ramp_steps
                 fire[0], fire[1], fire[2] = st.fire_alpha0, 0.0, 1.0
@@ -406,7 +242,7 @@ def _ramp_and_hold(
             load.tension[i] = la[i] + s * (lb[i] - la[i])
         refresh = k % st.block_refresh_steps == 0 or (st.block_refresh_restart and fire[2] > 0.0)
         fire[2] = 0.0
-        _step(
+        explicit_step(
             state,
             work,
             system,

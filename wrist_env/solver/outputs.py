@@ -91,20 +91,20 @@ def driven_body_load(
     """The net force (3,) N and moment (3,) N·mm, RCS, of every force on the driven capitate body at one
     frame's poses (6, 4, 4) and RSC membrane nodes (M, 3) (a `Result`'s `poses[f]`, `membrane_nodes[f]`):
     its contacts, ligaments, the membrane and `driver`'s lines at `frame` (`Driver.kernel_load`), summed
-    by the solver's own force kernel (`kernel.net_forces`), the moment about the capitate's centre of
+    by the solver's own force kernel (`step.net_forces`), the moment about the capitate's centre of
     mass where the poses put it. The driver holds the opposite: at a loaded driver's equilibrium the
     force is ~0 (its translations are free) and the moment is what the prescribed rotation absorbs
     (about z flexion +, x ulnar deviation +, y pronation +: `cardan_deg`'s senses for a right wrist)."""
     from wrist_env.model import CAPITATE
-    from wrist_env.solver import kernel, simulate
+    from wrist_env.solver import simulate, step
 
     p = simulate.prepare(model, None, driver.mode)
     R, x = _state(model, pose_frame)
     nodes = np.array(membrane_nodes, dtype=np.float64)
-    state = kernel.State(R, x, np.zeros_like(x), np.zeros_like(x), nodes, np.zeros_like(nodes))
-    work = kernel.new_work(p.grids, nodes)
+    state = step.State(R, x, np.zeros_like(x), np.zeros_like(x), nodes, np.zeros_like(nodes))
+    work = step.new_work(p.grids, nodes)
     load = driver.kernel_load(frame)
-    kernel.net_forces(state, work, p.system, simulate.stiffness(p, design), load, True, True, p.settings.smooth_normals)
+    step.net_forces(state, work, p.system, simulate.stiffness(p, design), load, True, True, p.settings.smooth_normals)
     return work.F[CAPITATE].copy(), work.T[CAPITATE].copy()
 
 

@@ -15,7 +15,7 @@ from numba import typeof, types
 
 from wrist_env.design import population
 from wrist_env.model import N_BODIES
-from wrist_env.solver import arrays, kernel, membrane, preconditioner, tangent
+from wrist_env.solver import arrays, membrane, preconditioner, step, tangent
 from wrist_env.solver.precompile import NORMALS
 from wrist_env.solver.settings import SolverSettings
 
@@ -31,7 +31,7 @@ def part_signatures(settings: SolverSettings) -> list[tuple[object, tuple]]:
     R, x = np.zeros((N_BODIES, 3, 3)), np.zeros((N_BODIES, 3))
     nodes = np.zeros((len(p.model.membrane_nodes), 3))
     design = stiffness(p, population())
-    work = kernel.new_work(p.grids, nodes)
+    work = step.new_work(p.grids, nodes)
     m = preconditioner.metric()
     smooth = types.literal(bool(settings.smooth_normals))  # a compile-time constant in the entry point
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from wrist_env.design import ALL_LIGAMENT_NAMES, Design, population
 from wrist_env.model import N_BODIES, PAIRS, Model
-from wrist_env.solver import arrays, kernel, precompile
+from wrist_env.solver import arrays, kernel, precompile, step
 from wrist_env.solver.drivers import Driver, static
 from wrist_env.solver.rigid import pose_state
 from wrist_env.solver.settings import SolverSettings
@@ -125,10 +125,10 @@ def prepare(model: Model, settings: SolverSettings | None = None, mode: int = ar
     )
 
 
-def stiffness(p: Prepared, design: Design) -> kernel.Stiffness:
+def stiffness(p: Prepared, design: Design) -> step.Stiffness:
     """The kernel's per-design arrays (`arrays.design_arrays`) and the membrane's node mass (`arrays.node_mass`)."""
     f_l0, f_K, m_l0, m_K = arrays.design_arrays(p.model, p.fibres, p.membrane, design)
-    return kernel.Stiffness(f_l0, f_K, m_l0, m_K, arrays.node_mass(p.settings, p.membrane_eigenvalue, m_l0, m_K))
+    return step.Stiffness(f_l0, f_K, m_l0, m_K, arrays.node_mass(p.settings, p.membrane_eigenvalue, m_l0, m_K))
 
 
 def _prepared(model, settings, driver, prepared) -> Prepared:
@@ -156,7 +156,7 @@ def simulate(
     return _result(out, driver, int(out.status[0]))
 
 
-def _run(entry, p: Prepared, design: kernel.Stiffness, frames: kernel.Frames, out: kernel.Outputs) -> None:
+def _run(entry, p: Prepared, design: step.Stiffness, frames: kernel.Frames, out: kernel.Outputs) -> None:
     """The kernel's `entry` point (`kernel.entry`) for one design from rest (rotations identity, bones and
     membrane nodes at their neutral places), filling `out`."""
     R = np.repeat(np.eye(3)[None], N_BODIES, axis=0)

@@ -1,0 +1,190 @@
+"""One explicit step of the solver (Numba): the forces at a state (`net_forces`), the step that moves the free
+bodies under them (`explicit_step`), the secant predictor's start of a stage (`predicted_start`), and the
+state, scratch, design and load tuples they read (`State`, `Work`, `Stiffness`, `Load`). `kernel` runs them
+stage by stage; `equilibrium` and `outputs` call `net_forces` alone.
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+
+import numpy as np
+from numba import njit
+
+from wrist_env.design import ALL_LIGAMENT_NAMES, RSC_INDEX
+from wrist_env.model import BONES, CAPITATE, FREE
+from wrist_env.solver.arrays import EXPERIMENTAL
+from wrist_env.solver.forces import apply_force, contact_forces, fibre_forces, joint_forces, to_world
+from wrist_env.solver.integrator import fire_step, move_blocks, move_diagonal
+from wrist_env.solver.membrane import membrane_forces, place_nodes, substep
+from wrist_env.solver.preconditioner import block_mass
+from wrist_env.solver.predictor import predict
+from wrist_env.solver.rigid import copy_into, orthonormalize
+from wrist_env.solver.stopping import residual
+from wrist_env.solver.tangent import tangent
+
+N_BONES = len(BONES)
+N_LIGAMENTS = len(ALL_LIGAMENT_NAMES)
+RSC = RSC_INDEX
+
+
+@njit(cache=True, error_model="numpy")
+def net_forces(state, work, system, stiffness, load, rebuild, want_energy, smooth):
+    """Forces F (N), torques T (N·mm), contact stats and bundle forces (all in `work`) at `state`
+    (`State`) of `system` (`arrays.System`) under a design's `stiffness` and the driver's `load`; with
+    `rebuild`, every pair's active contact samples are refilled first (otherwise a pair refills when
+    its samples may have moved half the band); returns internal energy (N·mm; 0 unless `want_energy`)."""
+    bod, grids, law, fib, mem, st = system
+    R, x, v, w, nodes, _ = state
+    active, n_active, ref, F, T, node_force, stats, bundle = work
+    f_l0, f_K, m_l0, m_K, _ = stiffness
+    com0 = bod.com0
+    if rebuild:
+        ref[:] = np.nan
+    place_nodes(R, x, com0, mem, nodes)
+    F[:] = 0.0
+    T[:] = 0.0
+    bundle[:] = 0.0
+    band = st.active_band_mm
+    energy = contact_forces(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, want_energy, smooth)
+    energy += fibre_forces(R, x, v, w, com0, fib, f_l0, f_K, st.fibre_damping_s, F, T, bundle, want_energy)
+    energy += joint_forces(R, x, com0, bod, F, T, want_energy)
+    k_mem = st.membrane_contact_stiffness
+    e_mem, rsc = membrane_forces(R, x, com0, mem, nodes, m_l0, m_K, k_mem, F, T, node_force, want_energy, smooth)
+    energy += e_mem
+    bundle[RSC] += rsc
+    tension = load.tension
+    for i in range(tension.shape[0]):  # the driver's lines of action (`Load`)
+        if tension[i] != 0.0:
+            b = load.body[i]
+            p, u = load.point[i], load.direction[i]
+            px, py, pz = to_world(R, x, com0, b, p[0], p[1], p[2])
+            apply_force(F, T, x, b, tension[i] * u[0], tension[i] * u[1], tension[i] * u[2], px, py, pz)
+    return energy
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def explicit_step(
+    state, work, system, stiffness, capR, capx, load, step_index, fire, m, refresh, scratch, smooth, preconditioned
+):
+    """One explicit step with the capitate at target (capR, capx), or, for the loaded
+    driver, at rotation capR; `load` (`Load`) the driver's lines of action at this step's tensions; with st.block_mass and
+    `refresh`, the block mass m (`preconditioner.Metric`) is rebuilt at this state first; with
+    st.membrane_substeps the membrane's free nodes then take that many more steps of their own
+    (`membrane.substep`; scratch its arrays)."""
+    bod, _, _, _, mem, st = system
+    R, x, v, w, nodes, nv = state
+    active, n_active, _, F, T, node_force, _, _ = work
+    copy_into(R[CAPITATE], capR)
+    if st.driver == EXPERIMENTAL:
+        x[CAPITATE, 0], x[CAPITATE, 1], x[CAPITATE, 2] = capx
+        v[CAPITATE] = 0.0
+    w[CAPITATE] = 0.0
+    net_forces(state, work, system, stiffness, load, np.bool_(False), np.bool_(False), smooth)
+    blocks = False
+    if preconditioned:  # a compile-time constant: see `_run`
+        blocks = st.block_mass
+        if blocks and refresh:
+            tangent(R, x, nodes, system, stiffness, active, n_active, m, smooth)
+            block_mass(R, bod, st, m)
+    if st.fire_alpha0 > 0.0:
+        fire_step(v, w, nv, F, T, node_force, mem, st, fire, m, preconditioned)
+    dt = st.dt
+    lin = 1.0 / (1.0 + st.damping * dt)
+    if blocks:
+        move_blocks(R, x, v, w, F, T, st, m)
+    else:
+        move_diagonal(R, x, v, w, F, T, bod, st)
+    if stiffness.node_mass > 0.0:
+        for i in range(nodes.shape[0]):
+            if mem.bone[i] < 0:
+                for k in range(3):
+                    nv[i, k] = (nv[i, k] + dt / stiffness.node_mass * node_force[i, k]) * lin
+                    nodes[i, k] += dt * nv[i, k]
+        if preconditioned:
+            if st.membrane_substeps > 0:
+                place_nodes(R, x, bod.com0, mem, nodes)
+                substep(
+                    R,
+                    x,
+                    bod.com0,
+                    mem,
+                    nodes,
+                    nv,
+                    stiffness.m_l0,
+                    stiffness.m_K,
+                    stiffness.node_mass,
+                    st,
+                    scratch,
+                    smooth,
+                )
+    if step_index % 100 == 0:
+        for b in FREE:
+            orthonormalize(R[b])
+
+
+@njit(cache=True, error_model="numpy")
+def predicted_start(state, work, system, stiffness, hist, capR, capx, load, move, smooth):
+    """Start the next stage, whose capitate pose is (capR, capx) under `load`, from the secant
+    predictor's state (`predictor.predict`) if the free bodies' residual there, with the capitate
+    already at that pose, is below their residual left where they are; True if so (the state is
+    the prediction), False if not (the positions are restored; the velocities, ~0 at the end of a
+    hold, stay zeroed)."""
+    mem, st = system.membrane, system.settings
+    R, x, v, w, nodes, nv = state
+    keep_R, keep_x, keep_nodes = R.copy(), x.copy(), nodes.copy()
+    copy_into(R[CAPITATE], capR)
+    if st.driver == EXPERIMENTAL:
+        copy_into(x[CAPITATE], capx)
+    net_forces(state, work, system, stiffness, load, np.bool_(False), np.bool_(False), smooth)
+    before = residual(work.F, work.T, st)
+    if not predict(hist, R, x, v, w, nodes, nv, mem, st, move):
+        restore(R, x, nodes, keep_R, keep_x, keep_nodes)
+        return False
+    net_forces(state, work, system, stiffness, load, np.bool_(False), np.bool_(False), smooth)
+    if residual(work.F, work.T, st) < before:
+        return True
+    restore(R, x, nodes, keep_R, keep_x, keep_nodes)
+    return False
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def restore(R, x, nodes, keep_R, keep_x, keep_nodes):
+    copy_into(R, keep_R)
+    copy_into(x, keep_x)
+    copy_into(nodes, keep_nodes)
+
+
+State = namedtuple("State", ["R", "x", "v", "w", "nodes", "nv"])
+"""A run's mutable state: rotations (n_bodies, 3, 3), centres of mass (n_bodies, 3) mm, velocities
+(n_bodies, 3) mm/s and angular velocities (n_bodies, 3) rad/s of the bodies; RSC membrane node positions
+(n_nodes, 3) mm and velocities (n_nodes, 3) mm/s."""
+Work = namedtuple("Work", ["active", "n_active", "ref", "F", "T", "node_force", "stats", "bundle"])
+"""A run's scratch: active contact samples, their count per pair and the pair transforms when they
+were filled (n_pairs, 12; NaN to refill), forces (n_bodies, 3) N and torques (n_bodies, 3) N·mm on the
+bodies, membrane node forces (n_nodes, 3) N, per-pair contact stats (n_pairs, 3), bundle forces (n_ligaments,) N."""
+
+
+@njit(cache=True)
+def new_work(grids, nodes):
+    """A zeroed `Work` for the contact grids and a membrane of nodes (n_nodes, 3)."""
+    n_pairs = grids.pair_bones.shape[0]
+    return Work(
+        np.zeros(grids.points.shape[0], np.int64),
+        np.zeros(n_pairs, np.int64),
+        np.full((n_pairs, 12), np.nan),
+        np.zeros((N_BONES, 3)),
+        np.zeros((N_BONES, 3)),
+        np.zeros_like(nodes),
+        np.zeros((n_pairs, 3)),
+        np.zeros(N_LIGAMENTS),
+    )
+
+
+Stiffness = namedtuple("Stiffness", ["f_l0", "f_K", "m_l0", "m_K", "node_mass"])
+"""A design's zero-load lengths (mm) and stiffnesses of the fibres and the membrane connectors, and the
+membrane's free-node mass (t) its connectors need (`arrays.node_mass`)."""
+Load = namedtuple("Load", ["body", "point", "direction", "tension"])
+"""The driver's loads as lines of action (the tendons where they enter, `drivers.Loads`): each line's
+body (n_lines,) int64, point (n_lines, 3) mm fixed in the body (RCS at neutral), direction (n_lines, 3)
+unit, RCS, and tension N: (n_lines,) at one state, (n_frames, n_lines) per frame in `Frames`."""
