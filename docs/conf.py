@@ -20,9 +20,9 @@ myst_enable_extensions = ["dollarmath"]
 autodoc_member_order = "bysource"
 autodoc_typehints = "description"
 autodoc_default_options = {"members": True, "undoc-members": False}
-html_theme = "alabaster"
+html_theme = "furo"  # the maintained theme Gymnasium's docs use: a navigation sidebar, light and dark
 html_title = "wrist-env"
-html_theme_options = {"description": "Participant-specific wrist models as a Gymnasium environment and a benchmark"}
+html_theme_options = {"navigation_with_keys": True}
 
 
 def plain_docstrings(app, what, name, obj, options, lines):
