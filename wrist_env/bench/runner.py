@@ -18,7 +18,7 @@ Local processes: `workers` processes (default: one per core), each with
 machine two single-threaded processes beat one process with two threads:
 calibrators that ask one point at a time (Nelder–Mead, a TPE step, the
 surrogate's search) cannot fill two threads, and a batch's slowest design
-holds the other thread idle (README, "Benchmark", has the measurement).
+holds the other thread idle (docs/history.md, "The benchmark", has the measurement).
 """
 
 from __future__ import annotations
