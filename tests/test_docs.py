@@ -211,3 +211,21 @@ def test_the_layout_page_names_every_module_and_no_other():
         if p.name != "__init__.py" or p.parent.name == "wrist_env"
     }
     assert listed == tree, {"not listed": sorted(tree - listed), "listed, not there": sorted(listed - tree)}
+
+
+EXTENDING = DOCS / "extending.md"
+CODE_PATH = r"(?:wrist_env|optimizers|tests|experiments)/[\w./-]+"
+
+
+def test_the_extending_page_names_only_files_and_names_that_exist():
+    """Every path the Extending page names is in the tree, and every `NAME` it places "in `path`" is in that
+    file: the walk-throughs follow the code when it moves."""
+    text = EXTENDING.read_text()
+    paths = set(re.findall(rf"`({CODE_PATH})`", text))
+    assert len(paths) >= 30, sorted(paths)
+    missing = sorted(p for p in paths if not (ROOT / p).exists())
+    assert not missing, f"docs/extending.md names paths that do not exist: {missing}"
+    placed = re.findall(rf"`(\w+)`\s+in\s+`({CODE_PATH}\.py)`", text)
+    assert len(placed) >= 8, placed
+    absent = [(name, path) for name, path in placed if not re.search(rf"\b{name}\b", (ROOT / path).read_text())]
+    assert not absent, f"docs/extending.md places names in files that do not hold them: {absent}"
