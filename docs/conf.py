@@ -12,14 +12,39 @@ sys.path.insert(0, str(Path(__file__).parent / "_ext"))
 project = "wrist-env"
 author = "the wrist-env developers"
 copyright = "2026, the wrist-env developers"
-extensions = ["myst_parser", "sphinx.ext.autodoc", "sphinx.ext.napoleon", "sphinx.ext.viewcode", "results"]
-source_suffix = {".md": "markdown"}
-exclude_patterns = ["_build", "speed"]  # speed/: tables the benchmark scripts write, included by solver.md
+extensions = [
+    "myst_parser",
+    "sphinx.ext.autodoc",
+    "sphinx.ext.napoleon",
+    "sphinx.ext.viewcode",
+    "sphinx_gallery.gen_gallery",
+    "results",
+]
+source_suffix = {".md": "markdown", ".rst": "restructuredtext"}  # .rst: the pages sphinx-gallery writes
+# speed/: tables the benchmark scripts write, included by solver.md; examples/: the gallery's sources, which
+# sphinx-gallery turns into auto_examples/
+exclude_patterns = ["_build", "speed", "examples"]
 myst_heading_anchors = 4
 myst_enable_extensions = ["dollarmath"]
 autodoc_member_order = "bysource"
 autodoc_typehints = "description"
 autodoc_default_options = {"members": True, "undoc-members": False}
+sphinx_gallery_conf = {
+    # docs/examples/plot_*.py, each run at build time (small budgets), rendered with its output and figures
+    # into docs/auto_examples/ (git-ignored). An example that raises fails the build.
+    "examples_dirs": "examples",
+    "gallery_dirs": "auto_examples",
+    "filename_pattern": r"/plot_",
+    "within_subsection_order": "FileNameSortKey",
+    "abort_on_example_error": True,
+    "download_all_examples": False,
+    "remove_config_comments": True,
+    "show_memory": False,
+    "image_scrapers": ("matplotlib",),
+}
+napoleon_numpy_docstring = True
+napoleon_google_docstring = False
+napoleon_use_rtype = False  # the return type beside its description, as numpydoc renders it
 html_theme = "furo"  # the maintained theme Gymnasium's docs use: a navigation sidebar, light and dark
 html_title = "wrist-env"
 html_theme_options = {"navigation_with_keys": True}
