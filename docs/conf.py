@@ -4,6 +4,8 @@ Build: `sphinx-build -W -b html docs docs/_build/html` (warnings are errors; the
 The results pages are rendered from the committed results files at build time (`_ext/results.py`).
 """
 
+import inspect
+import re
 import sys
 from pathlib import Path
 
@@ -28,6 +30,7 @@ myst_heading_anchors = 4
 myst_enable_extensions = ["dollarmath"]
 autodoc_member_order = "bysource"
 autodoc_typehints = "description"
+autodoc_type_aliases = {"ArrayLike": "ArrayLike", "DTypeLike": "DTypeLike"}  # not numpy's expanded unions
 autodoc_default_options = {"members": True, "undoc-members": False}
 sphinx_gallery_conf = {
     # docs/examples/plot_*.py, each run at build time (small budgets), rendered with its output and figures
@@ -44,16 +47,38 @@ sphinx_gallery_conf = {
 }
 napoleon_numpy_docstring = True
 napoleon_google_docstring = False
-napoleon_use_rtype = False  # the return type beside its description, as numpydoc renders it
+napoleon_use_rtype = True  # the return type as its own field: autodoc's type hints then do not add it twice
+napoleon_use_ivar = True  # an Attributes section as a field list: autodoc documents the attributes themselves
+# Gymnasium's sections of an environment's docstring (`envs.wrist.WristEnv`), each rendered as a titled section
+napoleon_custom_sections = [
+    "Description",
+    "Action Space",
+    "Observation Space",
+    "Rewards",
+    "Starting State",
+    "Episode End",
+    ("Arguments", "params_style"),
+    "Info",
+    "Version History",
+]
 html_theme = "furo"  # the maintained theme Gymnasium's docs use: a navigation sidebar, light and dark
 html_title = "wrist-env"
 html_theme_options = {"navigation_with_keys": True}
 
 
+NUMPYDOC_SECTION = re.compile(r"^[A-Z][A-Za-z ]+\n-{3,}$", re.MULTILINE)
+"""A numpydoc section header: a title line underlined with dashes (`Parameters`, `Returns`, `Action Space`)."""
+
+
 def plain_docstrings(app, what, name, obj, options, lines):
-    """The code's docstrings are plain text (shapes, units, field lists), not reST: the summary line is
-    shown as a paragraph and the rest verbatim, so `|z|`, `(V, 3) mm` and indented fields read as written."""
+    """Most of the code's docstrings are plain text (shapes, units, field lists), not reST: the summary line is
+    shown as a paragraph and the rest verbatim, so `|z|`, `(V, 3) mm` and indented fields read as written.
+    A docstring in numpydoc sections (the public entry points') is left to napoleon, which renders its
+    sections as field lists and titled blocks."""
     if not lines:
+        return
+    doc = getattr(obj, "__doc__", None)
+    if isinstance(doc, str) and NUMPYDOC_SECTION.search(inspect.cleandoc(doc)):
         return
     end = next((i for i, line in enumerate(lines) if not line.strip()), len(lines))
     summary = [line.replace("\\", "\\\\").replace("|", "\\|").replace("*", "\\*") for line in lines[:end]]
