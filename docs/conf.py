@@ -57,7 +57,7 @@ napoleon_custom_sections = [
     "Rewards",
     "Starting State",
     "Episode End",
-    ("Arguments", "params_style"),
+    ("Arguments", "Parameters"),  # rendered as Parameters, so autodoc adds the types to the same list
     "Info",
     "Version History",
 ]

@@ -24,7 +24,7 @@ from optimizers import Optimizer, register
 
 @register("gallery-es")
 class GalleryES(Optimizer):
-    """A (1, λ) evolution strategy: λ = batch_size steps of size sigma around the best point."""
+    """A (1, λ) evolution strategy: λ = batch_size steps of size sigma."""
 
     OPTIONS = ("batch_size", "sigma")
 
@@ -52,7 +52,9 @@ print("registered:", "gallery-es" in optimizers.available())
 # ``wrist-bench benchmark``, and the contract tests) find it by name.
 from wrist_env.bench import calibrate
 
-runs = {name: calibrate("P1", name, budget=24, seed=0) for name in ("gallery-es", "random")}
+runs = {
+    name: calibrate("P1", name, budget=24, seed=0) for name in ["gallery-es", "random"]
+}
 for name, run in runs.items():
     print(f"{name}: best cost {run.cost:.3f} after {run.result.nfev} evaluations")
 
@@ -60,8 +62,8 @@ for name, run in runs.items():
 # Best so far, evaluation by evaluation, on the calibration trial.
 plt.figure(figsize=(6, 3.5))
 for name, run in runs.items():
-    cost = run.result.history_fun
-    plt.step(np.arange(1, len(cost) + 1), np.minimum.accumulate(cost), where="post", label=name)
+    best = np.minimum.accumulate(run.result.history_fun)
+    plt.step(np.arange(1, len(best) + 1), best, where="post", label=name)
 plt.xlabel("evaluation")
 plt.ylabel("best kinematic cost so far")
 plt.title("P1, one seed: a custom calibrator against random search")

@@ -31,23 +31,26 @@ print(summary.counts["P1"])
 # exclusion threshold is kept in the log and marked ``excluded``.
 runs = read_runs(out).to_pandas()
 runs["SLIL torn"] = runs[["SLIL_v.torn", "SLIL_p.torn", "SLIL_d.torn"]].any(axis=1)
-print(runs[["sample_id", "SLIL torn", "RSC.torn", "LRL.torn", "ok", "excluded"]].head(8).to_string(index=False))
+columns = ["sample_id", "SLIL torn", "RSC.torn", "LRL.torn", "ok", "excluded"]
+print(runs[columns].head(8).to_string(index=False))
 
 # %%
 # Radioscaphoid peak pressure over the sweep, run by run: the outcome the
 # preprint's Table 5 models. Runs with an SLIL bundle torn are drawn in red.
 plt.figure(figsize=(6, 3.5))
-for angle, peak, torn in zip(runs.angle_deg[runs.ok], runs.rs_peak_mpa[runs.ok], runs["SLIL torn"][runs.ok]):
+ok = runs[runs.ok]
+for angle, peak, torn in zip(ok.angle_deg, ok.rs_peak_mpa, ok["SLIL torn"]):
     plt.plot(angle, peak, color="tab:red" if torn else "tab:blue", alpha=0.6, lw=1)
 plt.plot([], [], color="tab:red", label="an SLIL bundle torn")
 plt.plot([], [], color="tab:blue", label="SLIL intact")
 plt.xlabel("wrist angle (deg, flexion +)")
 plt.ylabel("radioscaphoid peak pressure (MPa)")
-plt.title(f"P1, n = {int(runs.ok.sum())} runs")
+plt.title(f"P1, n = {len(ok)} runs")
 plt.legend()
 plt.tight_layout()
 
 # %%
 # A per-run summary, the mean over the sweep, by SLIL state.
-runs["rs_mean_over_sweep_mpa"] = [np.nanmean(v) if v is not None else np.nan for v in runs.rs_mean_mpa]
-print(runs[runs.ok].groupby("SLIL torn")["rs_mean_over_sweep_mpa"].describe()[["count", "mean", "min", "max"]])
+ok = ok.assign(rs_mean_over_sweep_mpa=[np.nanmean(v) for v in ok.rs_mean_mpa])
+summary = ok.groupby("SLIL torn")["rs_mean_over_sweep_mpa"].describe()
+print(summary[["count", "mean", "min", "max"]])

@@ -27,7 +27,8 @@ from wrist_env.participants.folder import write_participant_folder
 
 p1 = builtin.source("P1")
 root = Path(tempfile.mkdtemp(prefix="participant-"))
-folder = write_participant_folder(dataclasses.replace(p1, name="my_wrist"), root / "my_wrist")
+my_wrist = dataclasses.replace(p1, name="my_wrist")
+folder = write_participant_folder(my_wrist, root / "my_wrist")
 for path in sorted(folder.rglob("*")):
     print(path.relative_to(root))
 
@@ -57,7 +58,8 @@ import trimesh
 
 from wrist_env.errors import WristEnvError
 
-bad = write_participant_folder(dataclasses.replace(p1, name="in_metres"), root / "in_metres")
+in_metres = dataclasses.replace(p1, name="in_metres")
+bad = write_participant_folder(in_metres, root / "in_metres")
 mesh = trimesh.load(bad / "bones" / "scaphoid.stl")
 mesh.apply_scale(1e-3)
 mesh.export(bad / "bones" / "scaphoid.stl")
@@ -76,12 +78,14 @@ trial = registry.trial(name, "calibrate")
 fig, (ax_bones, ax_trial) = plt.subplots(1, 2, figsize=(9, 4))
 for bone, (vertices, faces) in p1.bones.items():
     ax_bones.plot(vertices[::20, 2], vertices[::20, 1], ".", ms=1, label=bone)
-ax_bones.set(xlabel="z (mm, radial +)", ylabel="y (mm, proximal +)", title="bones, volar view", aspect="equal")
+ax_bones.set(xlabel="z (mm, radial +)", ylabel="y (mm, proximal +)", aspect="equal")
+ax_bones.set_title("bones, volar view")
 ax_bones.legend(markerscale=8, fontsize=8)
 flexion = DOF_NAMES.index("Flex/Ext")
 for bone in ("scaphoid", "lunate", "capitate"):
     ax_trial.plot(pose_to_dof(trial.pose(bone))[:, flexion], label=bone)
-ax_trial.set(xlabel="frame", ylabel="flexion (deg)", title=f"{name}'s calibration trial")
+ax_trial.set(xlabel="frame", ylabel="flexion (deg)")
+ax_trial.set_title(f"{name}'s calibration trial")
 ax_trial.legend()
 fig.tight_layout()
 
@@ -92,12 +96,12 @@ fig.tight_layout()
 #
 # .. code-block:: python
 #
-#    model = registry.load_model("my_wrist")           # or: wrist-bench build my_wrist --folder DIR
+#    model = registry.load_model("my_wrist")  # wrist-bench build my_wrist --folder DIR
 #
 #    import gymnasium as gym
 #    import wrist_env
 #
-#    ids = wrist_env.register_participant(folder)       # Calibrate-, Validate-, Idealized-my_wrist
+#    ids = wrist_env.register_participant(folder)  # Calibrate-, Validate-, Idealized-
 #    env = gym.make(ids[0])
 #    obs, info = env.reset(seed=0)
 #    obs, reward, terminated, truncated, info = env.step(env.action_space.sample())

@@ -19,7 +19,15 @@ import matplotlib.pyplot as plt
 from wrist_env.bench import RunLog, benchmark
 
 out = tempfile.mkdtemp(prefix="benchmark-")
-report = benchmark(["P1"], ["random", "lhs"], seeds=1, budget=16, out_dir=out, workers=1, progress=False)
+report = benchmark(
+    ["P1"],
+    ["random", "lhs"],
+    seeds=1,
+    budget=16,
+    out_dir=out,
+    workers=1,
+    progress=False,
+)
 print(f"{report.evaluations} evaluations logged in {out}")
 
 # %%
@@ -29,7 +37,8 @@ print(f"{report.evaluations} evaluations logged in {out}")
 # (``rmse.<bone>.<DOF>``, mm and deg).
 log = RunLog(out).read()
 print(log.shape)
-print(log[["participant", "optimizer", "seed", "eval", "batch", "cost", "failed"]].head(8).to_string(index=False))
+columns = ["participant", "optimizer", "seed", "eval", "batch", "cost", "failed"]
+print(log[columns].head(8).to_string(index=False))
 
 # %%
 # Best so far per calibrator: a ``groupby`` and a cumulative minimum in the
@@ -49,7 +58,6 @@ plt.tight_layout()
 # Each finished cell also has a JSON summary: the calibrated design, its
 # held-out cost and its parameter recovery.
 for cell in RunLog(out).summaries():
-    print(
-        f"{cell['optimizer']}: best cost {cell['best_cost']:.3f}, held-out {cell['validate']['cost']:.3f}, "
-        f"recovery {cell['recovery_z']:.2f} SD"
-    )
+    held_out = cell["validate"]["cost"]
+    print(f"{cell['optimizer']}: best {cell['best_cost']:.3f}, held-out {held_out:.3f}")
+    print(f"  recovery {cell['recovery_z']:.2f} SD")

@@ -68,7 +68,8 @@ class WristEnv(gym.Env):
     Starting State
     --------------
     Every episode starts from the model at rest in its neutral pose; nothing is random. ``reset(seed=...)``
-    seeds the action space's sampler only.
+    seeds the environment's ``np_random``, which nothing in it draws from; ``env.action_space.seed(seed)``
+    seeds ``action_space.sample()``.
 
     Episode End
     -----------
@@ -124,10 +125,51 @@ class WristEnv(gym.Env):
         self.action_space, self.observation_space = _spaces()
 
     def reset(self, *, seed: int | None = None, options: dict | None = None) -> tuple[np.ndarray, dict]:
+        """Start an episode: the fixed observation, nothing simulated.
+
+        Parameters
+        ----------
+        seed : int, optional
+            Seeds ``self.np_random`` (Gymnasium's convention; nothing here draws from it).
+        options : dict, optional
+            Not used.
+
+        Returns
+        -------
+        observation : ndarray of shape (27,), float32
+            Zeros: the population-mean design in normalized units.
+        info : dict
+            Empty.
+        """
         super().reset(seed=seed)
         return OBSERVATION.copy(), {}
 
     def step(self, action: ArrayLike) -> tuple[np.ndarray, float, bool, bool, dict]:
+        """Simulate one design through the motion and score it: the whole episode.
+
+        Parameters
+        ----------
+        action : array_like of shape (27,)
+            The design variables normalized to [-1, 1] (see Action Space).
+
+        Returns
+        -------
+        observation : ndarray of shape (27,), float32
+            Zeros, as `reset` returns.
+        reward : float
+            −cost (see Rewards).
+        terminated : bool
+            Always True: an episode is one step.
+        truncated : bool
+            Always False.
+        info : dict
+            The simulation's outputs and the cost's terms (see Info).
+
+        Raises
+        ------
+        DesignError
+            An action of another shape, or not finite and in [-1, 1] (the message names the values).
+        """
         evaluation = self.task.evaluate_action(action)
         return OBSERVATION.copy(), float(evaluation.reward), True, False, evaluation.info
 
