@@ -80,12 +80,30 @@ def plain_docstrings(app, what, name, obj, options, lines):
     doc = getattr(obj, "__doc__", None)
     if isinstance(doc, str) and NUMPYDOC_SECTION.search(inspect.cleandoc(doc)):
         return
+    if what in ("attribute", "data", "property"):
+        _undo_inline_type(lines)
     end = next((i for i, line in enumerate(lines) if not line.strip()), len(lines))
     summary = [line.replace("\\", "\\\\").replace("|", "\\|").replace("*", "\\*") for line in lines[:end]]
     rest = lines[end:]
     while rest and not rest[0].strip():
         rest = rest[1:]
     lines[:] = summary + (["", "::", ""] + ["    " + line for line in rest] + [""] if rest else [])
+
+
+def _undo_inline_type(lines):
+    """Napoleon reads the first line of an attribute's docstring as "type: description" and moves the part
+    before the colon to a `:type:` line at the end ("Bool array of shape (11,): which ligaments are torn"
+    became "which ligaments are torn ... :type: Bool array of shape (11,)"); a plain docstring is put back as
+    written."""
+    typed = [i for i, line in enumerate(lines) if line.startswith(":type: ")]
+    if not typed or not lines:
+        return
+    i = typed[-1]
+    kind = lines[i][len(":type: ") :]
+    del lines[i]
+    while lines and not lines[-1].strip():
+        lines.pop()
+    lines[0] = f"{kind}: {lines[0]}" if lines else kind
 
 
 def setup(app):
