@@ -25,11 +25,24 @@ class OptionError(InputError):
 
 @dataclass(frozen=True)
 class OptimizeResult:
-    """SciPy's field names plus the history.
+    """What every calibrator returns: SciPy's `OptimizeResult` field names plus the history.
 
-    x (dim,) the best point; fun its value; nfev evaluations used; success,
-    message as SciPy's; history_x (nfev, dim) and history_fun (nfev,) every
-    evaluation in the order told.
+    Attributes
+    ----------
+    x : ndarray of shape (dim,)
+        The best point told.
+    fun : float
+        Its value (the kinematic cost, in the benchmark).
+    nfev : int
+        Evaluations used.
+    success : bool
+        Whether the best value is finite.
+    message : str
+        Why the run ended: the budget spent, or the method converged before it.
+    history_x : ndarray of shape (nfev, dim)
+        Every point, in the order told.
+    history_fun : ndarray of shape (nfev,)
+        Their values (a non-finite value is told as inf).
     """
 
     x: np.ndarray
@@ -214,9 +227,22 @@ def minimize(
     fun_batch: Callable[[np.ndarray], ArrayLike],
     callback: Callable[[np.ndarray, np.ndarray], object] | None = None,
 ) -> OptimizeResult:
-    """Run `optimizer` on `fun_batch` ((k, dim) → (k,)) until its budget is spent or it stops.
+    """Drive a calibrator's ask/tell loop until its budget is spent or it stops.
 
-    callback(x, y) is called after every batch (e.g. to log evaluations).
+    Parameters
+    ----------
+    optimizer : Optimizer
+        A fresh calibrator (`optimizers.make`).
+    fun_batch : callable
+        The objective over a batch: points of shape (k, dim) to values of shape (k,). In the benchmark, one
+        batched simulation of the calibration trial.
+    callback : callable, optional
+        ``callback(x, y)``, called after every batch (the benchmark logs the evaluations there).
+
+    Returns
+    -------
+    OptimizeResult
+        The best point, its value and every evaluation in order.
     """
     while not optimizer.done:
         x = optimizer.ask()
