@@ -1,7 +1,7 @@
-"""Regenerate every committed result from real runs: the README's figures, `leaderboards/`
+"""Regenerate every committed result from real runs: the figures in `experiments/figures/`, `leaderboards/`
 and `leaderboards/montecarlo/` (the maintainer's one command after a model change).
 
-Runs, from the repository root, each step as the README documents it and prints its wall time:
+Runs, from the repository root, each step as the docs document it and prints its wall time:
 the built-in models shipped with the package (`experiments/authoring/ship_models.py`), the figures (`wrist-bench figure ...`, `wrist-bench validate P1` … `P3`, whose JSON records the docs' validation page renders, the scaling benchmark `experiments/benchmarks/bench_scaling.py`), the full default benchmark
 and its leaderboard (3 participants × instances 0–4 × 11 calibrators × 300 evaluations, seed = instance; Nevergrad's four
 need the `[nevergrad]` extra) with its IOHanalyzer files (`[ioh]`), and the full
@@ -31,7 +31,7 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-FIGURES = "experiments/figures"  # the README's figures (the commands' own default is runs/figures)
+FIGURES = "experiments/figures"  # the committed figures the docs show (the commands' own default is runs/figures)
 # the 1,200-step study's saved runs are committed (0.4-0.5 MB a run, compressed): at 34-51 min a run on the issue-33
 # model (P1-P3, nine runs: 24 MAP starts, then 58,000-63,000 simulations), its 9 runs span sessions,
 # and a saved run is loaded, not rerun, unless it was sampled on another model (`Posterior.model_hash`)

@@ -25,11 +25,24 @@ class OptionError(InputError):
 
 @dataclass(frozen=True)
 class OptimizeResult:
-    """SciPy's field names plus the history.
+    """What every calibrator returns: SciPy's `OptimizeResult` field names plus the history.
 
-    x (dim,) the best point; fun its value; nfev evaluations used; success,
-    message as SciPy's; history_x (nfev, dim) and history_fun (nfev,) every
-    evaluation in the order told.
+    Attributes
+    ----------
+    x : ndarray of shape (dim,)
+        The best point told.
+    fun : float
+        Its value (the kinematic cost, in the benchmark).
+    nfev : int
+        Evaluations used.
+    success : bool
+        Whether the best value is finite.
+    message : str
+        Why the run ended: the budget spent, or the method converged before it.
+    history_x : ndarray of shape (nfev, dim)
+        Every point, in the order told.
+    history_fun : ndarray of shape (nfev,)
+        Their values (a non-finite value is told as inf).
     """
 
     x: np.ndarray
@@ -42,13 +55,51 @@ class OptimizeResult:
 
 
 class Optimizer(ABC):
-    """Base of every calibrator: bounds, budget, seed, bookkeeping of what was told.
+    """The calibrator interface: ask/tell over batches, within bounds and a budget of evaluations.
 
-    Subclasses implement `_ask(n_max)` → (k, dim) with 1 ≤ k ≤ n_max and, if
-    they learn from values, `_tell(x, y)`; they read `self.rng` (a seeded numpy
-    Generator), the bounds `self.lower`, `self.upper` (dim,) and `self.options`,
-    whose names they declare in `OPTIONS` (any other name is an `OptionError`
-    listing these). One that holds a thread or a file releases it in `close()`.
+    The base keeps the bounds, the budget, the seed and the record of what was told; a calibrator is a
+    subclass that proposes points. Asking for a batch lets a population method (CMA-ES) be one batched
+    simulation per generation.
+
+    Subclasses implement ``_ask(n_max)``, a batch of shape (k, dim) with 1 ≤ k ≤ n_max, and, if they learn
+    from values, ``_tell(x, y)``. They draw randomness from ``self.rng`` (a numpy Generator seeded with
+    `seed`, so a run is replayed exactly), read the bounds ``self.lower`` and ``self.upper`` (dim,) and
+    ``self.options``, whose names they declare in ``OPTIONS``. One that holds a thread or a file releases
+    it in ``close()``.
+
+    Parameters
+    ----------
+    dim : int
+        The number of variables (22 normalized materials in the benchmark).
+    budget : int
+        Evaluations allowed: ``ask`` never proposes more than remain.
+    seed : int, default 0
+        The seed of ``self.rng``.
+    lower, upper : float or array_like of shape (dim,), default -1.0 and 1.0
+        The box; every asked point is clipped into it.
+    **options
+        The calibrator's options, names from its ``OPTIONS``.
+
+    Raises
+    ------
+    ValueError
+        dim or budget below 1, or a bound not below its upper bound.
+    OptionError
+        An option the calibrator does not declare (the message lists those it does).
+
+    See Also
+    --------
+    optimizers.registry.register : make a subclass available by name.
+    minimize : the ask/evaluate/tell loop until the budget is spent.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from optimizers import make, minimize
+    >>> opt = make("random", dim=3, budget=32, seed=0)
+    >>> result = minimize(opt, lambda x: np.sum(x**2, axis=1))  # fun_batch: (k, dim) -> (k,)
+    >>> result.nfev, result.history_x.shape
+    (32, (32, 3))
     """
 
     name: str = ""
@@ -174,9 +225,22 @@ def minimize(
     fun_batch: Callable[[np.ndarray], ArrayLike],
     callback: Callable[[np.ndarray, np.ndarray], object] | None = None,
 ) -> OptimizeResult:
-    """Run `optimizer` on `fun_batch` ((k, dim) → (k,)) until its budget is spent or it stops.
+    """Drive a calibrator's ask/tell loop until its budget is spent or it stops.
 
-    callback(x, y) is called after every batch (e.g. to log evaluations).
+    Parameters
+    ----------
+    optimizer : Optimizer
+        A fresh calibrator (`optimizers.make`).
+    fun_batch : callable
+        The objective over a batch: points of shape (k, dim) to values of shape (k,). In the benchmark, one
+        batched simulation of the calibration trial.
+    callback : callable, optional
+        ``callback(x, y)``, called after every batch (the benchmark logs the evaluations there).
+
+    Returns
+    -------
+    OptimizeResult
+        The best point, its value and every evaluation in order.
     """
     while not optimizer.done:
         x = optimizer.ask()

@@ -30,7 +30,37 @@ class UnknownOptimizerError(WristEnvError, KeyError):
 
 
 def register(name: str) -> Callable[[type], type]:
-    """Class decorator: make an `Optimizer` subclass available under `name`."""
+    """Class decorator: make an `Optimizer` subclass available under `name`.
+
+    The benchmark, ``wrist-bench calibrate --optimizer NAME`` and the contract tests then find it by name;
+    `name` is set as the class's ``name``.
+
+    Parameters
+    ----------
+    name : str
+        The calibrator's name, unique in the registry.
+
+    Returns
+    -------
+    callable
+        The decorator, which registers the class and returns it unchanged.
+
+    Raises
+    ------
+    ValueError
+        `name` is taken by another class.
+
+    Examples
+    --------
+    >>> from optimizers import Optimizer, register
+    >>> @register("my-random")
+    ... class MyRandom(Optimizer):
+    ...     def _ask(self, n_max):
+    ...         return self.rng.uniform(self.lower, self.upper, (min(n_max, 8), self.dim))
+    >>> import optimizers
+    >>> "my-random" in optimizers.available()
+    True
+    """
 
     def decorate(cls):
         if name in _REGISTRY and _REGISTRY[name] is not cls:

@@ -39,19 +39,44 @@ def test_the_readme_examples_run(built, tmp_path, monkeypatch, capsys):
 
 @pytest.fixture(scope="module")
 def site(tmp_path_factory):
+    """The site built afresh with warnings as errors; every gallery example run again (sphinx-gallery would
+    skip one whose source is unchanged since the last build in docs/auto_examples/), an example that raises
+    failing the build."""
     out = tmp_path_factory.mktemp("site")
     done = subprocess.run(
-        [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-E", "-q", "-b", "html", str(ROOT / "docs"), str(out)],
+        [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-E", "-q", "-b", "html",
+         "-D", "sphinx_gallery_conf.run_stale_examples=1", str(ROOT / "docs"), str(out)],
         capture_output=True,
         text=True,
-    )
+    )  # fmt: skip
     assert done.returncode == 0, done.stderr[-4000:]
     return out
 
 
 def test_the_docs_build_without_warnings(site):
-    for page in ("index", "getting-started", "solver", "benchmark", "api", "results/index", "results/validation"):
+    pages = ("index", "getting-started", "extending", "solver", "benchmark", "api", "results/index")
+    for page in (*pages, "results/validation", "auto_examples/index"):
         assert (site / f"{page}.html").is_file(), page
+
+
+EXAMPLES = sorted((ROOT / "docs" / "examples").glob("plot_*.py"))
+
+
+def test_there_are_gallery_examples():
+    assert len(EXAMPLES) >= 5, EXAMPLES
+
+
+@pytest.mark.parametrize("example", EXAMPLES, ids=lambda p: p.stem)
+def test_every_gallery_example_ran_in_the_build_and_shows_its_figures(site, example):
+    """Each docs/examples/plot_*.py is a page of the built gallery, linked from its index, executed in this build
+    (sphinx-gallery writes its running time) and showing the figures it drew."""
+    page = site / "auto_examples" / f"{example.stem}.html"
+    assert page.is_file(), f"{example.name} is not in the built gallery"
+    assert f'href="{example.stem}.html' in (site / "auto_examples" / "index.html").read_text()
+    html = page.read_text()
+    assert "Total running time of the script" in html
+    figures = sorted((site / "_images").glob(f"sphx_glr_{example.stem}_0*.png"))
+    assert figures and all(f.name in html for f in figures), f"{example.name}: no figure on its page"
 
 
 def test_a_results_page_shows_the_committed_numbers(site):
@@ -211,3 +236,21 @@ def test_the_layout_page_names_every_module_and_no_other():
         if p.name != "__init__.py" or p.parent.name == "wrist_env"
     }
     assert listed == tree, {"not listed": sorted(tree - listed), "listed, not there": sorted(listed - tree)}
+
+
+EXTENDING = DOCS / "extending.md"
+CODE_PATH = r"(?:wrist_env|optimizers|tests|experiments)/[\w./-]+"
+
+
+def test_the_extending_page_names_only_files_and_names_that_exist():
+    """Every path the Extending page names is in the tree, and every `NAME` it places "in `path`" is in that
+    file: the walk-throughs follow the code when it moves."""
+    text = EXTENDING.read_text()
+    paths = set(re.findall(rf"`({CODE_PATH})`", text))
+    assert len(paths) >= 30, sorted(paths)
+    missing = sorted(p for p in paths if not (ROOT / p).exists())
+    assert not missing, f"docs/extending.md names paths that do not exist: {missing}"
+    placed = re.findall(rf"`(\w+)`\s+in\s+`({CODE_PATH}\.py)`", text)
+    assert len(placed) >= 8, placed
+    absent = [(name, path) for name, path in placed if not re.search(rf"\b{name}\b", (ROOT / path).read_text())]
+    assert not absent, f"docs/extending.md places names in files that do not hold them: {absent}"

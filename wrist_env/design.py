@@ -174,11 +174,42 @@ for _a in (MEAN, SD):
 
 @dataclass(frozen=True)
 class Design:
-    """A design in physical units.
+    """A design in physical units: the 27 ligament variables of the preprint's Table 2 for one wrist.
 
-    stiffness: array of shape (11,), N/mm, Table 2 order.
-    reference_strain: array of shape (11,), l_ref / l0 (>1 taut, <1 slack in the neutral pose).
-    injury: array of shape (5,), scalars of SLIL_v, SLIL_p, SLIL_d, RSC, LRL; < 0 is a complete tear.
+    The fields are frozen copies (read-only arrays), checked when the design is made, so a design that
+    exists is one the solver can run.
+
+    Parameters
+    ----------
+    stiffness : array_like of shape (n_ligaments,)
+        Each ligament's stiffness, N/mm, in Table 2 order (`LIGAMENT_NAMES`, n_ligaments = 11).
+    reference_strain : array_like of shape (n_ligaments,)
+        Each ligament's reference strain l_ref / l0, dimensionless: above 1 the ligament is taut in
+        the neutral pose, below 1 slack.
+    injury : array_like of shape (n_injurable,)
+        The injury scalars of `INJURABLE` (SLIL_v, SLIL_p, SLIL_d, RSC, LRL; n_injurable = 5): below 0
+        a complete tear, +1 intact.
+
+    Raises
+    ------
+    DesignError
+        A field of another shape, a value that is not finite, or a stiffness or reference strain ≤ 0
+        (the message names the field and its values).
+
+    See Also
+    --------
+    from_action : the design of a normalized action in [-1, 1]^27 (what the environments take).
+    population : Table 2's population means, intact.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from wrist_env import design
+    >>> d = design.population()
+    >>> d.stiffness.shape, d.injury.shape
+    ((11,), (5,))
+    >>> design.from_action(np.zeros(27)).as_dict()["SLIL_d.stiffness"]  # N/mm: the action's centre is the mean
+    79.0
     """
 
     stiffness: np.ndarray

@@ -1,7 +1,7 @@
 """Bounds on the sizes and values a user can ask for, checked at the boundary before anything is allocated,
 spawned or built.
 
-Each size limit is far above any study in the README (Monte Carlo n 12,500; budgets of 300; batches of 64;
+Each size limit is far above any study the docs describe (Monte Carlo n 12,500; budgets of 300; batches of 64;
 sweeps of 17 frames; Sobol n 64; 48 walkers x 1,200 steps) and below what this machine's memory or process
 table survives: a Monte Carlo round holds its n draws (27 floats each) and the bookkeeping of every sample
 id in memory, so n = 10^8 asked 20 GiB; `simulate --frames 3000000` asked 4 GB, `sensitivity --n 2000000`

@@ -90,15 +90,66 @@ def require_reference(participant: str, motion: str) -> None:
 
 
 class Task:
-    """Participant × motion: "calibrate" (unresisted trial), "validate" (held-out resisted
-    trial) or "idealized" (flexion–extension sweep; reference = the hidden truth's
-    sweep for built-in participants, none for user participants → reward 0, and the
-    info's `REFERENCE_KEYS` None).
-    load_direction: the loads' lines (`settings.LOAD_DIRECTIONS`, default `settings.DEFAULT_LOADS`): the
-    sweep's, and in a trial the radial column's (the capitate is prescribed) at the trial's `load_n`.
-    instance: the problem instance of a built-in participant (`participants.instances`; 0, the default,
-    its shipped truth and trials; k ≥ 1 a truth drawn from the prior and the trials made from it);
-    `truth` is the instance's hidden truth (None for a folder participant)."""
+    """A participant's model, one motion's driver and its reference kinematics: designs in, rewards out.
+
+    The one door from designs to rewards: the environments, the calibrators, the Monte Carlo study and
+    the identification tools all score designs through a `Task`. It loads the model and prepares the
+    solver's arrays once, so that each evaluation is a simulation and a cost.
+
+    Parameters
+    ----------
+    participant : str
+        A registered participant: a built-in (P1, P2, P3) or a folder's (`registry.add_folder`).
+    motion : {"calibrate", "validate", "idealized"}, default "calibrate"
+        The unresisted trial, the held-out resisted trial, or the idealized flexion–extension sweep. The
+        sweep's reference is the hidden truth's sweep for a built-in participant, none for a folder's (its
+        reward is then 0 and the info's `REFERENCE_KEYS` are None).
+    settings : SolverSettings, optional
+        The solver's settings (default `SolverSettings()`).
+    weights : CostWeights, optional
+        The cost's per-DOF weights (default 1 for every DOF).
+    load_direction : str, default `settings.DEFAULT_LOADS`
+        The loads' lines of action (`settings.LOAD_DIRECTIONS`): the sweep's, and in a trial the free
+        bodies' (the capitate is prescribed) at the trial's recorded `load_n`.
+    instance : int, default 0
+        The problem instance of a built-in participant (`participants.instances`): 0 its shipped truth and
+        trials, k ≥ 1 a truth drawn from the prior and the trials made from it.
+
+    Attributes
+    ----------
+    model : Model
+        The participant's built model.
+    driver : Driver
+        The motion's driver: the capitate's targets and the loads per frame.
+    reference : ndarray of shape (2, n_frames, 4, 4) or None
+        The scaphoid's and lunate's reference poses (RCS, mm); None without reference kinematics.
+    truth : Design or None
+        The instance's hidden truth (None for a folder participant).
+
+    Raises
+    ------
+    ValueError
+        An unknown motion or load direction (the message lists the valid ones).
+    ParticipantError
+        An unknown participant, or an instance k ≥ 1 of a folder participant.
+
+    See Also
+    --------
+    task : the shared `Task` of default settings, one per participant, motion, load and instance.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from wrist_env import design
+    >>> from wrist_env.task import Task
+    >>> calibration = Task("P1", "calibrate")
+    >>> evaluation = calibration.evaluate(design.population())
+    >>> evaluation.reward == -evaluation.cost
+    True
+    >>> batch = calibration.evaluate_actions(np.zeros((4, 27)))  # one batched solver call
+    >>> batch.cost.shape
+    (4,)
+    """
 
     def __init__(
         self,
@@ -225,6 +276,31 @@ def _zero_undefined(per_bone: dict) -> dict:
 
 @functools.lru_cache(maxsize=32)
 def task(participant: str, motion: str, load_direction: str = DEFAULT_LOADS, instance: int = 0) -> Task:
-    """A shared Task per participant, motion, load direction and instance with default settings (models are
-    big; build once)."""
+    """The shared `Task` of a participant's motion, with default solver settings and cost weights.
+
+    Models and their prepared arrays are large, so one `Task` per (participant, motion, load direction,
+    instance) is made and kept (the 32 most recent): the environments and `calibrate` use it.
+
+    Parameters
+    ----------
+    participant : str
+        A registered participant's name.
+    motion : {"calibrate", "validate", "idealized"}
+        The motion (`motions.MOTIONS`).
+    load_direction : str, default `settings.DEFAULT_LOADS`
+        The loads' lines of action (`settings.LOAD_DIRECTIONS`).
+    instance : int, default 0
+        The problem instance of a built-in participant (`participants.instances`).
+
+    Returns
+    -------
+    Task
+        The same object for the same arguments.
+
+    Examples
+    --------
+    >>> from wrist_env.task import task
+    >>> task("P1", "calibrate") is task("P1", "calibrate")
+    True
+    """
     return Task(participant, motion, load_direction=load_direction, instance=instance)

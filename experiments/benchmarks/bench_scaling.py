@@ -7,7 +7,7 @@ cost grows with the contact-sample resolution (issue 13).
 2. One sweep (population design, one thread) on P1 built at contact-sample spacings 0.7–2.0 mm:
    samples, steps, milliseconds per simulation and microseconds per step.
 
-Writes runs/figures/scaling_<name>.png (both panels; `experiments/regenerate.py` writes the README's copy). Timings are medians of repeated runs;
+Writes runs/figures/scaling_<name>.png (both panels; `experiments/regenerate.py` writes the copy in experiments/figures that docs/solver.md shows). Timings are medians of repeated runs;
 run it on a quiet machine (nothing else on its cores). Builds the coarser and finer P1 variants
 on first use (~1 min each, cached).
 

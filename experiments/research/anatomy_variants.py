@@ -1,4 +1,4 @@
-"""The numbers behind the README's "Anatomy variants" and validation prose.
+"""The numbers behind docs/validation.md's "Anatomy variants" and its validation prose.
 
 Prints, on this machine (each model built or read from the cache):
 1. for P1 (population design), one Markdown row per anatomy variant: the

@@ -176,7 +176,7 @@ def test_the_command_runs_smc_and_keeps_its_own_files(built, tmp_path, capsys):
     assert np.all(np.abs(post.samples) <= 3) and post.stages >= 1 and np.isfinite(post.log_evidence)
     assert post.evaluations >= 44 * (post.stages + 1) and np.all(np.isnan(post.rhat))
     # the stored log posterior is the particle's own (prior included); within 1 nat, as the samples are
-    # stored in float32 and the solver's stopping rule makes the likelihood rough at that scale (README)
+    # stored in float32 and the solver's stopping rule makes the likelihood rough at that scale
     best = post.samples[np.argmax(post.log_prob)]
     assert post.log_prob.max() == pytest.approx(
         float(mcmc.log_probability(bayes._tasks("P1", "built-in", 0)[0])(best[None])[0]), abs=1.0

@@ -184,19 +184,65 @@ def calibrate(
     made_from: dict | None = None,
     instance: int = 0,
 ) -> CalibrationRun:
-    """Calibrate the 22 materials of `participant` with the calibrator `optimizer_name`.
+    """Calibrate the 22 ligament materials of a participant with one calibrator: one benchmark cell.
 
-    instance: the problem instance (`participants.instances`): its calibrate trial is the objective, its
-        validate trial the held-out score and its hidden truth what recovery is measured against (0: the
-        shipped problem; k ≥ 1 only for built-in participants).
-    log: a `RunLog` or its directory: every batch is logged as it finishes and a cell cut short
-        resumes from it (see the module doc).
-    storage: an Optuna storage URL, given (with study_name = the cell's key name) to calibrators
-        that take one; ignored by the others. Its study is rebuilt from the log on every start.
-    options: extra options for the calibrator (`optimizers.make(..., **options)`).
-    callback(n_new, nfev): called after every batch with the number of new evaluations.
-    made_from: the instance's `provenance.of_participant`, if the caller has it (else read here when
-        there is a log).
+    The search space is the 22 normalized materials in [-1, 1]^22 (the injury scalars frozen intact);
+    each batch the calibrator asks for is one batched simulation of the calibration trial, and the
+    kinematic cost is the value minimized (the MAP objective for a name ending in ``+prior``). The best
+    design is then scored on the held-out trial and, for a built-in participant, against its hidden truth.
+
+    Parameters
+    ----------
+    participant : str
+        A registered participant's name.
+    optimizer_name : str
+        A registered calibrator (`optimizers.available()`), optionally with ``+prior`` appended.
+    budget : int
+        Evaluations (simulations of the calibration trial) the calibrator may spend.
+    seed : int
+        The calibrator's seed: the same seed gives the same run.
+    log : RunLog or path, optional
+        A run log or its directory: every batch is logged as it finishes, and a cell cut short resumes
+        from it by replay (see the module doc).
+    storage : str or optuna storage, optional
+        An Optuna storage given (with the cell's key as study name) to calibrators that take one; ignored
+        by the others. Its study is rebuilt from the log on every start.
+    options : dict, optional
+        Extra options for the calibrator (`optimizers.make(..., **options)`).
+    callback : callable, optional
+        ``callback(n_new, nfev)``, called after every batch with the number of new evaluations.
+    made_from : dict, optional
+        The instance's `provenance.of_participant`, if the caller has it (else read here when there is
+        a log).
+    instance : int, default 0
+        The problem instance (`participants.instances`): its calibrate trial is the objective, its validate
+        trial the held-out score and its hidden truth what recovery is measured against (0: the shipped
+        problem; k ≥ 1 only for built-in participants).
+
+    Returns
+    -------
+    CalibrationRun
+        ``result`` (the calibrator's `OptimizeResult`: ``x`` of shape (22,), ``history_fun`` of shape
+        (budget,)), ``design`` (the calibrated `Design`), ``calibrate`` and ``validate`` (cost, failed, RMSE
+        and 75th-percentile errors per bone and DOF, mm and deg), ``recovery_z`` (RMS distance to the
+        hidden truth over the 22 materials, Table 2 SD units; None without a truth).
+
+    Raises
+    ------
+    UnknownOptimizerError
+        `optimizer_name` is not registered (the message lists the ones that are).
+    ParticipantError
+        An unknown participant, or an instance k ≥ 1 of a folder participant.
+    ResumeError
+        A logged cell the calibrator does not replay (it is not deterministic for its seed).
+
+    Examples
+    --------
+    >>> from wrist_env.bench import calibrate
+    >>> run = calibrate("P3", "cmaes", budget=24, seed=0)
+    >>> run.result.history_fun.shape, run.result.x.shape
+    ((24,), (22,))
+    >>> run.design.as_dict()["SLIL_d.stiffness"]  # N/mm  # doctest: +SKIP
     """
 
     start_time = time.perf_counter()

@@ -18,7 +18,7 @@ Local processes: `workers` processes (default: one per core), each with
 machine two single-threaded processes beat one process with two threads:
 calibrators that ask one point at a time (Nelder–Mead, a TPE step, the
 surrogate's search) cannot fill two threads, and a batch's slowest design
-holds the other thread idle (README, "Benchmark", has the measurement).
+holds the other thread idle (docs/history.md, "The benchmark", has the measurement).
 """
 
 from __future__ import annotations
@@ -78,14 +78,43 @@ def make_cells(
     budget: int,
     instances: int | Iterable[int] | None = None,
 ) -> list[RunKey]:
-    """The cells participants × instances × optimizers × seeds, in that order.
+    """The benchmark's cells: participants × instances × optimizers × seeds, in that order.
 
-    instances: a count n → the drawn instances 1 … n; or a list of instances (0: the shipped problem);
-        None (the default): instance 0 alone, the benchmark before instances.
-    seeds: a count n → seeds 0 … n−1 on every instance; or a list; or `SEED_IS_INSTANCE` ("instance"):
-        one run per instance, seeded with the instance (`make_cells(ps, os, "instance", 300, instances=5)`
-        is instances 1 … 5 with seeds 1 … 5).
-    `InputError` if one is empty or repeats a name, instance or seed, or a size is out of bounds (`limits`)."""
+    Parameters
+    ----------
+    participants : sequence of str
+        Participant names, each once.
+    optimizers : sequence of str
+        Calibrator names (`optimizers.available()`, optionally with ``+prior``), each once.
+    seeds : int, sequence of int or "instance"
+        A count n: seeds 0 … n−1 on every instance; a list of seeds; or `SEED_IS_INSTANCE` ("instance"):
+        one run per instance, seeded with the instance's number.
+    budget : int
+        Evaluations per cell.
+    instances : int, sequence of int or None, default None
+        A count n: the drawn instances 1 … n; a list of instances (0: the shipped problem); None: instance
+        0 alone, the benchmark before instances.
+
+    Returns
+    -------
+    list of RunKey
+        One key (participant, optimizer, seed, budget, instance) per cell; its ``name`` names the cell's
+        files in the run log.
+
+    Raises
+    ------
+    InputError
+        A list is empty or repeats a name, instance or seed, or a size is out of bounds (`limits`).
+
+    Examples
+    --------
+    >>> from wrist_env.bench import make_cells
+    >>> cells = make_cells(["P1", "P2"], ["cmaes", "random"], seeds=2, budget=40)
+    >>> len(cells)  # 2 participants × 1 instance × 2 calibrators × 2 seeds
+    8
+    >>> [c.seed for c in make_cells(["P1"], ["cmaes"], "instance", 300, instances=3)]
+    [1, 2, 3]
+    """
     instances, seeds = _instances(instances), _seeds(seeds)
     if not seeds or not participants or not optimizers:
         raise InputError("a benchmark needs at least one participant, optimizer and seed")
@@ -205,19 +234,65 @@ def benchmark(
     options: dict | None = None,
     folders: Sequence[str | Path] = (),
 ) -> BenchmarkReport:
-    """Run every cell of participants × instances × optimizers × seeds with `budget` evaluations into `out_dir`.
+    """Run the calibration benchmark: every cell of participants × instances × optimizers × seeds.
 
-    seeds, instances: as `make_cells` takes them (instances None: instance 0 alone; seeds
-        `SEED_IS_INSTANCE`: one run per instance, seeded with it).
-    workers: local processes (default: the number of cores; 1 runs the cells in this process).
-    threads: Numba threads per local process (default ⌊cores / workers⌋).
-    scheduler: a dask.distributed scheduler address (or a `distributed.Client`): one task per cell.
-    storage: Optuna storage URL for calibrators that take one, "{cell}" replaced by the cell's key name
-        (default: `sqlite:///<out_dir>/optuna/{cell}.db`); the study is named by the cell's key.
-        "memory": studies in memory only (Optuna cells ~2× faster; resume still works, by replay).
-    options: {optimizer name: {option: value}} passed to `optimizers.make` (a `+prior` name takes its
+    Each cell is one `calibrate` call with `budget` evaluations, logged batch by batch into the run log
+    in `out_dir` (`RunLog`), so a benchmark stopped at any point resumes where it stopped: finished
+    cells are skipped and a cell cut short is replayed. ``wrist-bench leaderboard`` (`write_leaderboard`)
+    makes the tables and figures from the log.
+
+    Parameters
+    ----------
+    participants : sequence of str
+        Registered participant names.
+    optimizers : sequence of str
+        Calibrator names (`optimizers.available()`, optionally with ``+prior``).
+    seeds : int, sequence of int or "instance"
+        As `make_cells` takes them: a count, a list, or `SEED_IS_INSTANCE` (one run per instance, seeded
+        with it).
+    budget : int
+        Evaluations per cell.
+    out_dir : path
+        The run log's folder (made if missing).
+    instances : int, sequence of int or None, default None
+        As `make_cells` takes them (None: instance 0 alone).
+    workers : int, optional
+        Local processes (default: the number of cores; 1 runs the cells in this process).
+    scheduler : str or distributed.Client, optional
+        A dask.distributed scheduler's address or client: one task per cell.
+    progress : bool, default True
+        A progress bar of evaluations.
+    storage : str, optional
+        An Optuna storage URL for calibrators that take one, "{cell}" replaced by the cell's key name
+        (default ``sqlite:///<out_dir>/optuna/{cell}.db``); "memory": studies in memory only (resume
+        still works, by replay).
+    threads : int, optional
+        Numba threads per local process (default ⌊cores / workers⌋).
+    options : dict, optional
+        ``{optimizer name: {option: value}}`` passed to `optimizers.make` (a ``+prior`` name takes its
         base calibrator's options unless given its own).
-    folders: participant folders to register (in every worker too).
+    folders : sequence of path, default ()
+        Participant folders to register, in every worker too.
+
+    Returns
+    -------
+    BenchmarkReport
+        The cells run, skipped (finished before) and failed (with the error), and the wall time.
+
+    Raises
+    ------
+    InputError
+        Bad cells (`make_cells`) or a count of workers or threads out of bounds.
+    ParticipantError
+        An unknown participant, or an instance k ≥ 1 of a folder participant.
+    UnknownOptimizerError
+        An unregistered calibrator (the message lists the registered ones).
+
+    Examples
+    --------
+    >>> from wrist_env.bench import RunLog, benchmark
+    >>> report = benchmark(["P1"], ["random", "cmaes"], seeds=1, budget=16, out_dir="runs/tiny", workers=1)
+    >>> RunLog("runs/tiny").read().groupby("optimizer").cost.min()  # doctest: +SKIP
     """
     start = time.perf_counter()
     cells = make_cells(participants, optimizers, seeds, budget, instances)

@@ -28,8 +28,8 @@ def add_solver_argument(parser) -> None:
         "--solver",
         choices=SOLVERS,
         default="default",
-        help="the solver: its defaults, or the preconditioned one (block mass, subcycled membrane, predicted "
-        "sweep frames: 3-4x fewer steps, opt-in; README, 'The preconditioned solver')",
+        help="the solver: default (the block mass, the membrane subcycled, the sweep's frames predicted; "
+        "docs/solver.md, 'The preconditioned solver') or diagonal (each bone's scaled mass, the default before)",
     )
 
 

@@ -25,7 +25,7 @@ def register_ids(participant: str, motions: Iterable[str] = MOTIONS) -> tuple[st
 
 
 def register_participant(folder: str | Path) -> tuple[str, ...]:
-    """Validate a participant folder (see the README's folder format) and register its ids.
+    """Validate a participant folder (its format: docs/participants.md, "Registering your own participant") and register its ids.
 
     Returns the new ids: Calibrate and Idealized always, Validate when the folder
     has a trial with role "validate".

@@ -20,7 +20,7 @@ if TYPE_CHECKING:
 
 FIGURES = Path(os.environ.get("WRIST_ENV_FIGURES", Path("runs") / "figures"))
 """Default folder of every figure: `$WRIST_ENV_FIGURES`, else runs/figures under the working directory
-(never the committed README figures in experiments/figures: `experiments/regenerate.py` writes those)."""
+(never the committed figures in experiments/figures, which the docs show: `experiments/regenerate.py` writes those)."""
 BONE_COLOUR = {
     "radius": "#d9cfc1",
     "ulna": "#d9cfc1",

@@ -16,7 +16,7 @@ which needs torch) spend more simulations or dependencies on one posterior.
 
 Or (sampler="smc", `sample_smc`): adaptive tempered sequential Monte Carlo (Del Moral, Doucet &
 Jasra 2006, JRSS B 68:411) by SMCPy (NASA): each stage's moves are one batched call per step, and
-it estimates the evidence. From the prior it did not find the narrow basin of the best fit (README),
+it estimates the evidence. From the prior it did not find the narrow basin of the best fit (docs/history.md),
 so it bridges from a `DefensiveStart` around the MAP. SMCPy is chosen over `particles` (pins
 numpy < 2) and pocomc (torch).
 

@@ -23,7 +23,7 @@ SAMPLERS = ("emcee", "smc")
 WALKERS = 48
 """emcee's ensemble walkers."""
 STEPS = 1200
-"""Ensemble steps: at 300 the chains were overconfident even on the model's own trials (README); ~12 min a run."""
+"""Ensemble steps: at 300 the chains were overconfident even on the model's own trials (docs/history.md, "Status"); ~12 min a run."""
 PRIOR_REFRESH = 0.2
 """Share of emcee's moves that are `prior_refresh`; the rest DE (80 %) and DE snooker (20 %)."""
 PARTICLES = 256

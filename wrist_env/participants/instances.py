@@ -137,8 +137,38 @@ def _make(folder: Path, name: str, k: int) -> None:
 
 @functools.lru_cache(maxsize=64)
 def instance(name: str, k: int = 0) -> Instance:
-    """Instance k of built-in participant `name` (0: the shipped truth and trials), made on first use and
-    cached; `synthetic.TrialsRefused` if its truth cannot make a trial."""
+    """Instance k of a built-in participant: a calibration problem, its hidden truth and its trials.
+
+    Instance 0 is the shipped truth and trials; instance k ≥ 1 draws its truth from the population prior
+    and makes its trials from it, seeded from (participant, k) alone, so it is the same problem on every
+    machine. It is made on first use and cached beside the models.
+
+    Parameters
+    ----------
+    name : str
+        A built-in participant (P1, P2, P3).
+    k : int, default 0
+        The instance, 0 ≤ k ≤ `limits.MAX_INSTANCE`.
+
+    Returns
+    -------
+    Instance
+        ``truth`` (the hidden `Design`) and ``trials`` (one "calibrate", one "validate"; each bone's poses
+        of shape (n_frames, 4, 4), mm).
+
+    Raises
+    ------
+    ParticipantError
+        `name` is not a built-in participant, or k is not an integer in range.
+    synthetic.TrialsRefused
+        The drawn truth cannot make a trial (the message names the instance).
+
+    Examples
+    --------
+    >>> from wrist_env.participants.instances import instance
+    >>> problem = instance("P1", 2)
+    >>> problem.trial("calibrate").pose("scaphoid").shape  # doctest: +SKIP
+    """
     _check(name, k)
     if k == 0:
         return Instance(name, 0, builtin.truth(name), dict(builtin.trials(name)))

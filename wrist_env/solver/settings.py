@@ -37,8 +37,8 @@ class SolverSettings:
     the loaded driver from the secant through the last two frames' equilibria
     (`predictor`), ramping the capitate over predict_ramp_steps instead of
     ramp_steps, where that lowers the residual (the trials' measured poses
-    are too noisy to extrapolate: their holds then lock up, measured in the
-    README).
+    are too noisy to extrapolate: their holds then lock up; docs/solver.md,
+    "The preconditioned solver").
     The defaults (issue 32; the default since issue 52) are the block mass, the
     membrane's nodes subcycled 7 steps a step and the secant predictor, with the
     stages they need: ramps of 10 steps, a 60-step move to the first pose (30

@@ -33,17 +33,18 @@ STATUS = {
 class Result:
     """Per-frame outputs of one simulation.
 
-    poses (n_frames, 6, 4, 4): neutral → frame transforms of `BONES`, RCS mm.
-    contact (n_frames, 7, 4): per pair (`model.PAIRS`) mean pressure over the
+    poses (n_frames, n_bodies, 4, 4): neutral → frame transforms of `model.BONES`, RCS mm.
+    contact (n_frames, n_pairs, 4): per pair (`model.PAIRS`) mean pressure over the
         contacting area (MPa), peak pressure (MPa), contact area (mm²), force (N).
-    bundle_force (n_frames, 16): tension of each ligament, `design.ALL_LIGAMENT_NAMES` order (N).
+    bundle_force (n_frames, n_bundles): tension of each ligament, `design.ALL_LIGAMENT_NAMES` order (N).
     energy (n_frames, 2): kinetic and internal energy (N·mm).
     residual (n_frames, 2): largest net force (N) and moment (N·mm) on the free bones.
     steps (n_frames,): explicit steps since the previous frame (ramp + hold to equilibrium;
         frame 0 includes settling and the move to the first pose).
     settled (n_frames,): whether the frame's hold ended in equilibrium (False: it ran out of hold
         steps, and its outputs are where the bones were then).
-    membrane_nodes (n_frames, M, 3): the RSC membrane's nodes (`model.membrane_nodes` order), RCS mm.
+    membrane_nodes (n_frames, n_nodes, 3): the RSC membrane's nodes (`model.membrane_nodes` order), RCS mm.
+    angle_deg (n_frames,): the driver's wrist flexion angle per frame (deg, flexion +), NaN for a trial.
     status: 0 ok, otherwise failed (see `message`); a failed run's frames are NaN.
     """
 
@@ -146,9 +147,56 @@ def simulate(
     *,
     prepared: Prepared | None = None,
 ) -> Result:
-    """Simulate one design: settle, move the capitate to the first pose, then the motion.
+    """Simulate one design of one model through one driver's frames.
 
-    prepared: `prepare(model, settings, driver.mode)`, to skip rebuilding the kernel arrays."""
+    The run is a recipe: settle the free bones from rest, move the capitate to the driver's first pose,
+    then for every frame ramp the capitate to its pose and hold until the free bones are in equilibrium
+    (the explicit kernel, `solver.kernel`). It does not raise on a failed run: a run that diverges
+    or meets a NaN returns with `status` set and its frames NaN, so a batch of designs is never cut short.
+
+    Parameters
+    ----------
+    model : Model
+        A participant's built model (`participants.registry.load_model`).
+    design : Design
+        The 27 ligament variables in physical units (`design.from_action` for a normalized action).
+    driver : Driver
+        The capitate's targets and the loads, frame by frame: a trial's (`drivers.trial_driver`), the
+        idealized sweep (`drivers.idealized`) or the capitate held (`drivers.static`).
+    settings : SolverSettings, optional
+        The solver's settings; `SolverSettings()`, the default solver, when None.
+    prepared : Prepared, optional
+        `prepare(model, settings, driver.mode)`, to skip rebuilding the kernel arrays when many designs
+        are simulated on one model.
+
+    Returns
+    -------
+    Result
+        Per frame: the bones' poses (n_frames, n_bodies, 4, 4), RCS mm; contact per pair
+        (n_frames, n_pairs, 4), MPa, mm² and N; each bundle's tension (n_frames, n_bundles), N; the
+        energies, residuals and steps; `status` 0 (`Result.ok`) or the reason it failed (`message`).
+
+    Raises
+    ------
+    ValueError
+        `prepared` was made for another model or another driver mode.
+
+    See Also
+    --------
+    simulate_batch : many designs in one call, on every Numba thread.
+    wrist_env.task.Task : a model, a driver and a reference trial together, scoring designs by their cost.
+
+    Examples
+    --------
+    >>> from wrist_env import design
+    >>> from wrist_env.participants import registry
+    >>> from wrist_env.solver import drivers
+    >>> from wrist_env.solver.simulate import simulate
+    >>> model = registry.load_model("P1")
+    >>> result = simulate(model, design.population(), drivers.idealized(model, n_frames=5))
+    >>> result.ok, result.poses.shape  # (n_frames, n_bodies, 4, 4)
+    (True, (5, 7, 4, 4))
+    """
     p = _prepared(model, settings, driver, prepared)
     out = _outputs(0, len(driver.rotation), len(model.membrane_nodes))
     with precompile.compiling(p.settings) as entry:
