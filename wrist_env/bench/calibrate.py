@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 import optimizers
-from optimizers.optuna_storage import open_storage
+from optimizers.optuna_storage import open_url
 from wrist_env import design as design_vars
 from wrist_env.bench.log import RunLog
 from wrist_env.bench.schema import X_COLUMNS, RunKey
@@ -254,7 +254,7 @@ def calibrate(
     if storage is not None and accepts_storage(cls):
         import optuna
 
-        storage_obj = open_storage(storage)
+        storage_obj = open_url(storage) if isinstance(storage, str) else storage
         try:  # the log is the record: rebuild the study by replay
             optuna.delete_study(study_name=key.name, storage=storage_obj)
         except KeyError:

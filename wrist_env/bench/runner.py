@@ -33,7 +33,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import optimizers
-from optimizers.optuna_storage import open_storage
+from optimizers.optuna_storage import open_url
 from wrist_env.bench.calibrate import accepts_storage, calibrate, split_prior
 from wrist_env.bench.log import RunLog
 from wrist_env.bench.schema import RunKey
@@ -370,7 +370,7 @@ def _prepare_storage(cells, storage) -> None:
         and STORAGE_PER_CELL not in storage
         and any(accepts_storage(optimizers.get(split_prior(k.optimizer)[0])) for k in cells)
     ):
-        open_storage(storage)
+        open_url(storage)
 
 
 def _bar(progress, total, initial, n_cells, n_done):

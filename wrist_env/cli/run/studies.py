@@ -95,7 +95,7 @@ def calibrate(args) -> int:
 def _calibrate_storage(storage: str | None, optimizer: str) -> str | None:
     """The Optuna storage URL of `calibrate --storage` (None: in memory), checked before the run: "memory" is
     none, a calibrator that keeps no Optuna study refuses one (it would be ignored), and a URL that Optuna
-    cannot open is named by `optimizers.optuna_storage.open_storage`."""
+    cannot open is named by `optimizers.optuna_storage.open_url`."""
     if storage is None or storage in NO_STORAGE:
         return None
     cls = optimizers.get(split_prior(optimizer)[0])  # an unknown name: UnknownOptimizerError lists them
@@ -104,9 +104,9 @@ def _calibrate_storage(storage: str | None, optimizer: str) -> str | None:
         raise UsageError(
             f"--storage {storage!r}: {optimizer} keeps no Optuna study; --storage is for {', '.join(takes)}"
         )
-    from optimizers.optuna_storage import open_storage
+    from optimizers.optuna_storage import open_url
 
-    open_storage(storage)  # InputError naming the URL if it cannot be opened (tables created, as the run would)
+    open_url(storage)  # InputError naming the URL if it cannot be opened (tables created, as the run would)
     return storage
 
 
