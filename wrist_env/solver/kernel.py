@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 
 from wrist_env.design import ALL_LIGAMENT_NAMES, RSC_INDEX
-from wrist_env.model import BONES, CAPITATE, FREE, PAIRS
+from wrist_env.model import BONES, CAPITATE, FREE
 from wrist_env.solver.arrays import LOADED, System
 from wrist_env.solver.forces import (
     C_AREA,
@@ -47,7 +47,7 @@ from wrist_env.solver.rigid import copy_into, interpolate_pose, rotvec_between, 
 from wrist_env.solver.step import Load, State, explicit_step, net_forces, new_work, predicted_start
 from wrist_env.solver.stopping import converged, displacement
 
-N_BONES, N_PAIRS = len(BONES), len(PAIRS)
+N_BONES = len(BONES)
 N_LIGAMENTS = len(ALL_LIGAMENT_NAMES)
 RSC = RSC_INDEX
 OK, FAILED_NAN, FAILED_DIVERGED = 0, 1, 2
