@@ -18,6 +18,8 @@ from numpy.typing import ArrayLike
 from wrist_env.design import SPAN_SD, material_prior
 from wrist_env.errors import InputError
 
+__all__ = ["OptimizeResult", "Optimizer", "OptionError", "minimize", "prior_draw"]
+
 
 class OptionError(InputError):
     """An option a calibrator does not have (the message lists the ones it has)."""

@@ -44,6 +44,8 @@ from wrist_env.frames import (
     validate_poses,
 )
 
+__all__ = ["COST_BONES", "FAILED_COST", "PERCENTILE", "RANGE_FLOOR", "CostReport", "CostWeights", "kinematic_cost"]
+
 COST_BONES = ("scaphoid", "lunate")
 PERCENTILE = 75.0
 RANGE_FLOOR = (1.0, 1.0, 1.0, 1.0, 1.0, 1.0)

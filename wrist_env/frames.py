@@ -37,6 +37,30 @@ from numpy.typing import ArrayLike
 
 from wrist_env.errors import InputError
 
+__all__ = [
+    "BOTTOM_ROW_TOL",
+    "CARDAN_SEQUENCE",
+    "DOF_NAMES",
+    "DOF_UNITS",
+    "EXPRESSED_IN",
+    "ORTHONORMAL_TOL",
+    "ROTATION",
+    "TRANSLATION",
+    "apply",
+    "cardan_angles",
+    "cardan_rotation",
+    "dof_to_pose",
+    "error_dof",
+    "error_dof_validated",
+    "error_transform",
+    "invert",
+    "pose_to_dof",
+    "pose_to_dof_validated",
+    "rmse",
+    "validate_points",
+    "validate_poses",
+]
+
 DOF_NAMES = ("Vol/Dor", "Pro/Dis", "Rad/Uln", "Flex/Ext", "UlnD/RadD", "Pro/Sup")
 DOF_UNITS = ("mm", "mm", "mm", "deg", "deg", "deg")
 TRANSLATION = slice(0, 3)

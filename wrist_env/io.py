@@ -30,6 +30,20 @@ from wrist_env.errors import InputError, StoreError
 if TYPE_CHECKING:
     from _typeshed import DataclassInstance
 
+__all__ = [
+    "FORMAT_VERSION",
+    "atomic_write",
+    "check_regular",
+    "clean_temporary",
+    "fields_equal",
+    "json_sha256",
+    "load_dataclass",
+    "read_json",
+    "save_dataclass",
+    "sha256_file",
+    "write_json",
+]
+
 _D = TypeVar("_D", bound="DataclassInstance")
 
 FORMAT_VERSION = 1

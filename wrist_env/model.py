@@ -17,6 +17,32 @@ from numpy.typing import ArrayLike
 from wrist_env.errors import InputError
 from wrist_env.io import load_dataclass, save_dataclass
 
+__all__ = [
+    "ARTICULATIONS",
+    "BODY_PARTS",
+    "BONES",
+    "CAPITATE",
+    "CARPALS",
+    "CARRIED",
+    "CARRIED_WITH",
+    "FREE",
+    "HAMATE",
+    "LUNATE",
+    "MIDCARPAL",
+    "N_BODIES",
+    "OPTIONAL_BONES",
+    "PAIRS",
+    "PAIR_BONES",
+    "PARTS",
+    "RADIUS",
+    "SCAPHOID",
+    "SUPPLIED",
+    "TRAPEZIUM",
+    "ULNA",
+    "Model",
+    "offsets",
+]
+
 BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate", "trapezium", "hamate")
 """The seven rigid bodies, each named after its principal bone."""
 RADIUS, ULNA, SCAPHOID, LUNATE, CAPITATE, TRAPEZIUM, HAMATE = range(7)

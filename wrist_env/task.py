@@ -26,6 +26,18 @@ from wrist_env.solver.forces import CONTACT_FIELDS
 from wrist_env.solver.settings import DEFAULT_LOADS, LOAD_DIRECTIONS, SolverSettings
 from wrist_env.solver.simulate import Result, prepare, simulate, simulate_batch
 
+__all__ = [
+    "REFERENCE_KEYS",
+    "Evaluation",
+    "Evaluations",
+    "Task",
+    "cost_poses",
+    "has_reference",
+    "outputs",
+    "require_reference",
+    "task",
+]
+
 
 @dataclass(frozen=True)
 class Evaluation:

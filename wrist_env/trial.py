@@ -31,6 +31,26 @@ from wrist_env.limits import MAX_TRIAL_FRAMES
 from wrist_env.model import BONES, CARPALS
 from wrist_env.motions import TRIAL_MOTIONS
 
+__all__ = [
+    "COLUMNS",
+    "MATRIX_COLUMNS",
+    "MAX_TRANSLATION_MM",
+    "METRES_ROTATION_DEG",
+    "METRES_TRANSLATION_MM",
+    "MIRROR",
+    "RADIUS_TOLERANCE_DEG",
+    "RADIUS_TOLERANCE_MM",
+    "REQUIRED_BONES",
+    "ROLES",
+    "ULNA_TOLERANCE_DEG",
+    "ULNA_TOLERANCE_MM",
+    "Trial",
+    "mirror_trial",
+    "read_trial_csv",
+    "validate_transforms",
+    "write_trial_csv",
+]
+
 ROLES = TRIAL_MOTIONS + ("other",)
 REQUIRED_BONES = CARPALS
 MATRIX_COLUMNS = tuple(f"m{r}{c}" for r in range(3) for c in range(4))
