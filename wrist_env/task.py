@@ -244,7 +244,7 @@ class Task:
 
 
 def cost_poses(poses: np.ndarray) -> np.ndarray:
-    """(n_frames, 5, 4, 4) → (2, n_frames, 4, 4) for the cost's bones."""
+    """(n_frames, n_bodies, 4, 4) → (2, n_frames, 4, 4) for the cost's bones."""
     return np.stack([poses[:, BONES.index(b)] for b in COST_BONES])
 
 
