@@ -18,7 +18,13 @@ from numpy.typing import ArrayLike
 from wrist_env.design import SPAN_SD, material_prior
 from wrist_env.errors import InputError
 
-__all__ = ["OptimizeResult", "Optimizer", "OptionError", "minimize", "prior_draw"]
+__all__ = [
+    "OptionError",
+    "OptimizeResult",
+    "Optimizer",
+    "prior_draw",
+    "minimize",
+]
 
 
 class OptionError(InputError):

@@ -17,7 +17,15 @@ from wrist_env.errors import WristEnvError
 if TYPE_CHECKING:
     from optimizers.base import Optimizer
 
-__all__ = ["ENTRY_POINT_GROUP", "UnknownOptimizerError", "available", "get", "make", "register", "unavailable"]
+__all__ = [
+    "ENTRY_POINT_GROUP",
+    "UnknownOptimizerError",
+    "register",
+    "unavailable",
+    "available",
+    "get",
+    "make",
+]
 
 ENTRY_POINT_GROUP = "wrist_env.optimizers"
 _REGISTRY: dict[str, type] = {}

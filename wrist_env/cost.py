@@ -44,7 +44,15 @@ from wrist_env.frames import (
     validate_poses,
 )
 
-__all__ = ["COST_BONES", "FAILED_COST", "PERCENTILE", "RANGE_FLOOR", "CostReport", "CostWeights", "kinematic_cost"]
+__all__ = [
+    "COST_BONES",
+    "PERCENTILE",
+    "RANGE_FLOOR",
+    "FAILED_COST",
+    "CostWeights",
+    "CostReport",
+    "kinematic_cost",
+]
 
 COST_BONES = ("scaphoid", "lunate")
 PERCENTILE = 75.0

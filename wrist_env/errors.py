@@ -5,16 +5,16 @@ also name the file. Each class inherits a builtin so callers can catch either.
 """
 
 __all__ = [
-    "BuildError",
-    "DesignError",
-    "InputError",
-    "Interrupted",
-    "MeshError",
-    "ParticipantError",
-    "StoreError",
-    "TrialError",
-    "UsageError",
     "WristEnvError",
+    "InputError",
+    "MeshError",
+    "TrialError",
+    "ParticipantError",
+    "DesignError",
+    "BuildError",
+    "StoreError",
+    "UsageError",
+    "Interrupted",
 ]
 
 

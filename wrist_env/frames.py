@@ -38,27 +38,27 @@ from numpy.typing import ArrayLike
 from wrist_env.errors import InputError
 
 __all__ = [
-    "BOTTOM_ROW_TOL",
-    "CARDAN_SEQUENCE",
     "DOF_NAMES",
     "DOF_UNITS",
+    "TRANSLATION",
+    "ROTATION",
+    "CARDAN_SEQUENCE",
     "EXPRESSED_IN",
     "ORTHONORMAL_TOL",
-    "ROTATION",
-    "TRANSLATION",
-    "apply",
+    "BOTTOM_ROW_TOL",
+    "validate_poses",
+    "validate_points",
     "cardan_angles",
     "cardan_rotation",
-    "dof_to_pose",
-    "error_dof",
-    "error_dof_validated",
-    "error_transform",
+    "apply",
     "invert",
     "pose_to_dof",
+    "dof_to_pose",
+    "error_transform",
+    "error_dof",
+    "error_dof_validated",
     "pose_to_dof_validated",
     "rmse",
-    "validate_points",
-    "validate_poses",
 ]
 
 DOF_NAMES = ("Vol/Dor", "Pro/Dis", "Rad/Uln", "Flex/Ext", "UlnD/RadD", "Pro/Sup")

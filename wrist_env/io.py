@@ -32,16 +32,16 @@ if TYPE_CHECKING:
 
 __all__ = [
     "FORMAT_VERSION",
-    "atomic_write",
-    "check_regular",
-    "clean_temporary",
-    "fields_equal",
-    "json_sha256",
-    "load_dataclass",
-    "read_json",
     "save_dataclass",
+    "load_dataclass",
+    "fields_equal",
+    "check_regular",
     "sha256_file",
+    "atomic_write",
+    "clean_temporary",
     "write_json",
+    "json_sha256",
+    "read_json",
 ]
 
 _D = TypeVar("_D", bound="DataclassInstance")

@@ -27,14 +27,14 @@ from wrist_env.solver.settings import DEFAULT_LOADS, LOAD_DIRECTIONS, SolverSett
 from wrist_env.solver.simulate import Result, prepare, simulate, simulate_batch
 
 __all__ = [
-    "REFERENCE_KEYS",
     "Evaluation",
     "Evaluations",
+    "REFERENCE_KEYS",
+    "has_reference",
+    "require_reference",
     "Task",
     "cost_poses",
-    "has_reference",
     "outputs",
-    "require_reference",
     "task",
 ]
 

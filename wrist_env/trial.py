@@ -32,22 +32,22 @@ from wrist_env.model import BONES, CARPALS
 from wrist_env.motions import TRIAL_MOTIONS
 
 __all__ = [
-    "COLUMNS",
-    "MATRIX_COLUMNS",
-    "MAX_TRANSLATION_MM",
-    "METRES_ROTATION_DEG",
-    "METRES_TRANSLATION_MM",
-    "MIRROR",
-    "RADIUS_TOLERANCE_DEG",
-    "RADIUS_TOLERANCE_MM",
-    "REQUIRED_BONES",
     "ROLES",
-    "ULNA_TOLERANCE_DEG",
+    "REQUIRED_BONES",
+    "MATRIX_COLUMNS",
+    "COLUMNS",
+    "METRES_TRANSLATION_MM",
+    "METRES_ROTATION_DEG",
+    "MAX_TRANSLATION_MM",
+    "RADIUS_TOLERANCE_MM",
+    "RADIUS_TOLERANCE_DEG",
     "ULNA_TOLERANCE_MM",
+    "ULNA_TOLERANCE_DEG",
+    "MIRROR",
     "Trial",
     "mirror_trial",
-    "read_trial_csv",
     "validate_transforms",
+    "read_trial_csv",
     "write_trial_csv",
 ]
 
