@@ -18,6 +18,14 @@ from numpy.typing import ArrayLike
 from wrist_env.design import SPAN_SD, material_prior
 from wrist_env.errors import InputError
 
+__all__ = [
+    "OptionError",
+    "OptimizeResult",
+    "Optimizer",
+    "prior_draw",
+    "minimize",
+]
+
 
 class OptionError(InputError):
     """An option a calibrator does not have (the message lists the ones it has)."""

@@ -17,6 +17,16 @@ from wrist_env.errors import WristEnvError
 if TYPE_CHECKING:
     from optimizers.base import Optimizer
 
+__all__ = [
+    "ENTRY_POINT_GROUP",
+    "UnknownOptimizerError",
+    "register",
+    "unavailable",
+    "available",
+    "get",
+    "make",
+]
+
 ENTRY_POINT_GROUP = "wrist_env.optimizers"
 _REGISTRY: dict[str, type] = {}
 _UNAVAILABLE: dict[str, str] = {}  # name -> why it is not registered here (what to install)

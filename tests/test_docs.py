@@ -254,3 +254,33 @@ def test_the_extending_page_names_only_files_and_names_that_exist():
     assert len(placed) >= 8, placed
     absent = [(name, path) for name, path in placed if not re.search(rf"\b{name}\b", (ROOT / path).read_text())]
     assert not absent, f"docs/extending.md places names in files that do not hold them: {absent}"
+
+
+def _docstrings(path: Path):
+    import ast
+
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant) and isinstance(node.value.value, str):
+            yield node.value.value  # docstrings of modules, classes, functions and attributes alike
+
+
+def test_no_docstring_writes_a_model_count_as_a_literal_shape():
+    """A shape of the model's bodies or contact pairs is written in symbols (`n_bodies`, `n_pairs`: defined in
+    `wrist_env.model`'s docstring), not in today's counts, which went stale as bodies were added: a tuple
+    with a comma whose first entry, or the first after one leading symbol, is the count ("(7, 3)",
+    "(n_frames, 7, 4, 4)", "(10,)"). A doctest's printed output ("(5, 7, 4, 4)") leads with a number and
+    passes."""
+    from wrist_env.model import BONES, PAIRS
+
+    found = []
+    for count, symbol in ((len(BONES), "n_bodies"), (len(PAIRS), "n_pairs")):
+        shape = re.compile(rf"\((?:[a-z_]+, )?{count}(?:, \d+)*,?\)")
+        for top in ("wrist_env", "optimizers"):
+            for path in sorted((ROOT / top).rglob("*.py")):
+                for doc in _docstrings(path):
+                    found += [
+                        f"{path.relative_to(ROOT)}: {m.group()} (write {symbol})"
+                        for m in shape.finditer(doc)
+                        if "," in m.group()
+                    ]
+    assert not found, "shapes written in today's counts:\n" + "\n".join(found)

@@ -9,6 +9,7 @@ import pytest
 from wrist_env import design, validation
 from wrist_env.cli import main
 from wrist_env.model import CAPITATE
+from wrist_env.validation.chain import _row
 
 pytestmark = pytest.mark.slow  # builds models or runs simulations/studies (minutes)
 
@@ -122,7 +123,7 @@ def test_cli_validate_json_has_the_fourteen_checks(capsys, built, tmp_path):
 
 
 def test_a_failed_run_fails_its_check_and_says_why():
-    row = validation._row(
+    row = _row(
         "sl_gap_growth_mm", "SL gap growth", 5.0, (3.0, math.inf), "mm", "SLIL-torn sweep run failed: NaN in the state"
     )
     assert math.isnan(row.value) and not row.passed and "failed: NaN in the state" in row.description

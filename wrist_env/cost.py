@@ -44,6 +44,16 @@ from wrist_env.frames import (
     validate_poses,
 )
 
+__all__ = [
+    "COST_BONES",
+    "PERCENTILE",
+    "RANGE_FLOOR",
+    "FAILED_COST",
+    "CostWeights",
+    "CostReport",
+    "kinematic_cost",
+]
+
 COST_BONES = ("scaphoid", "lunate")
 PERCENTILE = 75.0
 RANGE_FLOOR = (1.0, 1.0, 1.0, 1.0, 1.0, 1.0)

@@ -4,6 +4,19 @@ Every error names the rule that failed and the offending value; input errors
 also name the file. Each class inherits a builtin so callers can catch either.
 """
 
+__all__ = [
+    "WristEnvError",
+    "InputError",
+    "MeshError",
+    "TrialError",
+    "ParticipantError",
+    "DesignError",
+    "BuildError",
+    "StoreError",
+    "UsageError",
+    "Interrupted",
+]
+
 
 class WristEnvError(Exception):
     """Base class of every wrist-env error."""

@@ -37,6 +37,30 @@ from numpy.typing import ArrayLike
 
 from wrist_env.errors import InputError
 
+__all__ = [
+    "DOF_NAMES",
+    "DOF_UNITS",
+    "TRANSLATION",
+    "ROTATION",
+    "CARDAN_SEQUENCE",
+    "EXPRESSED_IN",
+    "ORTHONORMAL_TOL",
+    "BOTTOM_ROW_TOL",
+    "validate_poses",
+    "validate_points",
+    "cardan_angles",
+    "cardan_rotation",
+    "apply",
+    "invert",
+    "pose_to_dof",
+    "dof_to_pose",
+    "error_transform",
+    "error_dof",
+    "error_dof_validated",
+    "pose_to_dof_validated",
+    "rmse",
+]
+
 DOF_NAMES = ("Vol/Dor", "Pro/Dis", "Rad/Uln", "Flex/Ext", "UlnD/RadD", "Pro/Sup")
 DOF_UNITS = ("mm", "mm", "mm", "deg", "deg", "deg")
 TRANSLATION = slice(0, 3)

@@ -30,6 +30,20 @@ from wrist_env.errors import InputError, StoreError
 if TYPE_CHECKING:
     from _typeshed import DataclassInstance
 
+__all__ = [
+    "FORMAT_VERSION",
+    "save_dataclass",
+    "load_dataclass",
+    "fields_equal",
+    "check_regular",
+    "sha256_file",
+    "atomic_write",
+    "clean_temporary",
+    "write_json",
+    "json_sha256",
+    "read_json",
+]
+
 _D = TypeVar("_D", bound="DataclassInstance")
 
 FORMAT_VERSION = 1

@@ -4,6 +4,19 @@ All positions are in the RCS at the neutral pose (mm), which is also each
 bone's own frame: a bone's pose is the 4x4 transform of its neutral-pose
 points. Ragged per-bone or per-pair data are concatenated with offsets, so
 `x[offsets[i]:offsets[i + 1]]` is item i; this is the layout the kernels read.
+
+Shapes in the package's docstrings are written in these symbols, not in the current counts, which
+change as the model grows:
+
+- n_bodies: the rigid bodies, `N_BODIES = len(BONES)`; n_bones in the solver is the same count.
+- n_free: the bodies free in 6 DOF, `len(FREE)`.
+- n_pairs: the contact pairs, `len(PAIRS)`; n_samples: the contact samples of all pairs.
+- n_bundles: the ligament bundles the solver pulls, `len(design.ALL_LIGAMENT_NAMES)` (the design's
+  ligaments, then the fixed ones); n_ligaments in a design: `design.N_LIGAMENTS`, the 11 of Table 2.
+- n_frames: the frames of a driver or trial; n_nodes: the RSC membrane's nodes.
+
+What is fixed stays a number: 27 design variables, 22 materials, 2 bones × 6 DOF = 12 errors, 4×4
+transforms, 3 axes.
 """
 
 from __future__ import annotations
@@ -16,6 +29,32 @@ from numpy.typing import ArrayLike
 
 from wrist_env.errors import InputError
 from wrist_env.io import load_dataclass, save_dataclass
+
+__all__ = [
+    "BONES",
+    "RADIUS",
+    "ULNA",
+    "SCAPHOID",
+    "LUNATE",
+    "CAPITATE",
+    "TRAPEZIUM",
+    "HAMATE",
+    "N_BODIES",
+    "FREE",
+    "CARRIED",
+    "BODY_PARTS",
+    "SUPPLIED",
+    "OPTIONAL_BONES",
+    "CARPALS",
+    "CARRIED_WITH",
+    "PARTS",
+    "PAIRS",
+    "PAIR_BONES",
+    "ARTICULATIONS",
+    "MIDCARPAL",
+    "Model",
+    "offsets",
+]
 
 BONES = ("radius", "ulna", "scaphoid", "lunate", "capitate", "trapezium", "hamate")
 """The seven rigid bodies, each named after its principal bone."""
@@ -119,24 +158,25 @@ MIDCARPAL = ("scaphotrapeziotrapezoid", "scaphocapitate", "lunocapitate", "triqu
 class Model:
     """A participant model.
 
-    Bones (7, `BONES` order):
-        vertices (V, 3) mm, vertex_offsets (8,); faces (F, 3) local indices, face_offsets (8,);
+    Bodies (n_bodies, `BONES` order):
+        vertices (V, 3) mm, vertex_offsets (n_bodies + 1,); faces (F, 3) local indices,
+        face_offsets (n_bodies + 1,);
         vertex_part (V,) index into `BODY_PARTS[body]` of the bone each vertex belongs to;
         thickness (V,) mm, cartilage thickness per vertex (0 off cartilage);
-        mass (7,) t; com (7, 3) mm; inertia (7, 3, 3) t·mm² about the com, RCS axes;
-        centroid (7, 3) mm, volume centroid of each body's principal bone alone (the point
+        mass (n_bodies,) t; com (n_bodies, 3) mm; inertia (n_bodies, 3, 3) t·mm² about the com, RCS axes;
+        centroid (n_bodies, 3) mm, volume centroid of each body's principal bone alone (the point
         whose motion the kinematic cost tracks; the lunate's without the triquetrum).
     Contact grids (one per bone; empty for the radial column; the ulna's its head, closed, with the TFCC):
-        grid_origin (7, 3) mm; grid_spacing (7,) mm; grid_shape (7, 3);
-        grid_values (G,) float32 mm, C-order per bone, grid_offsets (8,).
-    Contact samples (pair-sorted, 10 pairs in `PAIRS` order, bones in `PAIR_BONES`):
+        grid_origin (n_bodies, 3) mm; grid_spacing (n_bodies,) mm; grid_shape (n_bodies, 3);
+        grid_values (G,) float32 mm, C-order per bone, grid_offsets (n_bodies + 1,).
+    Contact samples (pair-sorted, n_pairs in `PAIRS` order, bones in `PAIR_BONES`):
         sample_points (S, 3) mm on the sample bone's cartilage surface; sample_normals (S, 3);
         sample_area (S,) mm²; sample_thickness (S,) mm, total cartilage thickness of both layers;
-        sample_offsets (11,).
+        sample_offsets (n_pairs + 1,).
     contact_law (5,): tri-linear pressure–strain law [e1, e2, k1, k2, k3] (strain, MPa).
     Ligament fibres (1D bundles, Table 2 order):
         fibre_ligament (N,) ligament index; fibre_bones (N, 2) origin, insertion bone;
-        fibre_origin (N, 3), fibre_insertion (N, 3) mm; reference_length (11,) mm, the mean
+        fibre_origin (N, 3), fibre_insertion (N, 3) mm; reference_length (n_ligaments,) mm, the mean
         neutral fibre length of each bundle (for the RSC, of its longitudinal connectors).
     RSC membrane:
         membrane_nodes (M, 3) mm; membrane_bone (M,) attached bone or -1 if free;

@@ -26,6 +26,18 @@ from wrist_env.solver.forces import CONTACT_FIELDS
 from wrist_env.solver.settings import DEFAULT_LOADS, LOAD_DIRECTIONS, SolverSettings
 from wrist_env.solver.simulate import Result, prepare, simulate, simulate_batch
 
+__all__ = [
+    "Evaluation",
+    "Evaluations",
+    "REFERENCE_KEYS",
+    "has_reference",
+    "require_reference",
+    "Task",
+    "cost_poses",
+    "outputs",
+    "task",
+]
+
 
 @dataclass(frozen=True)
 class Evaluation:
@@ -232,7 +244,7 @@ class Task:
 
 
 def cost_poses(poses: np.ndarray) -> np.ndarray:
-    """(n_frames, 5, 4, 4) → (2, n_frames, 4, 4) for the cost's bones."""
+    """(n_frames, n_bodies, 4, 4) → (2, n_frames, 4, 4) for the cost's bones."""
     return np.stack([poses[:, BONES.index(b)] for b in COST_BONES])
 
 

@@ -31,6 +31,26 @@ from wrist_env.limits import MAX_TRIAL_FRAMES
 from wrist_env.model import BONES, CARPALS
 from wrist_env.motions import TRIAL_MOTIONS
 
+__all__ = [
+    "ROLES",
+    "REQUIRED_BONES",
+    "MATRIX_COLUMNS",
+    "COLUMNS",
+    "METRES_TRANSLATION_MM",
+    "METRES_ROTATION_DEG",
+    "MAX_TRANSLATION_MM",
+    "RADIUS_TOLERANCE_MM",
+    "RADIUS_TOLERANCE_DEG",
+    "ULNA_TOLERANCE_MM",
+    "ULNA_TOLERANCE_DEG",
+    "MIRROR",
+    "Trial",
+    "mirror_trial",
+    "validate_transforms",
+    "read_trial_csv",
+    "write_trial_csv",
+]
+
 ROLES = TRIAL_MOTIONS + ("other",)
 REQUIRED_BONES = CARPALS
 MATRIX_COLUMNS = tuple(f"m{r}{c}" for r in range(3) for c in range(4))

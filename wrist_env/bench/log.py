@@ -88,7 +88,6 @@ class RunLog:
         self.root = Path(root)
         self.store = RunStore(self.root, parts="evals", records="cells")
         self.evals_dir = self.store.parts_dir
-        self.cells_dir = self.store.records_dir
         self.locks_dir = self.store.locks_dir
 
     # writing

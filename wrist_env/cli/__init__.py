@@ -11,6 +11,8 @@ from pkgutil import resolve_name
 
 from wrist_env.errors import UsageError, WristEnvError
 
+__all__ = ["COMMANDS", "main", "parser"]
+
 COMMANDS = {
     "participants": ("participant_commands", "list the known participants"),
     "build": ("participant_commands", "build (or load from cache) a participant model"),

@@ -26,7 +26,7 @@ class SweepFrames:
     """The population design's idealized sweep of a participant's model, as the animation draws it.
 
     name: the participant; angle_deg (n_frames,): the capitate's angle (deg, flexion +); poses (n_frames,
-    n_bodies, 4, 4): each body's pose (RCS, mm); bundle_force (n_frames, n_ligaments): each ligament
+    n_bodies, 4, 4): each body's pose (RCS, mm); bundle_force (n_frames, n_bundles): each ligament
     bundle's force (N); pressure_mpa (n_frames, n_radiocarpal): the pressure (MPa) of the `RADIOCARPAL`
     pairs' samples, in `model.sample_points` order, pair after pair; samples: those pairs' slices of
     `model.sample_points`."""

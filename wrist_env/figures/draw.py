@@ -31,7 +31,6 @@ BONE_COLOUR = {
     "hamate": "#e1d3bf",
 }
 DISTAL_CROP_MM = 12.0  # radius and ulna are drawn by their distal end only (RCS y below this, mm)
-VIEWS = (("volar view", 0, 0), ("radial view", 0, 90), ("oblique", 25, 40))
 LIGAMENT_COLOURS = dict(
     zip(
         ALL_LIGAMENT_NAMES,

@@ -7,3 +7,5 @@
   from there, `bayes.calibrate` (one run: a `posterior.Posterior`) with a `settings.SamplerSettings`,
   `study` (runs, coverage, figures).
 """
+
+__all__: list[str] = []  # the modules are the API: nothing is imported here

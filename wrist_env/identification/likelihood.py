@@ -51,7 +51,7 @@ BOUND_Z = SPAN_SD
 def residuals(task: Task, poses: np.ndarray, reference: np.ndarray | None = None) -> np.ndarray:
     """Per-frame DOF errors of the cost bones over `NOISE`, shape (2, n_frames, 6).
 
-    poses: a simulation's poses (n_frames, 5, 4, 4); reference: (2, n_frames, 4, 4) in
+    poses: a simulation's poses (n_frames, n_bodies, 4, 4); reference: (2, n_frames, 4, 4) in
     `COST_BONES` order (default: the task's trial).
     """
 

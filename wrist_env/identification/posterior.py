@@ -52,8 +52,6 @@ class Posterior:
     settings: dict | None = None
     model_hash: str | None = None
 
-    ARRAYS = ("samples", "log_prob", "map_z", "autocorr", "ess", "rhat", "noise", "predictive", "observed")
-
     @property
     def mean(self) -> np.ndarray:
         return self.samples.mean(axis=0)

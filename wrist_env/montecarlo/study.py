@@ -32,7 +32,7 @@ from __future__ import annotations
 import functools
 import time
 from collections.abc import Iterable, Iterator, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -315,13 +315,3 @@ def counts(out: str | Path, *, complete: bool = False) -> dict[str, ParticipantC
                 f"deleted, or the study still running?); {RERUN}"
             )
     return out_counts
-
-
-def summary_dict(summary: StudySummary) -> dict:
-    return {
-        "config": asdict(summary.config),
-        "counts": {p: asdict(c) for p, c in summary.counts.items()},
-        "simulated": summary.simulated,
-        "wall_seconds": round(summary.wall_seconds, 3),
-        "done": summary.done,
-    }

@@ -213,9 +213,6 @@ class RunStore:
                     out.append((name, str(e)))
         return out
 
-    def remove_part(self, name: str) -> None:
-        remove_file(self.part_path(name))
-
     # records
 
     def record_path(self, name: str) -> Path:

@@ -104,7 +104,7 @@ def _jacobian(q, R0, x0, nodes0, free_nodes, system, stiffness, load, step):
 class Equilibrium:
     """The equilibria nearest an explicit run's frames.
 
-    poses (n_frames, 5, 4, 4): neutral → frame transforms at equilibrium, RCS mm.
+    poses (n_frames, n_bodies, 4, 4): neutral → frame transforms at equilibrium, RCS mm.
     residual (n_frames, 2): largest net force (N) and moment (N·mm) left on the free bones.
     distance (n_frames, 2): largest centre-of-mass distance (mm) and rotation (deg) of a moving
         bone (the free bodies and the capitate) between the explicit answer and the equilibrium.
@@ -117,7 +117,7 @@ class Equilibrium:
 
 def distance(a: np.ndarray, b: np.ndarray, com0: np.ndarray) -> np.ndarray:
     """Per frame, the largest centre-of-mass distance (mm) and rotation (deg) of a moving bone
-    (the free bodies and the capitate) between two pose arrays (n_frames, 5, 4, 4); shape (n_frames, 2)."""
+    (the free bodies and the capitate) between two pose arrays (n_frames, n_bodies, 4, 4); shape (n_frames, 2)."""
     out = np.zeros((len(a), 2))
     for k in FREE + (CAPITATE,):
         ca = np.einsum("fij,j->fi", a[:, k, :3, :3], com0[k]) + a[:, k, :3, 3]

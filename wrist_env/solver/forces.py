@@ -4,7 +4,7 @@ Bodies are indexed as in `wrist_env.model.BONES`. A body's state is its
 rotation R (3, 3), the world position x (3,) of its centre of mass, linear
 velocity v and angular velocity w (world). A neutral-pose point p of the
 body is at R (p − com0) + x. Forces F (N) and torques T (N·mm, about the
-centre of mass) are accumulated into arrays of shape (5, 3).
+centre of mass) are accumulated into arrays of shape (n_bodies, 3).
 
 The kernels work on scalars (3-vectors as tuples) so the hot loops allocate
 nothing.
@@ -268,7 +268,7 @@ def fibre_forces(R, x, v, w, com0, fibres, l0, K, damping_s, F, T, bundle_force,
     """Blankevoort fibre forces; returns strain energy (N·mm; 0 unless `want_energy`).
 
     l0, K: per-fibre zero-load length (mm) and scale (N per unit strain), K = 0 if torn.
-    bundle_force (n_ligaments,) receives the summed tension of each bundle (N).
+    bundle_force (n_bundles,) receives the summed tension of each bundle (N).
     """
     energy = 0.0
     o, ins = fibres.origin, fibres.insertion

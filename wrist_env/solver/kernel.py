@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 
 from wrist_env.design import ALL_LIGAMENT_NAMES, RSC_INDEX
-from wrist_env.model import BONES, CAPITATE, FREE, PAIRS
+from wrist_env.model import BONES, CAPITATE, FREE
 from wrist_env.solver.arrays import LOADED, System
 from wrist_env.solver.forces import (
     C_AREA,
@@ -47,7 +47,7 @@ from wrist_env.solver.rigid import copy_into, interpolate_pose, rotvec_between, 
 from wrist_env.solver.step import Load, State, explicit_step, net_forces, new_work, predicted_start
 from wrist_env.solver.stopping import converged, displacement
 
-N_BONES, N_PAIRS = len(BONES), len(PAIRS)
+N_BONES = len(BONES)
 N_LIGAMENTS = len(ALL_LIGAMENT_NAMES)
 RSC = RSC_INDEX
 OK, FAILED_NAN, FAILED_DIVERGED = 0, 1, 2
@@ -60,8 +60,8 @@ the lines (body, point, direction) of `Load` (flat: a parallel loop takes no nes
 Outputs = namedtuple(
     "Outputs", ["poses", "contact", "bundle", "energy", "residual", "steps", "settled", "nodes", "status"]
 )
-"""What a run fills: poses (n_frames, 5, 4, 4); contact (n_frames, n_pairs, 4) (`forces.CONTACT_FIELDS`);
-bundle forces (n_frames, n_ligaments) N; kinetic and internal energy (n_frames, 2) N·mm; largest net
+"""What a run fills: poses (n_frames, n_bodies, 4, 4); contact (n_frames, n_pairs, 4) (`forces.CONTACT_FIELDS`);
+bundle forces (n_frames, n_bundles) N; kinetic and internal energy (n_frames, 2) N·mm; largest net
 force (N) and moment (N·mm) on the free bones (n_frames, 2); steps per frame (n_frames,); 1 where the
 frame's hold ended in equilibrium, 0 where it ran out of hold steps (n_frames,); RSC membrane
 node positions (n_frames, M, 3) mm; status (1,)."""
@@ -127,7 +127,7 @@ def entry(settings):
 @njit(cache=True, error_model="numpy", inline="always")
 def _run(system, stiffness, frames, out, R, x, nodes, first, smooth, preconditioned):
     """Simulate one design (`Stiffness`) of the model whose `arrays.System` is (bod, grids, law, fib,
-    mem, st) through the capitate's `Frames` from the state (R (5, 3, 3), centres of mass x (5, 3) mm,
+    mem, st) through the capitate's `Frames` from the state (R (n_bodies, 3, 3), centres of mass x (n_bodies, 3) mm,
     membrane nodes (M, 3) mm; all overwritten), its stages from `first`: `SETTLE` from rest, or 1 from
     a frame-0 state (frame 0's outputs then left unfilled). Fills `out` (`Outputs`) and out.status[0]
     (0 ok, 1 NaN, 2 diverged). Steps per frame count those since the previous frame (frame 0: settling

@@ -24,7 +24,8 @@ if TYPE_CHECKING:
 
 
 def _state(model: Model, pose_frame):
-    """(R (5, 3, 3), x (5, 3)) of the kernels from one frame's poses (5, 4, 4), neutral → frame."""
+    """(R (n_bodies, 3, 3), x (n_bodies, 3)) of the kernels from one frame's poses (n_bodies, 4, 4),
+    neutral → frame."""
     P = np.asarray(pose_frame, dtype=np.float64)
     if P.shape != (len(BONES), 4, 4):
         raise ValueError(f"pose_frame must have shape ({len(BONES)}, 4, 4), but got {P.shape}")
@@ -32,7 +33,8 @@ def _state(model: Model, pose_frame):
 
 
 def pressure_map(model: Model, pose_frame: ArrayLike) -> np.ndarray:
-    """Contact pressure (MPa) of every contact sample, shape (n_samples,), at one frame's poses (5, 4, 4).
+    """Contact pressure (MPa) of every contact sample, shape (n_samples,), at one frame's poses
+    (n_bodies, 4, 4).
 
     Samples are in `model.sample_points` order (pair-sorted, `PAIRS`; pair p is
     `model.sample_offsets[p]:model.sample_offsets[p + 1]`); a sample out of
@@ -72,7 +74,7 @@ def sample_parts(model: Model, pair: str) -> np.ndarray:
 def articulation_forces(model: Model, pose_frame: ArrayLike) -> dict[str, float]:
     """Contact force (N: pressure integrated over area, as pressure-sensitive film measures it and
     `Result.contact` reports it) through each articulation (`model.ARTICULATIONS`) at one frame's poses
-    (5, 4, 4), from `pressure_map`; "ulnocarpal" sums the pairs that touch the ulna (0 in a model
+    (n_bodies, 4, 4), from `pressure_map`; "ulnocarpal" sums the pairs that touch the ulna (0 in a model
     without an ulnar load path)."""
     load = pressure_map(model, pose_frame) * model.sample_area
     out = {}
@@ -89,7 +91,7 @@ def driven_body_load(
     model: Model, design, driver, pose_frame: ArrayLike, membrane_nodes: ArrayLike, frame: int = 0
 ) -> tuple[np.ndarray, np.ndarray]:
     """The net force (3,) N and moment (3,) N·mm, RCS, of every force on the driven capitate body at one
-    frame's poses (6, 4, 4) and RSC membrane nodes (M, 3) (a `Result`'s `poses[f]`, `membrane_nodes[f]`):
+    frame's poses (n_bodies, 4, 4) and RSC membrane nodes (n_nodes, 3) (a `Result`'s `poses[f]`, `membrane_nodes[f]`):
     its contacts, ligaments, the membrane and `driver`'s lines at `frame` (`Driver.kernel_load`), summed
     by the solver's own force kernel (`step.net_forces`), the moment about the capitate's centre of
     mass where the poses put it. The driver holds the opposite: at a loaded driver's equilibrium the

@@ -223,7 +223,7 @@ def simulate_frame(
     prepared: Prepared | None = None,
 ) -> Result:
     """Simulate one frame of `driver` (≥ 1) alone, from the state of frame − 1 given as the bones'
-    poses (6, 4, 4) and the membrane's nodes (M, 3) mm (another run's answer there): the capitate ramps
+    poses (n_bodies, 4, 4) and the membrane's nodes (n_nodes, 3) mm (another run's answer there): the capitate ramps
     from frame − 1's pose to frame's and holds. A `Result` of two frames, the first left NaN."""
     if not 1 <= frame < driver.n_frames:
         raise ValueError(f"frame must be in 1..{driver.n_frames - 1}, but got {frame}")

@@ -162,7 +162,7 @@ State = namedtuple("State", ["R", "x", "v", "w", "nodes", "nv"])
 Work = namedtuple("Work", ["active", "n_active", "ref", "F", "T", "node_force", "stats", "bundle"])
 """A run's scratch: active contact samples, their count per pair and the pair transforms when they
 were filled (n_pairs, 12; NaN to refill), forces (n_bodies, 3) N and torques (n_bodies, 3) N·mm on the
-bodies, membrane node forces (n_nodes, 3) N, per-pair contact stats (n_pairs, 3), bundle forces (n_ligaments,) N."""
+bodies, membrane node forces (n_nodes, 3) N, per-pair contact stats (n_pairs, 3), bundle forces (n_bundles,) N."""
 
 
 @njit(cache=True)

@@ -15,19 +15,19 @@ from wrist_env.solver.outputs import articulation_forces
 
 
 def rotation_from_capitate_deg(poses: np.ndarray, body: int) -> np.ndarray:
-    """The rotation (deg, per frame) of `body` relative to the capitate over a run's poses (n, 7, 4, 4)."""
+    """The rotation (deg, per frame) of `body` relative to the capitate over a run's poses (n_frames, n_bodies, 4, 4)."""
     relative = np.einsum("fij,fkj->fik", poses[:, body, :3, :3], poses[:, CAPITATE, :3, :3])
     cos = np.clip((np.trace(relative, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
     return np.degrees(np.arccos(cos))
 
 
 def column_rotation_deg(poses: np.ndarray) -> float:
-    """The radial column's largest rotation (deg) relative to the capitate over a run's poses (n, 7, 4, 4)."""
+    """The radial column's largest rotation (deg) relative to the capitate over a run's poses (n_frames, n_bodies, 4, 4)."""
     return float(rotation_from_capitate_deg(poses, TRAPEZIUM).max())
 
 
 def hamate_rotation_deg(poses: np.ndarray) -> float:
-    """The hamate's largest rotation (deg) relative to the capitate over a run's poses (n, 7, 4, 4): the
+    """The hamate's largest rotation (deg) relative to the capitate over a run's poses (n_frames, n_bodies, 4, 4): the
     distal row moves rigidly together, < 3 deg (Akhbari 2019, J Orthop Res 37:2661)."""
     return float(rotation_from_capitate_deg(poses, HAMATE).max())
 
@@ -77,7 +77,7 @@ def surface_gap_mm(
 
 
 def sl_gap_mm(model: Model, poses: np.ndarray) -> np.ndarray:
-    """Scapholunate gap (mm) per frame of a Result's poses (n_frames, 5, 4, 4): bone surface to bone surface."""
+    """Scapholunate gap (mm) per frame of a Result's poses (n_frames, n_bodies, 4, 4): bone surface to bone surface."""
     s, l = BONES.index("scaphoid"), BONES.index("lunate")
     return surface_gap_mm(model.part_mesh("scaphoid"), model.part_mesh("lunate"), poses[:, s], poses[:, l])
 
