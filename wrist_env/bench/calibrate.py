@@ -35,9 +35,12 @@ import optimizers
 from optimizers.optuna_storage import open_storage
 from wrist_env import design as design_vars
 from wrist_env.bench.log import RunLog
-from wrist_env.bench.replay import REPLAY_TOLERANCE, Logged, Replayed, ResumeError
+from wrist_env.bench.replay import REPLAY_TOLERANCE as REPLAY_TOLERANCE  # `X as X`: re-exported from here
+from wrist_env.bench.replay import Logged, Replayed
+from wrist_env.bench.replay import ResumeError as ResumeError
 from wrist_env.bench.schema import RunKey
-from wrist_env.bench.scoring import recovery_error, rmse_vector, score, unsettled_frames
+from wrist_env.bench.scoring import recovery_error as recovery_error
+from wrist_env.bench.scoring import rmse_vector, score, unsettled_frames
 from wrist_env.design import N_MATERIAL, Design
 from wrist_env.identification.likelihood import map_objective
 from wrist_env.runs import provenance
@@ -45,25 +48,6 @@ from wrist_env.task import Task, task
 
 if TYPE_CHECKING:
     from optuna.storages import BaseStorage
-
-__all__ = [
-    "PRIOR_SUFFIX",
-    "REPLAY_TOLERANCE",
-    "BatchLog",
-    "CalibrationRun",
-    "ResumeError",
-    "Simulated",
-    "accepts_storage",
-    "action",
-    "calibrate",
-    "calibrator_options",
-    "recovery_error",
-    "rmse_vector",
-    "score",
-    "simulate",
-    "split_prior",
-    "unsettled_frames",
-]
 
 PRIOR_SUFFIX = "+prior"
 """Appended to a calibrator's name: the same calibrator on the MAP objective (kinematic misfit + prior)."""
