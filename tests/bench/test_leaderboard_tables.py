@@ -51,8 +51,8 @@ def test_best_cost_counts_runs_whose_calibrated_design_did_not_settle():
 
 
 def test_a_calibrated_design_reports_its_unsettled_frames():
-    """`calibrate._score` counts the frames whose hold ran out (info["settled"] False); None if failed."""
-    from wrist_env.bench.calibrate import _score
+    """`scoring._score` counts the frames whose hold ran out (info["settled"] False); None if failed."""
+    from wrist_env.bench.scoring import _score
 
     info = {"rmse": {}, "error_p75": {}, "settled": np.array([True, False, True, False])}
     assert _score(SimpleNamespace(cost=1.5, failed=False, info=info))["unsettled_frames"] == 2

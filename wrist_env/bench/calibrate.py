@@ -13,10 +13,11 @@ and, for built-in participants, against the hidden truth (parameter recovery
 in Table 2 SD units). On a problem instance k (`instance=k`, `participants.instances`) the trials are
 instance k's and the truth is instance k's draw (`Task.truth`); instance 0 is the shipped problem.
 
-With a run log, every batch is logged as it finishes, and a cell that was
-cut short resumes: its logged evaluations are replayed into a fresh
-calibrator with the same seed (each asked batch must equal the logged points;
-their logged values are told without simulating), then the run continues.
+With a run log, every batch is logged as it finishes (`BatchLog`), and a cell
+that was cut short resumes: its logged evaluations are replayed into a fresh
+calibrator with the same seed (`bench.replay.Replayed`: each asked batch must
+equal the logged points; their logged values are told without simulating),
+then the run continues.
 """
 
 from __future__ import annotations
@@ -34,46 +35,27 @@ import optimizers
 from optimizers.optuna_storage import open_url
 from wrist_env import design as design_vars
 from wrist_env.bench.log import RunLog
-from wrist_env.bench.schema import X_COLUMNS, RunKey
-from wrist_env.cost import COST_BONES
+from wrist_env.bench.replay import REPLAY_TOLERANCE as REPLAY_TOLERANCE  # `X as X`: re-exported from here
+from wrist_env.bench.replay import Logged, Replayed
+from wrist_env.bench.replay import ResumeError as ResumeError
+from wrist_env.bench.schema import RunKey
+from wrist_env.bench.scoring import recovery_error as recovery_error
+from wrist_env.bench.scoring import rmse_vector, score, unsettled_frames
 from wrist_env.design import N_MATERIAL, Design
-from wrist_env.errors import WristEnvError
-from wrist_env.frames import DOF_NAMES
 from wrist_env.identification.likelihood import map_objective
 from wrist_env.runs import provenance
-from wrist_env.task import task
+from wrist_env.task import Task, task
 
 if TYPE_CHECKING:
     from optuna.storages import BaseStorage
 
 PRIOR_SUFFIX = "+prior"
 """Appended to a calibrator's name: the same calibrator on the MAP objective (kinematic misfit + prior)."""
-REPLAY_TOLERANCE = 1e-9
-"""Largest |asked − logged| (normalized units) accepted when replaying a logged batch."""
-
-
-class ResumeError(WristEnvError, RuntimeError):
-    """A calibrator did not ask again for the points it asked before (it is not deterministic)."""
 
 
 def action(x: ArrayLike) -> np.ndarray:
     """The 27-variable action(s) of 22 normalized materials (..., 22), injury scalars intact (+1)."""
     return design_vars.full_action(x)
-
-
-def rmse_vector(info: dict) -> np.ndarray:
-    """The 12 per-DOF RMSE of an evaluation's info, in `RMSE_COLUMNS` order (NaN when missing)."""
-    rmse = info.get("rmse") or {}
-    return np.array(
-        [np.nan if rmse.get(b, {}).get(d) is None else rmse[b][d] for b in COST_BONES for d in DOF_NAMES],
-        dtype=np.float64,
-    )
-
-
-def recovery_error(calibrated: Design, truth: Design) -> float:
-    """Parameter-recovery error: RMS over the 22 materials of z(calibrated) − z(truth), Table 2 SD units."""
-    dz = design_vars.z_scores(calibrated) - design_vars.z_scores(truth)
-    return float(np.sqrt(np.mean(dz**2)))
 
 
 def split_prior(name: str) -> tuple[str, bool]:
@@ -155,20 +137,97 @@ class CalibrationRun:
         return out
 
 
-def unsettled_frames(evaluation) -> int | None:
-    """Frames of an evaluated run whose hold ran out before equilibrium; None if the run failed."""
-    return None if evaluation.failed else int(np.sum(~np.asarray(evaluation.info["settled"], dtype=bool)))
+def calibrator_options(cls, study_name: str, storage: str | BaseStorage | None, options: dict | None) -> dict:
+    """The options a cell's calibrator is made with: `options`, plus, for one that takes an Optuna storage
+    (and given one), the storage and the cell's study name, its study deleted first: the run log is the
+    record, and the replay of a resume rebuilds the study from it."""
+    options = dict(options or {})
+    if storage is not None and accepts_storage(cls):
+        import optuna
+
+        storage_obj = open_url(storage) if isinstance(storage, str) else storage
+        try:
+            optuna.delete_study(study_name=study_name, storage=storage_obj)
+        except KeyError:
+            pass
+        options.update(storage=storage_obj, study_name=study_name)
+    return options
 
 
-def _score(evaluation) -> dict:
-    info = evaluation.info
-    return {
-        "cost": float(evaluation.cost),
-        "failed": bool(evaluation.failed),
-        "rmse": info.get("rmse"),
-        "error_p75": info.get("error_p75"),
-        "unsettled_frames": unsettled_frames(evaluation),
-    }
+@dataclass(frozen=True)
+class Simulated:
+    """One batch simulated on the calibration trial: the values told (`objective`: the cost, or the MAP
+    objective for a ``+prior`` calibrator) and what the log keeps of each evaluation besides."""
+
+    objective: np.ndarray
+    cost: np.ndarray
+    failed: np.ndarray
+    rmse: np.ndarray
+    unsettled: list
+
+
+def simulate(calibration: Task, x: np.ndarray, prior: bool) -> Simulated:
+    """Evaluate a batch of normalized materials (k, 22) in one batched simulation of the calibration trial."""
+    designs = [design_vars.from_action(a) for a in action(x)]
+    evaluations = calibration.evaluate_batch(designs)
+    cost = evaluations.cost
+    objective = cost
+    if prior:
+        objective = np.array(
+            [map_objective(calibration, e, design_vars.z_scores(d)) for e, d in zip(evaluations, designs)]
+        )
+    rmse = np.stack([rmse_vector(e.info) for e in evaluations])
+    return Simulated(objective, cost, evaluations.failed, rmse, [unsettled_frames(e) for e in evaluations])
+
+
+class BatchLog:
+    """A cell's evaluation and its logging, batch by batch, for `minimize` (`evaluate`, then `told` as its
+    callback) and for a replay (`replayed`, as its `on_batch`).
+
+    Batches are numbered in the order asked; the first one simulated after a replay takes the next free
+    number of the log (`first_new`) if that is higher. Without a run log nothing is written.
+    ``callback(n_new, nfev)`` is called after every batch, n_new 0 for a replayed one.
+    """
+
+    def __init__(
+        self,
+        calibration: Task,
+        prior: bool,
+        run_log: RunLog | None,
+        key: RunKey,
+        first_new: int,
+        made_from: dict | None = None,
+        callback: Callable[[int, int], object] | None = None,
+    ):
+        self.calibration, self.prior, self.run_log, self.key = calibration, prior, run_log, key
+        self.first_new, self.made_from, self.callback = first_new, made_from, callback
+        self.nfev = self.batch = 0
+        self.pending: Simulated | None = None
+
+    def evaluate(self, x: np.ndarray) -> np.ndarray:
+        """The values of a batch asked, simulated (kept until `told` logs them)."""
+        self.pending = simulate(self.calibration, x, self.prior)
+        return self.pending.objective
+
+    def told(self, x: np.ndarray, y: np.ndarray) -> None:
+        """Log the batch just simulated and told."""
+        self.batch = max(self.batch, self.first_new)
+        if self.run_log is not None:
+            p = self.pending
+            self.run_log.append(
+                self.key, self.batch, self.nfev, x, p.cost, p.failed, p.rmse, y, p.unsettled, self.made_from
+            )
+        self._counted(len(x), len(x))
+
+    def replayed(self, x: np.ndarray, y: np.ndarray) -> None:
+        """Count a batch replayed from the log (nothing simulated, nothing written)."""
+        self._counted(len(x), 0)
+
+    def _counted(self, k: int, n_new: int) -> None:
+        self.batch += 1
+        self.nfev += k
+        if self.callback is not None:
+            self.callback(n_new, self.nfev)
 
 
 def calibrate(
@@ -248,103 +307,29 @@ def calibrate(
     start_time = time.perf_counter()
     key = RunKey(participant, optimizer_name, int(seed), int(budget), instance)
     run_log = None if log is None else (log if isinstance(log, RunLog) else RunLog(Path(log)))
-    options = dict(options or {})
     base_name, prior = split_prior(optimizer_name)
-    cls = optimizers.get(base_name)
-    if storage is not None and accepts_storage(cls):
-        import optuna
-
-        storage_obj = open_url(storage) if isinstance(storage, str) else storage
-        try:  # the log is the record: rebuild the study by replay
-            optuna.delete_study(study_name=key.name, storage=storage_obj)
-        except KeyError:
-            pass
-        options.update(storage=storage_obj, study_name=key.name)
+    options = calibrator_options(optimizers.get(base_name), key.name, storage, options)
     calibration = task(participant, "calibrate", instance=instance)
     if run_log is not None:
         made_from = made_from or provenance.of_participant(participant, instance)
         run_log.move_aside_stale(key, made_from)  # another model's evaluations are not replayed
+    logged = Logged.of(None if run_log is None else run_log.read_cell(key), N_MATERIAL)
 
-    logged = run_log.read_cell(key) if run_log is not None else None
-    logged_x = np.empty((0, N_MATERIAL)) if logged is None else logged[list(X_COLUMNS)].to_numpy()
-    logged_y = np.empty(0) if logged is None else logged["objective"].fillna(logged["cost"]).to_numpy()
-    logged_batches = 0 if logged is None else int(logged["batch"].max()) + 1
-    if len(logged_x) > budget:
-        raise ResumeError(f"{key.name}: {len(logged_x)} evaluations are logged, more than the budget {budget}")
-    state = {"nfev": 0, "batch": 0, "replayed": 0, "new": False, "pending": None}
-
-    def fun_batch(x):
-        n, k = state["nfev"], len(x)
-        if n < len(logged_x):
-            if n + k > len(logged_x) or np.max(np.abs(x - logged_x[n : n + k])) > REPLAY_TOLERANCE:
-                raise ResumeError(
-                    f"{key.name}: on resume the calibrator asked for evaluations {n}…{n + k - 1} differently than "
-                    f"logged ({len(logged_x)} logged); it is not deterministic for a seed, so this cell cannot "
-                    f"resume: delete its files from the run log to start it over"
-                )
-            state["new"] = False
-            return logged_y[n : n + k]
-        designs = [design_vars.from_action(a) for a in action(x)]
-        evaluations = calibration.evaluate_batch(designs)
-        cost = evaluations.cost
-        y = cost
-        if prior:
-            y = np.array([map_objective(calibration, e, design_vars.z_scores(d)) for e, d in zip(evaluations, designs)])
-        state["new"] = True
-        state["pending"] = (
-            cost,
-            evaluations.failed,
-            np.stack([rmse_vector(e.info) for e in evaluations]),
-            [unsettled_frames(e) for e in evaluations],
-        )
-        return y
-
-    def after_batch(x, y):
-        n, k = state["nfev"], len(x)
-        if state["new"]:
-            state["batch"] = max(state["batch"], logged_batches)  # after a replay: the next free batch number
-            if run_log is not None:
-                cost, failed, rmse, unsettled = state["pending"]
-                run_log.append(
-                    key, state["batch"], n, x, cost, failed, rmse, objective=y, unsettled=unsettled, made_from=made_from
-                )
-        else:
-            state["replayed"] += k
-        state["batch"] += 1
-        state["nfev"] = n + k
-        if callback is not None:
-            callback(k if state["new"] else 0, state["nfev"])
-
-    optimizer = optimizers.make(base_name, dim=N_MATERIAL, budget=budget, seed=seed, **options)
+    batches = BatchLog(calibration, prior, run_log, key, logged.batches, made_from, callback)
+    calibrator = optimizers.make(base_name, dim=N_MATERIAL, budget=budget, seed=seed, **options)
     try:
-        result = optimizers.minimize(optimizer, fun_batch, after_batch)
+        resumed = Replayed(calibrator, logged, key.name, on_batch=batches.replayed)
+        result = optimizers.minimize(resumed, batches.evaluate, batches.told)
     finally:
-        optimizer.close()
-    if state["nfev"] < len(logged_x):
-        raise ResumeError(
-            f"{key.name}: the calibrator stopped after {state['nfev']} evaluations, but {len(logged_x)} are logged"
-        )
+        calibrator.close()
 
-    best_eval = int(np.argmin(result.history_fun))
-    calibrated = design_vars.from_action(action(result.x))
-    at_calibrate = _score(calibration.evaluate(calibrated))
-    at_validate = _score(task(participant, "validate", instance=instance).evaluate(calibrated))
-    recovery = recovery_population = None
-    if calibration.truth is not None:  # the instance's hidden truth
-        recovery = recovery_error(calibrated, calibration.truth)
-        recovery_population = recovery_error(design_vars.population(), calibration.truth)
     run = CalibrationRun(
         key,
         result,
-        calibrated,
-        at_calibrate,
-        at_validate,
-        recovery,
-        recovery_population,
-        best_eval,
-        state["replayed"],
-        time.perf_counter() - start_time,
-        {k: v for k, v in options.items() if k not in ("storage",)},
+        **score(result, calibration, task(participant, "validate", instance=instance)),
+        replayed=resumed.replayed,
+        wall_seconds=time.perf_counter() - start_time,
+        options={k: v for k, v in options.items() if k not in ("storage",)},
     )
     if run_log is not None:
         run_log.compact(key)
