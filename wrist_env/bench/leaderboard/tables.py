@@ -52,7 +52,8 @@ def problem_label(participant: str, instance: int) -> str:
 
 
 def problem_of(problem: str) -> tuple[str, int]:
-    """(participant, instance) of a problem's name (`problem_label`'s inverse)."""
+    """(participant, instance) of a problem's name (`problem_label`'s inverse): unambiguous, since a participant's
+    name has no "." (`participants.folder.NAME_PATTERN`; the built-ins' neither)."""
     head, dot, tail = problem.rpartition(".i")
     return (head, int(tail)) if dot and tail.isdigit() else (problem, 0)
 
