@@ -43,7 +43,7 @@ COLUMN_BANDS = ("TZC_p", "TZC_d")
 def scaled(hamate: float = 1.0, column: float = 1.0):
     """The capitohamate joint's spring × `hamate` and the trapezocapitate bands' stiffness × `column`
     for the block (module constants read when a simulation is prepared), restored after."""
-    joint, fixed = arrays.CH_JOINT_STIFFNESS, design.FIXED_LIGAMENTS
+    joint, fixed = arrays.CH_JOINT_STIFFNESS, design.FIXED_LIGAMENTS  # design.ligament_arrays reads its own name
     arrays.CH_JOINT_STIFFNESS = tuple(hamate * k for k in joint)
     design.FIXED_LIGAMENTS = tuple(
         replace(lig, stiffness_mean=column * lig.stiffness_mean) if lig.name in COLUMN_BANDS else lig for lig in fixed

@@ -8,9 +8,10 @@ from pathlib import Path
 from typing import Any
 
 from wrist_env.bench.calibrate import CalibrationRun, ResumeError, calibrate
+from wrist_env.bench.cells import SEED_IS_INSTANCE, make_cells
 from wrist_env.bench.leaderboard import write_leaderboard as write
 from wrist_env.bench.log import DuplicateEvaluationError, RunLog
-from wrist_env.bench.runner import SEED_IS_INSTANCE, BenchmarkReport, benchmark, make_cells
+from wrist_env.bench.runner import BenchmarkReport, benchmark
 from wrist_env.bench.schema import RunKey
 
 

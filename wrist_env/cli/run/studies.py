@@ -13,10 +13,11 @@ from pathlib import Path
 import optimizers
 from wrist_env import bench
 from wrist_env.bench.calibrate import PRIOR_SUFFIX, accepts_storage, split_prior
+from wrist_env.bench.cells import SEED_IS_INSTANCE, make_cells
 from wrist_env.bench.iohanalyzer import export
 from wrist_env.bench.leaderboard import reference, write_leaderboard
 from wrist_env.bench.log import RunLog
-from wrist_env.bench.runner import NO_STORAGE, SEED_IS_INSTANCE, make_cells
+from wrist_env.bench.runner import NO_STORAGE
 from wrist_env.cli.run.outputs import out_file, out_folder
 from wrist_env.design import LIGAMENT_NAMES
 from wrist_env.errors import Interrupted, StoreError, UsageError, WristEnvError
