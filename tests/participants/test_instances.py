@@ -46,16 +46,29 @@ def test_a_drawn_truth_is_fixed_intact_and_within_the_prior():
     assert np.all(np.abs(action[: design.N_MATERIAL]) <= 1.0)  # Table 2's normals truncated at ±3 SD: the action box
 
 
-@pytest.mark.slow
-def test_a_drawn_instance_is_the_same_problem_on_every_machine():
-    """Instance 1 of P1 made from nothing in this session's model cache — the finer model built, the drawn
-    truth's two trials simulated on it with tracking noise — is the problem pinned here (its truth is pinned
-    above). A change to how instances are made changes it: raise `instances.VERSION` and pin anew."""
+def test_a_drawn_instance_is_the_same_problem_on_every_machine(built, tmp_path, monkeypatch):
+    """Instance 1 of P1 is pinned by what makes it, each part where it is cheap to check: its truth (pinned
+    above); the finer model its trials are simulated on, by its source hash in the instance's key (the bones,
+    the build parameters, the builder's and the annotations' versions: `registry.model_source_hash`, nothing
+    built) — that a build of the same inputs gives the same model is tests/participants/test_registry.py's
+    rebuild of P1 against its shipped model; and the making itself — the truth's two trials simulated with
+    the truth's solver and tracking noise, written and read back — run here on P1's shipped model instead of
+    the finer one (a build of a minute), its trials' digest pinned. A change to any of them changes instance
+    1: raise `instances.VERSION` and pin anew."""
+    from wrist_env.participants import synthetic
+
+    assert instances.instance_key("P1", 1) == "b12045d2f513c3b5"
+    monkeypatch.setenv("WRIST_ENV_CACHE", str(tmp_path))
+    shipped = built("P1")
+    monkeypatch.setattr(synthetic, "load_model", lambda name, params=None: shipped)
     instances.instance.cache_clear()
-    made = instances.instance("P1", 1)
+    try:
+        made = instances.instance("P1", 1)
+    finally:
+        instances.instance.cache_clear()
     assert sorted(made.trials) == ["resisted", "unresisted"]
-    assert all(t.transforms.shape == (len(made.trials[n].bones), 15, 4, 4) for n, t in made.trials.items())
-    assert _trials_digest(made) == "efb174626f4526a5"
+    assert all(t.transforms.shape == (len(t.bones), 15, 4, 4) for t in made.trials.values())
+    assert _trials_digest(made) == "3663e1ff1f077e3b"
 
 
 @pytest.mark.parametrize("bad", [-1, MAX_INSTANCE + 1, 1.5, True, "1"])

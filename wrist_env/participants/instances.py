@@ -96,8 +96,7 @@ def instance_key(name: str, k: int) -> str:
     source hash of the finer model its trials are simulated on."""
     from wrist_env.participants import synthetic  # the solver, on the first instance made or looked up
 
-    model = registry.load_model(name, synthetic.HIGH_FIDELITY_BUILD)
-    text = json.dumps([name, int(k), VERSION, model.source_hash])
+    text = json.dumps([name, int(k), VERSION, registry.model_source_hash(name, synthetic.HIGH_FIDELITY_BUILD)])
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 

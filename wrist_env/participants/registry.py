@@ -137,6 +137,13 @@ def trial(name: str, role: str) -> Trial:
     return found[0]
 
 
+def model_source_hash(name: str, params: BuildParams | None = None) -> str:
+    """The source hash of the model `load_model(name, params)` gives (`builder.digest.source_hash` of its bones
+    and build parameters), without building or loading it."""
+    params = build_params(name, params)
+    return source_hash(name, bones(name, params), params)
+
+
 def load_model(name: str, params: BuildParams | None = None, *, cache: bool = True) -> Model:
     """The participant's model, built on first use and cached by the hash of its inputs (a built-in
     participant's shipped model is used when its hash is that of the inputs: `builtin.SHIPPED_MODEL`).
