@@ -100,6 +100,27 @@ def test_simulate_picks_the_solver(capsys, built):
     assert main(["simulate", "P1", "--solver", "implicit"]) == 2  # argparse's refusal: one line, exit 2
 
 
+def test_simulate_drives_a_trial_as_the_task_does(capsys, built):
+    """`simulate --motion calibrate` drives the capitate through the participant's calibration trial with the driver
+    the task scores (`drivers.for_motion`, one map for both): the same frames and the same scaphoid poses as
+    `task("P1").evaluate`; --frames is refused for a trial (it has its own)."""
+    import numpy as np
+
+    from wrist_env import design
+    from wrist_env.model import BONES
+    from wrist_env.task import task
+
+    built("P1")
+    assert main(["simulate", "P1", "--motion", "calibrate", "--json"]) == 0
+    frames = json.loads(capsys.readouterr().out)["frames"]
+    result = task("P1", "calibrate").evaluate(design.population()).result
+    assert len(frames) == len(result.poses)
+    scaphoid = np.array([f["poses"]["scaphoid"] for f in frames])
+    assert np.allclose(scaphoid, result.poses[:, BONES.index("scaphoid")], atol=1e-9)
+    assert main(["simulate", "P1", "--motion", "validate", "--frames", "5"]) == 2
+    assert "has its trial's" in capsys.readouterr().err
+
+
 def test_simulate_static_truth_and_design_file(capsys, built, tmp_path):
     from wrist_env import design
     from wrist_env.participants.builtin import truth

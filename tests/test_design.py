@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from wrist_env import design
+from wrist_env import design, ligaments
 from wrist_env.errors import DesignError
 
 
@@ -9,7 +9,7 @@ def test_twenty_seven_variables_in_table_2_order():
     assert design.N_DESIGN == 27 and len(design.NAMES) == 27
     assert design.NAMES[0] == "SLIL_v.stiffness" and design.NAMES[11] == "SLIL_v.reference_strain"
     assert design.NAMES[22:] == tuple(f"{n}.injury" for n in ("SLIL_v", "SLIL_p", "SLIL_d", "RSC", "LRL"))
-    assert [l.fibres for l in design.LIGAMENTS] == [7, 7, 7, 0, 4, 4, 3, 3, 7, 3, 3]
+    assert [l.fibres for l in ligaments.LIGAMENTS] == [7, 7, 7, 0, 4, 4, 3, 3, 7, 3, 3]
 
 
 def test_action_maps_to_mean_plus_three_sd():
@@ -102,15 +102,15 @@ def test_the_capitohamate_bands_stiffness_is_ritt_1996s_distraction_shared_by_th
     """Each capitohamate interosseous band (fixed, outside the 27 variables): Ritt 1996's 20 N over the
     joint's 0.3 mm distraction, shared equally by the deep, dorsal and palmar bands (66.7 N/mm for the
     three in parallel, 22.2 N/mm each)."""
-    fixed = {lig.name: lig for lig in design.FIXED_LIGAMENTS}
-    assert design.HAMATE_LIGAMENTS == ("CH_deep", "CH_d", "CH_p")
-    assert design.STIFFNESS_CH == pytest.approx(20.0 / 0.3 / 3) == pytest.approx(22.22, abs=0.01)
-    for name in design.HAMATE_LIGAMENTS:
-        assert fixed[name].stiffness_mean == design.STIFFNESS_CH and not fixed[name].injurable
-        assert name not in design.LIGAMENT_NAMES and name in design.ALL_LIGAMENT_NAMES
-    assert sum(fixed[n].stiffness_mean for n in design.HAMATE_LIGAMENTS) * design.CH_DISTRACTION_MM == pytest.approx(
-        design.CH_RIG_FORCE_N
-    )
+    fixed = {lig.name: lig for lig in ligaments.FIXED_LIGAMENTS}
+    assert ligaments.HAMATE_LIGAMENTS == ("CH_deep", "CH_d", "CH_p")
+    assert ligaments.STIFFNESS_CH == pytest.approx(20.0 / 0.3 / 3) == pytest.approx(22.22, abs=0.01)
+    for name in ligaments.HAMATE_LIGAMENTS:
+        assert fixed[name].stiffness_mean == ligaments.STIFFNESS_CH and not fixed[name].injurable
+        assert name not in ligaments.LIGAMENT_NAMES and name in ligaments.ALL_LIGAMENT_NAMES
+    assert sum(
+        fixed[n].stiffness_mean for n in ligaments.HAMATE_LIGAMENTS
+    ) * ligaments.CH_DISTRACTION_MM == pytest.approx(ligaments.CH_RIG_FORCE_N)
     stiffness, strain, torn = design.ligament_arrays(design.population())
-    k = design.ALL_LIGAMENT_NAMES.index("CH_deep")
-    assert stiffness[k] == design.STIFFNESS_CH and strain[k] == 1.0 and not torn[k] and design.N_DESIGN == 27
+    k = ligaments.ALL_LIGAMENT_NAMES.index("CH_deep")
+    assert stiffness[k] == ligaments.STIFFNESS_CH and strain[k] == 1.0 and not torn[k] and design.N_DESIGN == 27

@@ -36,6 +36,13 @@ def test_light_modules_import_nothing_heavy(module):
     assert loaded == "", f"importing {module} imported {loaded}"
 
 
+@pytest.mark.parametrize("module", ["wrist_env.bench", "wrist_env.task", "wrist_env.montecarlo.sampler"])
+def test_running_a_study_loads_no_plotting(module):
+    """A benchmark's or a Monte Carlo study's workers load what runs a calibration, not matplotlib: the leaderboard
+    and the figures load when they are written."""
+    assert _run(f"import sys, {module}; print('matplotlib' in sys.modules)") == "False"
+
+
 @pytest.mark.parametrize("order", ["import wrist_env, gymnasium", "import gymnasium, wrist_env"])
 def test_builtin_ids_are_registered_in_either_import_order(order):
     ids = _run(f"{order}; print(' '.join(sorted(i for i in gymnasium.registry if i.startswith('wrist_env/'))))")
@@ -232,3 +239,26 @@ def test_no_function_local_import_hides_a_cycle():
         if not target.startswith(module + ".") and target != module and module in reach(target)
     ]
     assert not cycles, cycles
+
+
+def test_the_ligament_catalogue_is_imported_from_its_owner():
+    """One owner per concept (issue 56): every name of the ligament catalogue (`wrist_env.ligaments.__all__`) is
+    imported from `wrist_env.ligaments`, nowhere from `wrist_env.design`, which builds the design on it and no
+    longer re-exports it (package, tests, experiments and docs examples alike)."""
+    from wrist_env import ligaments
+
+    catalogue = set(ligaments.__all__)
+    found = []
+    for path in sorted(ROOT.rglob("*.py")):
+        if any(
+            part in {"runs", ".git", "build", "_build"} or part.startswith(".")
+            for part in path.parts[len(ROOT.parts) :]
+        ):
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.module == "wrist_env.design":
+                found += [f"{path.relative_to(ROOT)}:{node.lineno} {a.name}" for a in node.names if a.name in catalogue]
+    assert not found, found
+    from wrist_env import design
+
+    assert not catalogue & set(design.__all__)

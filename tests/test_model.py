@@ -60,7 +60,7 @@ def test_the_hamate_is_a_free_body_of_its_own_carried_by_the_capitate():
 def test_a_built_model_gives_the_hamate_mass_a_grid_contacts_and_its_capitohamate_bands(built):
     """P1 as built: the hamate has mass and a contact grid, samples on both of its pairs, and the three
     capitohamate bands (3 fibres each) run from it to the capitate; the TH ligament ends on it."""
-    from wrist_env.design import ALL_LIGAMENT_NAMES, HAMATE_LIGAMENTS
+    from wrist_env.ligaments import ALL_LIGAMENT_NAMES, HAMATE_LIGAMENTS
     from wrist_env.model import CAPITATE, HAMATE, LUNATE
 
     p1 = built("P1")

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from wrist_env import design, validation
+from wrist_env import design, ligaments, validation
 from wrist_env.cli import main
 from wrist_env.model import CAPITATE
 from wrist_env.validation.chain import _row
@@ -66,7 +66,7 @@ def test_surface_gap_of_two_translated_boxes():
 
 def test_with_tears_uses_the_injurable_names():
     d = validation.with_tears(design.population(), validation.SLIL)
-    torn = {n for n, t in zip(design.LIGAMENT_NAMES, d.torn) if t}
+    torn = {n for n, t in zip(ligaments.LIGAMENT_NAMES, d.torn) if t}
     assert torn == {"SLIL_v", "SLIL_p", "SLIL_d"}
     assert not design.population().torn.any()
 

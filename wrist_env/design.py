@@ -21,79 +21,11 @@ from numpy.typing import ArrayLike, DTypeLike
 
 from wrist_env.errors import DesignError
 from wrist_env.ligaments import (
-    ALL_LIGAMENT_NAMES as ALL_LIGAMENT_NAMES,
-)
-from wrist_env.ligaments import (
-    ALL_LIGAMENTS as ALL_LIGAMENTS,
-)
-from wrist_env.ligaments import (
-    BODY_LIGAMENTS as BODY_LIGAMENTS,
-)
-from wrist_env.ligaments import (
-    CH_BANDS as CH_BANDS,
-)
-from wrist_env.ligaments import (
-    CH_DISTRACTION_MM as CH_DISTRACTION_MM,
-)
-from wrist_env.ligaments import (
-    CH_JOINT_STIFFNESS as CH_JOINT_STIFFNESS,
-)
-from wrist_env.ligaments import (
-    CH_RIG_FORCE_N as CH_RIG_FORCE_N,
-)
-from wrist_env.ligaments import (
-    CH_RIG_MOMENT_NMM as CH_RIG_MOMENT_NMM,
-)
-from wrist_env.ligaments import (
-    CH_ROTATION_DEG as CH_ROTATION_DEG,
-)
-from wrist_env.ligaments import (
-    CH_SHEAR_MM as CH_SHEAR_MM,
-)
-from wrist_env.ligaments import (
-    COLUMN_LIGAMENTS as COLUMN_LIGAMENTS,
-)
-from wrist_env.ligaments import (
-    FIXED_LIGAMENTS as FIXED_LIGAMENTS,
-)
-from wrist_env.ligaments import (
-    FIXED_REFERENCE_STRAIN as FIXED_REFERENCE_STRAIN,
-)
-from wrist_env.ligaments import (
-    HAMATE_LIGAMENTS as HAMATE_LIGAMENTS,
-)
-from wrist_env.ligaments import (
-    INJURABLE as INJURABLE,
-)
-from wrist_env.ligaments import (
-    LIGAMENT_NAMES as LIGAMENT_NAMES,
-)
-from wrist_env.ligaments import (
-    LIGAMENTS as LIGAMENTS,
-)
-from wrist_env.ligaments import (
-    RSC_INDEX as RSC_INDEX,
-)
-from wrist_env.ligaments import (
-    SOURCE_CH as SOURCE_CH,
-)
-from wrist_env.ligaments import (
-    SOURCE_STT as SOURCE_STT,
-)
-from wrist_env.ligaments import (
-    SOURCE_TZC as SOURCE_TZC,
-)
-from wrist_env.ligaments import (
-    STIFFNESS_CH as STIFFNESS_CH,
-)
-from wrist_env.ligaments import (
-    STIFFNESS_STT as STIFFNESS_STT,
-)
-from wrist_env.ligaments import (
-    STIFFNESS_TZC as STIFFNESS_TZC,
-)
-from wrist_env.ligaments import (  # the catalogue's owner; re-exported for older imports
-    Ligament as Ligament,
+    FIXED_LIGAMENTS,
+    FIXED_REFERENCE_STRAIN,
+    INJURABLE,
+    LIGAMENT_NAMES,
+    LIGAMENTS,
 )
 
 if TYPE_CHECKING:

@@ -11,7 +11,7 @@ change as the model grows:
 - n_bodies: the rigid bodies, `N_BODIES = len(BONES)`; n_bones in the solver is the same count.
 - n_free: the bodies free in 6 DOF, `len(FREE)`.
 - n_pairs: the contact pairs, `len(PAIRS)`; n_samples: the contact samples of all pairs.
-- n_bundles: the ligament bundles the solver pulls, `len(design.ALL_LIGAMENT_NAMES)` (the design's
+- n_bundles: the ligament bundles the solver pulls, `len(ligaments.ALL_LIGAMENT_NAMES)` (the design's
   ligaments, then the fixed ones); n_ligaments in a design: `design.N_LIGAMENTS`, the 11 of Table 2.
 - n_frames: the frames of a driver or trial; n_nodes: the RSC membrane's nodes.
 
@@ -78,14 +78,14 @@ BODY_PARTS = {
 (lunotriquetral motion is small beside scapholunate motion: Ruby 1988, Kobayashi 1997). The trapezium
 and trapezoid are the radial column, a body of its own: it loads the scaphoid's distal pole through the
 STT joint with the 1st and 2nd rays' loads (issue 33: with it on the driven capitate no load reached the
-STT joint), held to the capitate by the trapezocapitate ligaments and joint (`design.FIXED_LIGAMENTS`).
+STT joint), held to the capitate by the trapezocapitate ligaments and joint (`ligaments.FIXED_LIGAMENTS`).
 The hamate is a body of its own too (issue 54, step 2), as in every full-carpus model that bears load
 (Fischli 2009, J Biomech 42:1363; Bajuri 2012, Proc IMechE H): on the driven capitate, the moment of
 its rays' loads (the 4th and 5th metacarpals and, through the pisiform, the FCU: 38 % of the tendon
 rig's tension) went to the driver and the capitate head took their load; free, it balances them on
 its own joints (capitohamate, triquetrohamate), held to the capitate by the three capitohamate
 interosseous ligaments of measured constraint (Ritt, Berger, Bishop & An 1996, J Hand Surg Br
-21:451; `design.HAMATE_LIGAMENTS`). The capitohamate joint still moves little (the distal row moves
+21:451; `ligaments.HAMATE_LIGAMENTS`). The capitohamate joint still moves little (the distal row moves
 rigidly together, < 3 deg: Akhbari 2019, J Orthop Res 37:2661; `validation` checks it)."""
 SUPPLIED = ("radius", "ulna", "scaphoid", "lunate", "capitate")
 """The bodies a participant folder supplies meshes of (the principal bones); the radial column, the

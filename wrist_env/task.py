@@ -16,12 +16,13 @@ from numpy.typing import ArrayLike
 
 from wrist_env import design as design_vars
 from wrist_env.cost import COST_BONES, CostReport, CostWeights, kinematic_cost
-from wrist_env.design import ALL_LIGAMENT_NAMES, Design
+from wrist_env.design import Design
 from wrist_env.errors import DesignError, ParticipantError
+from wrist_env.ligaments import ALL_LIGAMENT_NAMES
 from wrist_env.model import BONES, PAIRS, Model
-from wrist_env.motions import MOTIONS
+from wrist_env.motions import IDEALIZED, MOTIONS, TRIAL_MOTIONS
 from wrist_env.participants import builtin, instances, registry
-from wrist_env.solver.drivers import Driver, idealized, trial_driver
+from wrist_env.solver.drivers import Driver, for_motion
 from wrist_env.solver.forces import CONTACT_FIELDS
 from wrist_env.solver.settings import DEFAULT_LOADS, LOAD_DIRECTIONS, SolverSettings
 from wrist_env.solver.simulate import Result, prepare, simulate, simulate_batch
@@ -80,7 +81,7 @@ def has_reference(participant: str, motion: str) -> bool:
     """Whether the participant's motion has reference kinematics to score against (found without building
     its model): a trial with the motion's role, or for "idealized" a built-in participant's hidden truth
     (a folder participant has none: its sweep's reward is 0 and its `REFERENCE_KEYS` are None)."""
-    if motion == "idealized":
+    if motion == IDEALIZED:
         return participant in builtin.BUILTIN
     return any(t.role == motion for t in registry.trials(participant).values())
 
@@ -92,7 +93,7 @@ def require_reference(participant: str, motion: str) -> None:
         usable = [m for m in MOTIONS if has_reference(participant, m)]
         why = (
             "only the built-in participants' sweeps have one, from their hidden truth"
-            if motion == "idealized"
+            if motion == IDEALIZED
             else f"it has no trial with role {motion!r}"
         )
         raise ParticipantError(
@@ -191,16 +192,22 @@ class Task:
         self.reference_points = self.model.centroid[[BONES.index(b) for b in COST_BONES]]
 
     def _driver_and_reference(self) -> tuple[Driver, np.ndarray | None]:
-        if self.motion == "idealized":
-            driver = idealized(self.model, direction=self.load_direction)
-            if not has_reference(self.participant, self.motion):
-                return driver, None
-            truth = simulate(self.model, self.truth, driver, self.settings)
-            return driver, cost_poses(truth.poses)
-        role = "calibrate" if self.motion == "calibrate" else "validate"
-        trial = registry.trial(self.participant, role) if self.problem is None else self.problem.trial(role)
-        driver = trial_driver(self.model, trial, self.load_direction)
-        return driver, np.stack([trial.pose(b) for b in COST_BONES])
+        """The motion's driver (`drivers.for_motion`) and its reference kinematics of the cost bones: the trial's
+        poses, the hidden truth's sweep, or None (a user participant's sweep)."""
+        trial = None
+        if self.motion in TRIAL_MOTIONS:
+            trial = (
+                registry.trial(self.participant, self.motion)
+                if self.problem is None
+                else self.problem.trial(self.motion)
+            )
+        driver = for_motion(self.model, self.motion, trial, direction=self.load_direction)
+        if trial is not None:
+            return driver, np.stack([trial.pose(b) for b in COST_BONES])
+        if not has_reference(self.participant, self.motion):
+            return driver, None
+        truth = simulate(self.model, self.truth, driver, self.settings)
+        return driver, cost_poses(truth.poses)
 
     def evaluate(self, design: Design) -> Evaluation:
         """Simulate one design and score it."""

@@ -24,7 +24,7 @@ from scipy.spatial import cKDTree
 
 from wrist_env.anatomy import midcarpal
 from wrist_env.anatomy.template import JOINT_SPACE_MM, load_template, oriented_parts
-from wrist_env.design import LIGAMENTS
+from wrist_env.ligaments import LIGAMENTS
 
 DATA = Path(__file__).resolve().parents[2] / "wrist_env" / "anatomy" / "data"
 OUT = DATA / "annotations.json"

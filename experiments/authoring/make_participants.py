@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from wrist_env import design
+from wrist_env import design, ligaments
 from wrist_env.builder.warp import random_warp
 
 OUT = Path(__file__).resolve().parents[2] / "wrist_env" / "participants" / "data"
@@ -33,7 +33,7 @@ def main() -> None:
         warp = type(warp).from_dict({**warp.as_dict(), "scale": row["scale"]})
         truth_seed = row["seed"] + 1
         materials = design.sample_materials(1, truth_seed)[0]
-        action = np.concatenate([materials, np.ones(len(design.INJURABLE))])
+        action = np.concatenate([materials, np.ones(len(ligaments.INJURABLE))])
         truth = design.from_action(action)
         folder = OUT / name
         folder.mkdir(parents=True, exist_ok=True)

@@ -7,7 +7,7 @@ constraint that would bound that turn is measured for the radial column: no mech
 trapezoid–capitate interosseous ligament was found, and the 2nd and 3rd carpometacarpal joints, which
 bind the trapezoid and capitate through the metacarpal bases, are measured only as ranges of motion
 (El-Shennawy et al. 2001, J Hand Surg Am 26:1030: 11° and 7° of flexion–extension), not as a stiffness.
-The hamate's is measured (Ritt et al. 1996: `design.CH_JOINT_STIFFNESS`). So instead of choosing a
+The hamate's is measured (Ritt et al. 1996: `ligaments.CH_JOINT_STIFFNESS`). So instead of choosing a
 stiffness, this probe scales what the model has — the capitohamate joint's measured spring, and the
 trapezocapitate bands (TZC_p, TZC_d: Table 2's palmar radiocarpal stiffness, borrowed) — by 1, 2, 4, 8
 and 16 and prints each body's largest turn from the capitate over validate's sweep (population design,
@@ -26,7 +26,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from wrist_env import design
+from wrist_env import design, ligaments
 from wrist_env.model import CAPITATE, HAMATE, TRAPEZIUM
 from wrist_env.participants.registry import load_model
 from wrist_env.solver import arrays
@@ -43,15 +43,15 @@ COLUMN_BANDS = ("TZC_p", "TZC_d")
 def scaled(hamate: float = 1.0, column: float = 1.0):
     """The capitohamate joint's spring × `hamate` and the trapezocapitate bands' stiffness × `column`
     for the block (module constants read when a simulation is prepared), restored after."""
-    joint, fixed = arrays.CH_JOINT_STIFFNESS, design.FIXED_LIGAMENTS  # design.ligament_arrays reads its own name
+    joint, fixed = arrays.CH_JOINT_STIFFNESS, ligaments.FIXED_LIGAMENTS  # design.ligament_arrays reads its own name
     arrays.CH_JOINT_STIFFNESS = tuple(hamate * k for k in joint)
-    design.FIXED_LIGAMENTS = tuple(
+    ligaments.FIXED_LIGAMENTS = tuple(
         replace(lig, stiffness_mean=column * lig.stiffness_mean) if lig.name in COLUMN_BANDS else lig for lig in fixed
     )
     try:
         yield
     finally:
-        arrays.CH_JOINT_STIFFNESS, design.FIXED_LIGAMENTS = joint, fixed
+        arrays.CH_JOINT_STIFFNESS, ligaments.FIXED_LIGAMENTS = joint, fixed
 
 
 def sweep(model):

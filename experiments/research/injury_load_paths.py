@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from wrist_env import design
+from wrist_env import design, ligaments
 from wrist_env.model import BONES, PAIRS
 from wrist_env.montecarlo.report import PREPRINT_TABLE5
 from wrist_env.montecarlo.sampler import INTACT_ACTION, TORN_ACTION
@@ -50,7 +50,7 @@ def flexion_slopes(poses: np.ndarray) -> tuple[float, float]:
 def designs() -> dict[str, design.Design]:
     """The population design intact and with each injurable ligament torn, by name."""
     out = {"intact": design.population()}
-    for i, name in enumerate(design.INJURABLE):
+    for i, name in enumerate(ligaments.INJURABLE):
         a = design.to_action(design.population())
         a[design.N_MATERIAL :] = INTACT_ACTION
         a[design.N_MATERIAL + i] = TORN_ACTION
@@ -86,7 +86,7 @@ def probe(name: str) -> dict:
             "rs_pressure": float(np.nanmean(r.contact[:, PAIRS.index("radioscaphoid"), R_MEAN])),
             "rs_area": float(np.mean(r.contact[:, PAIRS.index("radioscaphoid"), R_AREA])),
             "pairs": {p: float(np.mean(r.contact[:, i, R_FORCE])) for i, p in enumerate(PAIRS)},
-            "bundles": dict(zip(design.ALL_LIGAMENT_NAMES, np.mean(r.bundle_force, axis=0).astype(float))),
+            "bundles": dict(zip(ligaments.ALL_LIGAMENT_NAMES, np.mean(r.bundle_force, axis=0).astype(float))),
             "slopes": flexion_slopes(r.poses),
         }
     return out
@@ -125,13 +125,13 @@ def report(name: str, rows: dict, study: dict) -> list[str]:
         fmt = "{:.3f}" if case == "intact" else "{:+.3f}"
         lines.append(f"| {case} | " + " | ".join(fmt.format(v) for v in cells) + " |")
     lines += ["", "Where each torn ligament's load goes (means over the sweep):", ""]
-    for lig in design.INJURABLE:
+    for lig in ligaments.INJURABLE:
         row = rows[f"{lig} torn"]
         if row is None or base is None:
             lines.append(f"- **{lig}**: the run failed.")
             continue
         change = row["rs_pressure"] - base["rs_pressure"]
-        others = {n: row["bundles"][n] - base["bundles"][n] for n in design.ALL_LIGAMENT_NAMES if n != lig}
+        others = {n: row["bundles"][n] - base["bundles"][n] for n in ligaments.ALL_LIGAMENT_NAMES if n != lig}
         pairs = {p: row["pairs"][p] - base["pairs"][p] for p in PAIRS}
         theirs = PREPRINT_TABLE5[lig][0]
         ours = study.get(lig)

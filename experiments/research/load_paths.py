@@ -57,8 +57,8 @@ from wrist_env.anatomy.template import load_template, oriented_parts
 from wrist_env.anatomy.ulnar_variance import built_variance, ulnar_variance
 from wrist_env.builder.params import BuildParams
 from wrist_env.builder.warp import Warp
-from wrist_env.design import ALL_LIGAMENT_NAMES
 from wrist_env.errors import BuildError
+from wrist_env.ligaments import ALL_LIGAMENT_NAMES
 from wrist_env.model import BODY_PARTS, BONES, CAPITATE, MIDCARPAL, PAIR_BONES, PAIRS, Model
 from wrist_env.participants import builtin, registry
 from wrist_env.participants.registry import load_model

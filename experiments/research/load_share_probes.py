@@ -23,7 +23,7 @@ import numpy as np
 from load_paths import signed_distance  # this folder's script (on sys.path when run)
 from scipy.spatial.transform import Rotation
 
-from wrist_env import design
+from wrist_env import design, ligaments
 from wrist_env.model import BODY_PARTS, BONES, PAIR_BONES, PAIRS
 from wrist_env.participants.registry import load_model
 from wrist_env.solver import drivers
@@ -89,7 +89,7 @@ def main(names) -> None:
                 for b in ("scaphoid", "lunate")
             ]
             print(f"| {load:g} | {_ratio(r):.2f} | {cap:.2f} | {rot[0]:.1f} / {rot[1]:.1f} |")
-        rsc = design.LIGAMENT_NAMES.index("RSC")
+        rsc = ligaments.LIGAMENT_NAMES.index("RSC")
         stiff = pop.stiffness.copy()
         stiff[rsc] *= 3.0
         print(f"\n{name}: probes at neutral, {PROBE_N:g} N")

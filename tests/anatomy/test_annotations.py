@@ -1,8 +1,9 @@
 import numpy as np
 import pytest
 
-from wrist_env.anatomy.annotations import ARTICULATIONS, read_annotation_data, template_annotations
-from wrist_env.design import LIGAMENTS
+from wrist_env.anatomy.annotations import read_annotation_data, template_annotations
+from wrist_env.ligaments import LIGAMENTS
+from wrist_env.model import PAIRS
 
 
 @pytest.fixture(scope="module")
@@ -14,7 +15,7 @@ def test_every_articulation_is_covered_on_both_bones(ann):
     """Each articulation has cartilage on both bones; the triquetrohamate one only with the distal row (the
     lunate body's triquetrum: the template's lunate, a type I lunate, comes no nearer the hamate than 3.8 mm)."""
     with_row = template_annotations((20.0, 10.0), True)
-    for art in ARTICULATIONS:
+    for art in PAIRS:
         for coverage in (ann.coverage, with_row.coverage):
             a, b, ma, mb = coverage[art]
             if art == "triquetrohamate" and coverage is ann.coverage:
@@ -46,12 +47,12 @@ def test_site_bones_follow_the_anatomy():
 
 
 def test_fixed_midcarpal_ligaments_join_the_triquetrum_to_the_distal_row():
-    """TC and TH (design.FIXED_LIGAMENTS) run palmar, from the triquetrum to the capitate neck and the
+    """TC and TH (ligaments.FIXED_LIGAMENTS) run palmar, from the triquetrum to the capitate neck and the
     hamate body (a body of its own); they are resolved only on bodies that carry the triquetrum (the
     distal row)."""
     from wrist_env.anatomy.annotations import template_annotations
     from wrist_env.anatomy.template import load_template
-    from wrist_env.design import FIXED_LIGAMENTS
+    from wrist_env.ligaments import FIXED_LIGAMENTS
 
     data = read_annotation_data()["ligaments"]
     with_row, without = template_annotations((20.0, 10.0), True), template_annotations()
@@ -72,7 +73,7 @@ def test_fixed_midcarpal_ligaments_join_the_triquetrum_to_the_distal_row():
 
 @pytest.mark.parametrize("distal_row", [False, True])
 def test_the_capitohamate_bands_span_the_joint_at_its_dorsal_palmar_and_deep_distal_parts(distal_row):
-    """CH_d, CH_p and CH_deep (design.HAMATE_LIGAMENTS, Ritt 1996) run from the hamate's side of the
+    """CH_d, CH_p and CH_deep (ligaments.HAMATE_LIGAMENTS, Ritt 1996) run from the hamate's side of the
     capitohamate joint to the capitate's, in every variant: each site within 2.5 mm of the other bone
     (the facing sides), the dorsal band dorsal of the deep one and the palmar band palmar of it (x volar),
     the deep band the most distal (y proximal), each band across the joint (mostly along the radioulnar
@@ -80,7 +81,7 @@ def test_the_capitohamate_bands_span_the_joint_at_its_dorsal_palmar_and_deep_dis
     from scipy.spatial import cKDTree
 
     from wrist_env.anatomy.template import load_template
-    from wrist_env.design import HAMATE_LIGAMENTS
+    from wrist_env.ligaments import HAMATE_LIGAMENTS
 
     data = read_annotation_data()["ligaments"]
     parts = load_template().parts

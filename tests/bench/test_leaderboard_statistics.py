@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 from scipy import stats
 
-from wrist_env.bench.leaderboard.readme import ert_cell, ranking_section
+from wrist_env.bench.leaderboard.readme import ert_cell, ranking_section, spread_cell
 from wrist_env.bench.leaderboard.statistics import (
     AUTORANK_MIN_BLOCKS,
     ERT_PERCENTILES,
@@ -173,3 +173,11 @@ def test_an_ert_cell_shows_the_interval_and_an_open_end():
     assert ert_cell(row) == "4/5, ERT 149 [92, 310]"
     assert ert_cell(SimpleNamespace(solved=1, runs=2, ert=25.0, ert_low=10.0, ert_high=np.inf)) == "1/2, ERT 25 [10, ∞]"
     assert ert_cell(SimpleNamespace(solved=0, runs=2, ert=np.inf, ert_low=np.inf, ert_high=np.inf)) == "0/2"
+
+
+def test_a_single_run_shows_its_value_without_a_degenerate_interval():
+    """The held-out table's cost: median [IQR] over two or more runs; one run (the default benchmark's one run per
+    problem) or a reference design its value alone, not "[x, x]"."""
+    assert spread_cell(1.5, 1.5, 1.5, 1) == "1.500"
+    assert spread_cell(0.25, 0.25, 0.25, 0) == "0.250"
+    assert spread_cell(1.5, 1.25, 2.0, 3) == "1.500 [1.250, 2.000]"

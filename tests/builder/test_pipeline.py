@@ -7,7 +7,7 @@ from wrist_env.anatomy.annotations import read_annotation_data
 from wrist_env.builder.params import BuildParams
 from wrist_env.builder.pipeline import TFCC
 from wrist_env.builder.sdf import DistanceGrid, trilinear
-from wrist_env.design import ALL_LIGAMENTS
+from wrist_env.ligaments import ALL_LIGAMENTS
 from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model
 
 pytestmark = pytest.mark.slow  # builds models or runs simulations/studies (minutes)

@@ -3,7 +3,7 @@
 import importlib.util
 from pathlib import Path
 
-from wrist_env import design
+from wrist_env import ligaments
 from wrist_env.model import PAIRS
 from wrist_env.montecarlo.report import PREPRINT_TABLE5
 
@@ -19,13 +19,13 @@ def _module():
 
 def _row(rs_pressure: float, rsc: float = 10.0, rl: float = 40.0) -> dict:
     pairs = dict.fromkeys(PAIRS, 5.0) | {"radiolunate": rl}
-    bundles = dict.fromkeys(design.ALL_LIGAMENT_NAMES, 1.0) | {"RSC": rsc}
+    bundles = dict.fromkeys(ligaments.ALL_LIGAMENT_NAMES, 1.0) | {"RSC": rsc}
     return {"rs_pressure": rs_pressure, "rs_area": 12.0, "pairs": pairs, "bundles": bundles, "slopes": (0.7, 0.4)}
 
 
 def test_a_sign_against_the_preprints_is_said_with_where_the_load_went():
     module = _module()
-    rows = {"intact": _row(1.0)} | {f"{lig} torn": _row(1.0) for lig in design.INJURABLE}
+    rows = {"intact": _row(1.0)} | {f"{lig} torn": _row(1.0) for lig in ligaments.INJURABLE}
     rows["RSC torn"] = _row(0.9, rsc=0.0, rl=47.5)  # the preprint's RSC estimate is positive
     lines = "\n".join(module.report("P1", rows, {"RSC": -0.06}))
     rsc = next(line for line in lines.splitlines() if line.startswith("- **RSC**"))

@@ -5,8 +5,8 @@ import patsy
 import pyarrow as pa
 import pytest
 
-from wrist_env.design import INJURABLE, LIGAMENT_NAMES
 from wrist_env.errors import InputError
+from wrist_env.ligaments import INJURABLE, LIGAMENT_NAMES
 from wrist_env.montecarlo import stats
 
 ANGLES = np.linspace(40.0, -40.0, 17)

@@ -9,8 +9,8 @@ import trimesh
 from wrist_env.anatomy.template import load_template
 from wrist_env.builder.params import BuildParams
 from wrist_env.builder.warp import random_warp
-from wrist_env.design import ALL_LIGAMENTS
 from wrist_env.errors import BuildError, ParticipantError
+from wrist_env.ligaments import ALL_LIGAMENTS
 from wrist_env.model import HAMATE, SUPPLIED
 from wrist_env.participants import registry
 from wrist_env.participants.folder import ParticipantSource, write_participant_folder

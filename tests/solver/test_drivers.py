@@ -36,3 +36,38 @@ def test_a_static_hold_of_too_many_frames_is_refused():
 def test_a_load_that_is_not_a_finite_push_is_refused(load_n):
     with pytest.raises(InputError, match="load_n must be finite and >= 0 N"):
         drivers.loaded(None, [[[1.0, 0, 0], [0, 1, 0], [0, 0, 1]]] * 2, load_n=load_n)
+
+
+@pytest.mark.parametrize(
+    "motion, kwargs, says",
+    [
+        ("sweep", {}, "motion must be one of ('calibrate', 'validate', 'idealized', 'static'), but got 'sweep'"),
+        ("calibrate", {}, "the 'calibrate' motion is a trial's: give its trial"),
+        ("static", {"trial": object()}, "the 'static' motion takes no trial"),
+        ("idealized", {"n_frames": 0}, "n_frames must be an integer in [1, 10,000], but got 0"),
+    ],
+)
+def test_a_motion_without_what_it_needs_is_refused(motion, kwargs, says):
+    with pytest.raises(InputError) as refused:
+        drivers.for_motion(None, motion, **kwargs)
+    assert says in str(refused.value)
+
+
+def test_each_motion_maps_to_its_driver(p1):
+    """`for_motion` is the one map from a motion's name to a driver (the task's and `wrist-bench simulate`'s): the
+    sweep is the loaded driver through 17 angles from 40° of flexion, the hold three identity frames, a trial the
+    experimental driver through its capitate's poses under its load; a trial motion takes its trial's frames."""
+    from wrist_env.participants import registry
+    from wrist_env.solver import arrays
+
+    sweep = drivers.for_motion(p1, "idealized")
+    assert sweep.mode == arrays.LOADED and sweep.n_frames == 17 and sweep.angle_deg[0] == 40.0
+    assert sweep.angle_deg[-1] == -40.0
+    hold = drivers.for_motion(p1, "static")
+    assert hold.mode == arrays.EXPERIMENTAL and hold.n_frames == 3 and not hold.load_n.any()
+    trial = registry.trial("P1", "validate")
+    driven = drivers.for_motion(p1, "validate", trial)
+    assert driven.mode == arrays.EXPERIMENTAL and driven.n_frames == trial.n_frames
+    assert (driven.load_n == trial.load_n).all() and driven.load_n.max() > 0
+    with pytest.raises(InputError, match=f"has its trial's {trial.n_frames} frames, but got n_frames=5"):
+        drivers.for_motion(p1, "validate", trial, n_frames=5)

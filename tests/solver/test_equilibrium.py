@@ -9,7 +9,7 @@ from test_verification import EPSILON_L, OSCILLATORS, oscillator, undamped
 
 from wrist_env import design
 from wrist_env.anatomy.tendons import resultant_direction
-from wrist_env.design import LIGAMENT_NAMES
+from wrist_env.ligaments import LIGAMENT_NAMES
 from wrist_env.model import CAPITATE
 from wrist_env.participants import registry
 from wrist_env.solver.drivers import AXIAL, experimental, idealized, loaded

@@ -111,14 +111,14 @@ def test_lines_need_a_known_rig(p1):
 
 
 def test_the_capitohamate_joint_resists_a_shift_and_a_turn_in_its_plane_by_ritts_constraint(p1):
-    """`forces.joint_forces` (the capitohamate joint's in-plane constraint, `design.CH_JOINT_STIFFNESS` from
+    """`forces.joint_forces` (the capitohamate joint's in-plane constraint, `ligaments.CH_JOINT_STIFFNESS` from
     Ritt 1996): the hamate moved by 0.5 mm along the joint's dorsopalmar axis, 0.3 mm proximodistally and
     0.2 mm along the normal, and turned 5 deg about the normal, gets back 30.8 N/mm × 0.5 and × 0.3 mm in
     the plane, nothing along the normal, and −3.18 N·m/rad × 5 deg about it plus the shift's lever; the
     capitate gets the opposite force and moment (about its own centre point)."""
     from scipy.spatial.transform import Rotation
 
-    from wrist_env.design import CH_JOINT_STIFFNESS
+    from wrist_env.ligaments import CH_JOINT_STIFFNESS
     from wrist_env.model import CAPITATE, HAMATE
     from wrist_env.solver.forces import joint_forces
 

@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from wrist_env import design
+from wrist_env import design, ligaments
 from wrist_env.model import BONES, N_BODIES, PAIR_BONES, PAIRS
 from wrist_env.solver import arrays, forces
 from wrist_env.solver.contact import sdf_lookup
@@ -126,7 +126,7 @@ def test_result_to_dict_is_strict_json_with_every_output(p1, sweep):
     assert rs == pytest.approx(
         dict(zip(("mean_pressure_mpa", "peak_pressure_mpa", "area_mm2", "force_n"), sweep.contact[4, RS]))
     )
-    assert set(frame["ligament_force_n"]) == set(design.ALL_LIGAMENT_NAMES)
+    assert set(frame["ligament_force_n"]) == set(ligaments.ALL_LIGAMENT_NAMES)
     for key in ("kinetic_energy_nmm", "internal_energy_nmm"):
         assert np.isfinite(frame[key])
     assert set(frame["residual"]) == {"force_n", "moment_nmm"} and frame["steps"] > 0

@@ -127,9 +127,9 @@ def test_the_tangent_includes_the_hamate_and_matches_the_force_kernels_jacobian_
     """The hamate (issue 54, step 2), the last of the free bodies: at frame 8 of P1's population sweep the
     analytic tangent's hamate block (its 6 unknowns) and the block coupling it to the others are within
     15 % (Frobenius) of the finite-difference tangent's, the hamate's block is not zero, and its rotations
-    carry at least the capitohamate joint's turn stiffness (`design.CH_JOINT_STIFFNESS`, 3.18 N·m/rad about
+    carry at least the capitohamate joint's turn stiffness (`ligaments.CH_JOINT_STIFFNESS`, 3.18 N·m/rad about
     the joint's normal, `arrays.capitohamate_joint`)."""
-    from wrist_env.design import CH_JOINT_STIFFNESS
+    from wrist_env.ligaments import CH_JOINT_STIFFNESS
     from wrist_env.model import FREE, HAMATE
     from wrist_env.solver.arrays import capitohamate_joint
 

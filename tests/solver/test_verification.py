@@ -26,7 +26,7 @@ from scipy.spatial.transform import Rotation
 
 from wrist_env import design
 from wrist_env.builder.contact_law import fit_contact_law
-from wrist_env.design import LIGAMENT_NAMES
+from wrist_env.ligaments import LIGAMENT_NAMES
 from wrist_env.model import BONES, CAPITATE, LUNATE, PAIRS, RADIUS, SCAPHOID
 from wrist_env.participants.builtin import truth
 from wrist_env.solver.drivers import experimental, idealized

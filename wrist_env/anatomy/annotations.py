@@ -20,11 +20,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from wrist_env.anatomy.template import load_template
-from wrist_env.design import ALL_LIGAMENT_NAMES, LIGAMENT_NAMES
+from wrist_env.ligaments import ALL_LIGAMENT_NAMES, LIGAMENT_NAMES
 from wrist_env.model import BODY_PARTS, PAIRS
-
-ARTICULATIONS = PAIRS
-"""The cartilage-covered articulations: the contact pairs (`model.PAIRS`)."""
 
 
 @dataclass(frozen=True)
@@ -81,13 +78,13 @@ def resolve(bones: dict, data: dict | None = None) -> Annotations:
 
     A site lies on one bone of its body (its `part`, default the principal bone; e.g. the
     DRC's insertion on the triquetrum); on bodies without that part (no distal row) its
-    `without_part` site is used instead, and a fixed ligament (`design.FIXED_LIGAMENTS`)
+    `without_part` site is used instead, and a fixed ligament (`ligaments.FIXED_LIGAMENTS`)
     without one is not built.
     """
     data = read_annotation_data() if data is None else data
     solids = {name: b.trimesh(solid_only=True) for name, b in bones.items() if b.solid.any()}
     coverage = {}
-    for art in ARTICULATIONS:
+    for art in PAIRS:  # each contact pair's cartilage (`model.PAIRS`)
         spec = data["cartilage"][art]
         a, b = spec["bones"]
         masks = []

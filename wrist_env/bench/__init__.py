@@ -9,14 +9,15 @@ from typing import Any
 
 from wrist_env.bench.calibrate import CalibrationRun, ResumeError, calibrate
 from wrist_env.bench.cells import SEED_IS_INSTANCE, make_cells
-from wrist_env.bench.leaderboard import write_leaderboard as write
 from wrist_env.bench.log import DuplicateEvaluationError, RunLog
 from wrist_env.bench.runner import BenchmarkReport, benchmark
 from wrist_env.bench.schema import RunKey
 
 
 def write_leaderboard(runs: str | Path, out: str | Path, **kwargs: Any) -> Path:
-    """Write the leaderboards of the run log in `runs` to the folder `out` (see `leaderboard`)."""
+    """Write the leaderboards of the run log in `runs` to the folder `out` (see `leaderboard`); loaded when
+    called, so that running a benchmark does not load matplotlib."""
+    from wrist_env.bench.leaderboard import write_leaderboard as write
 
     return write(runs, out, **kwargs)
 

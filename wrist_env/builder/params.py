@@ -63,7 +63,7 @@ class BuildParams:
     distal_row: bool = True
     """The triquetrum moves with the lunate and the trapezium, trapezoid and hamate with the
     capitate, bringing the STT and triquetrohamate contacts (`model.BODY_PARTS`) and the fixed
-    TC and TH ligaments (`design.FIXED_LIGAMENTS`); participant folders get these bones from
+    TC and TH ligaments (`ligaments.FIXED_LIGAMENTS`); participant folders get these bones from
     the template (`anatomy.template.carry_parts`)."""
     fixed_ligaments: bool = True
     """Build the fixed TC and TH with the distal row (False: the lunate body is tied to the

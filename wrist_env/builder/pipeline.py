@@ -24,8 +24,8 @@ from wrist_env.builder.digest import source_hash
 from wrist_env.builder.handedness import check_side
 from wrist_env.builder.params import BuildParams
 from wrist_env.builder.surface import displaced_vertices, extrusion_directions, gap_to, grnn_smooth
-from wrist_env.design import ALL_LIGAMENTS, BODY_LIGAMENTS, LIGAMENT_NAMES, LIGAMENTS, RSC_INDEX
 from wrist_env.errors import BuildError
+from wrist_env.ligaments import ALL_LIGAMENTS, BODY_LIGAMENTS, LIGAMENT_NAMES, LIGAMENTS, RSC_INDEX
 from wrist_env.model import BONES, PAIRS, Model, offsets
 
 BUILD_STEPS = ("morph", "cartilage", "ligaments", "contact_law", "grids", "mass")  # timed in the report

@@ -11,7 +11,7 @@ from wrist_env.cli.options import (
     participant_argument,
 )
 from wrist_env.limits import MAX_FRAMES, MAX_SWEEP_DEG, bounded_float, bounded_int
-from wrist_env.motions import MOTIONS
+from wrist_env.motions import DRIVEN_MOTIONS, MOTIONS
 from wrist_env.solver.settings import SOLVERS
 
 FIGURES_HELP = "$WRIST_ENV_FIGURES or runs/figures"  # where wrist_env.figures.draw.FIGURES points
@@ -77,11 +77,12 @@ def add_commands(command: Callable[..., argparse.ArgumentParser]) -> None:
     participant_argument(s)
     s.add_argument(
         "--motion",
-        choices=["idealized", "static"],
+        choices=DRIVEN_MOTIONS,
         default="idealized",
         help="idealized: capitate swept from --flexion to --extension about the RCS z axis under a "
         "small compressive load (default); static: capitate held at neutral (experimental "
-        "driver with identity transforms)",
+        "driver with identity transforms); calibrate, validate: the capitate through the participant's "
+        "trial of that role, under its recorded load (its frames: no --frames)",
     )
     s.add_argument("--design", default="population", help=DESIGN_HELP)
     s.add_argument(

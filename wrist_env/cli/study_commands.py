@@ -19,7 +19,8 @@ from wrist_env.cli.options import (
     scheduler_option,
     seed_option,
 )
-from wrist_env.design import INJURABLE, SPAN_SD
+from wrist_env.design import SPAN_SD
+from wrist_env.ligaments import INJURABLE
 from wrist_env.limits import (
     MAX_BATCH,
     MAX_BUDGET,

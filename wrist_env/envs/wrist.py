@@ -47,7 +47,7 @@ class WristEnv(gym.Env):
     ``Box(-1, 1, (27,), float32)``: the 27 design variables normalized (`design.NAMES` order,
     `design.from_action` maps them to physical units):
 
-    - 0–10: each Table 2 ligament's stiffness, mean + 3 SD · a (N/mm; `design.LIGAMENT_NAMES` order);
+    - 0–10: each Table 2 ligament's stiffness, mean + 3 SD · a (N/mm; `ligaments.LIGAMENT_NAMES` order);
     - 11–21: each ligament's reference strain l_ref / l0, 1.0 + 0.3 · a (dimensionless);
     - 22–26: the injury scalars of SLIL_v, SLIL_p, SLIL_d, RSC and LRL: below 0 a complete tear, +1 intact.
 

@@ -12,7 +12,7 @@ import numpy as np
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 from numpy.typing import ArrayLike
 
-from wrist_env.design import ALL_LIGAMENT_NAMES
+from wrist_env.ligaments import ALL_LIGAMENT_NAMES
 
 if TYPE_CHECKING:
     from matplotlib.typing import ColorType

@@ -12,8 +12,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
-from wrist_env.design import ALL_LIGAMENT_NAMES
 from wrist_env.figures import draw
+from wrist_env.ligaments import ALL_LIGAMENT_NAMES
 from wrist_env.model import BONES, PAIRS, Model
 
 MODEL_PANELS = (("volar view", 0, 0), ("radial view", 0, 90), ("dorsal view", 0, 180))
@@ -97,7 +97,7 @@ ANNOTATION_PANELS = (
 )
 
 
-ARTICULATION_COLOURS = dict(
+PAIR_COLOURS = dict(
     zip(
         PAIRS,
         ("#f4a6a0", "#9fc3e0", "#b9e3ae", "#d3bde0", "#fdd49e", "#a6dcd0", "#e0c39f", "#c9c9f2")
@@ -105,8 +105,7 @@ ARTICULATION_COLOURS = dict(
         strict=False,
     )
 )
-"""One colour per annotated articulation (`anatomy.annotations.ARTICULATIONS`, the contact `PAIRS`) of the
-annotations figure."""
+"""One colour per contact pair's cartilage (`model.PAIRS`) in the annotations figure."""
 
 
 def annotations_figure(bones: dict, annotations, out: Path | None = None) -> Path:
@@ -119,7 +118,7 @@ def annotations_figure(bones: dict, annotations, out: Path | None = None) -> Pat
 
     ann = annotations
     out = out or draw.FIGURES / "template_annotations.png"
-    art_colours = ARTICULATION_COLOURS
+    art_colours = PAIR_COLOURS
     fig = plt.figure(figsize=(18, 5.6))
     for k, (title, shown, elev, azim) in enumerate(ANNOTATION_PANELS):
         ax = fig.add_subplot(1, 4, k + 1, projection="3d")

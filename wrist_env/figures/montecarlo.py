@@ -23,7 +23,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from wrist_env.design import INJURABLE
+from wrist_env.ligaments import INJURABLE
 
 INTACT_COLOR, INJURED_COLOR = "#d6609a", "#3b6fb6"  # the preprint's pink and blue
 BUNDLE_COLORS = {"SLIL_v": "#2a9d8f", "SLIL_p": "#e9a23b", "SLIL_d": "#6a4c93"}
@@ -36,7 +36,7 @@ class TearEstimates:
     """Figure 8 (B)'s estimates: Table 5's sweep-average radioscaphoid pressure intact and with each ligament
     torn alone (`montecarlo.report.tear_estimates`).
 
-    tears: None (intact), then the tear columns of the frame table (`design.INJURABLE`), one per estimate;
+    tears: None (intact), then the tear columns of the frame table (`ligaments.INJURABLE`), one per estimate;
     labels: their tick labels; estimate_mpa, se_mpa (len(tears),): the estimate and its standard error, MPa."""
 
     tears: tuple[str | None, ...]

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from wrist_env.design import INJURABLE
 from wrist_env.errors import WristEnvError
+from wrist_env.ligaments import INJURABLE
 from wrist_env.limits import MAX_RUNS, MAX_SEED, check_int, check_unique
 from wrist_env.solver.settings import DEFAULT_LOADS, LOAD_DIRECTIONS
 

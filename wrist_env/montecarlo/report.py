@@ -18,9 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
-from wrist_env.design import INJURABLE
 from wrist_env.figures import montecarlo as figures
 from wrist_env.io import write_json
+from wrist_env.ligaments import INJURABLE
 from wrist_env.montecarlo import stats
 from wrist_env.montecarlo.config import StudyError
 from wrist_env.montecarlo.log import check_log, read_runs

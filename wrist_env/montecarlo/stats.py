@@ -46,8 +46,8 @@ import pyarrow as pa
 import pyarrow.compute as pc
 from numpy.typing import ArrayLike
 
-from wrist_env.design import INJURABLE
 from wrist_env.errors import WristEnvError
+from wrist_env.ligaments import INJURABLE
 from wrist_env.limits import MAX_SUBSET_RUNS, check_int
 from wrist_env.montecarlo.config import FIT_RUNS_WHY, MIN_FIT_RUNS
 

@@ -11,7 +11,8 @@ from collections import namedtuple
 
 import numpy as np
 
-from wrist_env.design import CH_JOINT_STIFFNESS, RSC_INDEX, Design, ligament_arrays
+from wrist_env.design import Design, ligament_arrays
+from wrist_env.ligaments import CH_JOINT_STIFFNESS, RSC_INDEX
 from wrist_env.model import BONES, PAIR_BONES, PAIRS, Model
 from wrist_env.solver.contact import nodal_normals
 from wrist_env.solver.settings import SolverSettings
@@ -54,7 +55,7 @@ def capitohamate_joint(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray
     area-weighted mean of the hamate's contact samples on the capitate at neutral; its axes (3, 3), rows
     in the RCS at neutral (carried by the capitate): dorsopalmar (the RCS volar axis x in the joint's
     plane), proximodistal in the plane, and the normal (the samples' area-weighted mean normal, hamate to
-    capitate); and its stiffness (6,) along and about them (`design.CH_JOINT_STIFFNESS`). A model without
+    capitate); and its stiffness (6,) along and about them (`ligaments.CH_JOINT_STIFFNESS`). A model without
     samples on that pair (a synthetic test model) gets zero stiffness."""
     k = PAIRS.index("capitohamate")
     lo, hi = model.sample_offsets[k], model.sample_offsets[k + 1]

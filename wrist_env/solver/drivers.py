@@ -5,7 +5,8 @@
 translations free under a compressive load (N) on lines of action (`Loads`: along the radius' axis,
 `AXIAL`, or the tendons where they enter the hand: `settings.LOAD_DIRECTIONS`); `idealized(model)` is the loaded
 driver ramping from maximum flexion to maximum extension (deg) about the RCS z axis; `static` holds it
-at neutral. Poses in the RCS, mm.
+at neutral. `for_motion` maps a motion's name (`motions.DRIVEN_MOTIONS`) to its driver: the one owner of that
+map. Poses in the RCS, mm.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from wrist_env.anatomy.tendons import model_lines
 from wrist_env.errors import InputError
 from wrist_env.limits import MAX_FRAMES, MAX_SWEEP_DEG, check_float, check_int
 from wrist_env.model import CAPITATE, Model
+from wrist_env.motions import DRIVEN_MOTIONS, IDEALIZED, TRIAL_MOTIONS
 from wrist_env.solver import arrays, step
 from wrist_env.solver.settings import DEFAULT_LOADS, JIG, LOAD_DIRECTIONS
 
@@ -210,3 +212,66 @@ def idealized(
             )
     rotations = Rotation.from_euler("z", angle[:, None], degrees=True).as_matrix()
     return loaded(model, rotations, load_n, angle, direction)
+
+
+def for_motion(
+    model: Model,
+    motion: str,
+    trial: Trial | None = None,
+    *,
+    n_frames: int | None = None,
+    flexion_deg: float = 40.0,
+    extension_deg: float = 40.0,
+    direction: str | ArrayLike = DEFAULT_LOADS,
+) -> Driver:
+    """The driver of a motion (`motions.DRIVEN_MOTIONS`): the one map from a motion's name to a driver.
+
+    Parameters
+    ----------
+    model : Model
+        The participant's model.
+    motion : str
+        ``"idealized"``: the loaded sweep from `flexion_deg` to `extension_deg` in `n_frames` frames (default
+        17; `idealized`); ``"static"``: the capitate held at neutral for `n_frames` frames (default 3;
+        `static`); ``"calibrate"`` or ``"validate"``: the experimental driver of that `trial` (`trial_driver`).
+    trial : Trial, optional
+        The trial of a trial motion (its role's trial of the participant or of an instance); required for
+        those, refused for the others.
+    n_frames : int, optional
+        Frames of the idealized or static motion; a trial has its own (refused).
+    flexion_deg, extension_deg : float
+        The idealized sweep's first flexion and last extension, deg.
+    direction : str or (3,) array_like
+        The loads' lines of action (`loads`); the static motion has no load.
+
+    Returns
+    -------
+    Driver
+
+    Raises
+    ------
+    InputError
+        An unknown motion, a trial motion without its trial, or frames or a trial given to a motion that
+        does not take them.
+    """
+    if motion not in DRIVEN_MOTIONS:
+        raise InputError(f"motion must be one of {DRIVEN_MOTIONS}, but got {motion!r}")
+    if motion in TRIAL_MOTIONS:
+        if trial is None:
+            raise InputError(f"the {motion!r} motion is a trial's: give its trial")
+        if n_frames is not None:
+            raise InputError(
+                f"the {motion!r} motion has its trial's {trial.n_frames} frames, but got n_frames={n_frames}"
+            )
+        return trial_driver(model, trial, direction)
+    if trial is not None:
+        raise InputError(f"the {motion!r} motion takes no trial")
+    if motion == IDEALIZED:
+        return idealized(
+            model,
+            flexion_deg=flexion_deg,
+            extension_deg=extension_deg,
+            n_frames=17 if n_frames is None else n_frames,
+            direction=direction,
+        )
+    return static(model, 3 if n_frames is None else n_frames)

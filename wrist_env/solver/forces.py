@@ -307,7 +307,7 @@ def fibre_forces(R, x, v, w, com0, fibres, l0, K, damping_s, F, T, bundle_force,
 
 @njit(cache=True, error_model="numpy")
 def joint_forces(R, x, com0, bod, F, T, want_energy):
-    """The capitohamate joint's in-plane constraint (`arrays.capitohamate_joint`, `design.CH_JOINT_STIFFNESS`):
+    """The capitohamate joint's in-plane constraint (`arrays.capitohamate_joint`, `ligaments.CH_JOINT_STIFFNESS`):
     a linear spring between the hamate and the capitate at the joint's centre, in the joint's axes carried by
     the capitate. The centre's shift on the hamate from the capitate's, d, gives the hamate −Σ kₖ(eₖ·d)eₖ
     at its centre point (the capitate the opposite at its own), the hamate's turn from the capitate θ

@@ -27,7 +27,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-from wrist_env.design import ALL_LIGAMENT_NAMES, RSC_INDEX
+from wrist_env.ligaments import ALL_LIGAMENT_NAMES, RSC_INDEX
 from wrist_env.model import BONES, CAPITATE, FREE
 from wrist_env.solver.arrays import LOADED, System
 from wrist_env.solver.forces import (

@@ -12,8 +12,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike
 
-from wrist_env.design import ALL_LIGAMENT_NAMES
 from wrist_env.frames import cardan_angles
+from wrist_env.ligaments import ALL_LIGAMENT_NAMES
 from wrist_env.model import ARTICULATIONS, BODY_PARTS, BONES, PAIR_BONES, PAIRS, ULNA, Model
 from wrist_env.solver import arrays, forces
 from wrist_env.solver.forces import CONTACT_FIELDS

@@ -12,7 +12,8 @@ from typing import TYPE_CHECKING
 import numba
 import numpy as np
 
-from wrist_env.design import ALL_LIGAMENT_NAMES, Design, population
+from wrist_env.design import Design, population
+from wrist_env.ligaments import ALL_LIGAMENT_NAMES
 from wrist_env.model import N_BODIES, PAIRS, Model
 from wrist_env.solver import arrays, kernel, precompile, step
 from wrist_env.solver.drivers import Driver, static
@@ -36,7 +37,7 @@ class Result:
     poses (n_frames, n_bodies, 4, 4): neutral → frame transforms of `model.BONES`, RCS mm.
     contact (n_frames, n_pairs, 4): per pair (`model.PAIRS`) mean pressure over the
         contacting area (MPa), peak pressure (MPa), contact area (mm²), force (N).
-    bundle_force (n_frames, n_bundles): tension of each ligament, `design.ALL_LIGAMENT_NAMES` order (N).
+    bundle_force (n_frames, n_bundles): tension of each ligament, `ligaments.ALL_LIGAMENT_NAMES` order (N).
     energy (n_frames, 2): kinetic and internal energy (N·mm).
     residual (n_frames, 2): largest net force (N) and moment (N·mm) on the free bones.
     steps (n_frames,): explicit steps since the previous frame (ramp + hold to equilibrium;

@@ -11,7 +11,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-from wrist_env.design import ALL_LIGAMENT_NAMES, RSC_INDEX
+from wrist_env.ligaments import ALL_LIGAMENT_NAMES, RSC_INDEX
 from wrist_env.model import BONES, CAPITATE, FREE
 from wrist_env.solver.arrays import EXPERIMENTAL
 from wrist_env.solver.forces import apply_force, contact_forces, fibre_forces, joint_forces, to_world

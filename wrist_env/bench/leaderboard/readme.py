@@ -41,6 +41,12 @@ def _median_iqr(frame: pd.DataFrame, participants: list, labels: list) -> pd.Dat
     return pd.DataFrame(wide)
 
 
+def spread_cell(median: float, q25: float, q75: float, runs: int) -> str:
+    """A table cell "median [q25, q75]" over `runs` runs; one run (or none: a reference design) has no spread to
+    show, so its value alone, not "[x, x]"."""
+    return fmt(median) if runs < 2 else f"{fmt(median)} [{fmt(q25)}, {fmt(q75)}]"
+
+
 def ert_cell(r) -> str:
     """An `evals_to_target.csv` row as a table cell: "solved/runs, ERT e [low, high]" (∞: an open end)."""
 
@@ -265,14 +271,14 @@ def readme(board: Leaderboard, title: str | None = None) -> str:
         "## Held-out resisted trial",
         "",
         "The calibrated design of each run (its best) simulated on the held-out resisted trial, never seen by "
-        "the calibrator: cost median [IQR] over seeds; mean RMSE over the scaphoid's and lunate's translations "
-        "(mm) and rotations (deg), median over seeds." + on,
+        "the calibrator: cost median [IQR] over its runs of the problem (one run: its cost); mean RMSE over the "
+        "scaphoid's and lunate's translations (mm) and rotations (deg), median over the runs." + on,
         "",
     ]
     hrows = []
     for p in shipped:
         for r in heldout[heldout.problem == p].itertuples():
-            cost = fmt(r.cost_median) if r.runs == 0 else f"{fmt(r.cost_median)} [{fmt(r.cost_q25)}, {fmt(r.cost_q75)}]"
+            cost = spread_cell(r.cost_median, r.cost_q25, r.cost_q75, r.runs)
             name = f"*{r.calibrator}*" if r.runs == 0 else r.calibrator
             hrows.append(
                 {

@@ -16,6 +16,7 @@ from wrist_env.cli.run.outputs import out_folder
 from wrist_env.errors import DesignError, ParticipantError
 from wrist_env.frames import DOF_NAMES, DOF_UNITS
 from wrist_env.model import BONES, PAIRS
+from wrist_env.motions import STATIC, TRIAL_MOTIONS
 from wrist_env.participants import builtin, registry
 from wrist_env.participants.folder import NAME_PATTERN, PARTICIPANT_FILE, write_participant_folder
 from wrist_env.solver import drivers
@@ -26,8 +27,6 @@ from wrist_env.task import task
 
 if TYPE_CHECKING:
     from wrist_env.design import Design
-    from wrist_env.model import Model
-    from wrist_env.solver.drivers import Driver
 
 
 def participants(args) -> int:
@@ -105,27 +104,25 @@ def load_design(spec: str, participant: str) -> Design:
     return design.read_json(spec)
 
 
-def make_driver(model: Model, motion: str, frames: int | None, flexion: float, extension: float) -> Driver:
-    """The capitate driver of `simulate`: an idealized sweep or the capitate held at neutral."""
-
-    if motion == "idealized":
-        return drivers.idealized(model, flexion_deg=flexion, extension_deg=extension, n_frames=frames or 17)
-    return drivers.static(model, frames or 3)
-
-
 def simulate(args) -> int:
 
     start = time.perf_counter()
     model = registry.load_model(args.participant)
     load_seconds = time.perf_counter() - start
     d = load_design(args.design, args.participant)
-    driver = make_driver(model, args.motion, args.frames, args.flexion, args.extension)
+    trial = registry.trial(args.participant, args.motion) if args.motion in TRIAL_MOTIONS else None
+    sweep = {"flexion_deg": args.flexion, "extension_deg": args.extension}
+    driver = drivers.for_motion(model, args.motion, trial, n_frames=args.frames, **sweep)
     compile_seconds = None
 
     settings = solver_settings(args.solver)
     if args.warm_up:
         start = time.perf_counter()
-        simulation.simulate(model, d, make_driver(model, args.motion, 1, 0.0, 0.0), settings)
+        # one frame of the same kind of driver (the kernel is the same; a trial's driver is the experimental one)
+        warm = STATIC if args.motion in TRIAL_MOTIONS else args.motion
+        simulation.simulate(
+            model, d, drivers.for_motion(model, warm, n_frames=1, flexion_deg=0.0, extension_deg=0.0), settings
+        )
         compile_seconds = time.perf_counter() - start
     start = time.perf_counter()
     result = simulation.simulate(model, d, driver, settings)

@@ -19,8 +19,8 @@ from wrist_env.bench.leaderboard import reference, write_leaderboard
 from wrist_env.bench.log import RunLog
 from wrist_env.bench.runner import NO_STORAGE
 from wrist_env.cli.run.outputs import out_file, out_folder
-from wrist_env.design import LIGAMENT_NAMES
 from wrist_env.errors import Interrupted, StoreError, UsageError, WristEnvError
+from wrist_env.ligaments import LIGAMENT_NAMES
 from wrist_env.montecarlo.config import StudyConfig
 from wrist_env.montecarlo.log import read_runs
 from wrist_env.montecarlo.report import write_report
