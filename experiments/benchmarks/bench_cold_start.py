@@ -81,18 +81,26 @@ def main() -> None:
         for name, tree in trees.items():
             runs[name].append(measure(tree))
             print(f"repeat {r + 1}/{args.repeats}, {name} ({tree}): done", file=sys.stderr, flush=True)
-    keys = list(runs["this"][0])
-    median = {name: {k: float(np.median([m[k] for m in ms])) for k in keys} for name, ms in runs.items()}
     lines = [f"| figure (median of {args.repeats}) | this |" + (" against | this / against |" if args.against else "")]
     lines.append("|---|---|" + ("---|---|" if args.against else ""))
-    for k in keys:
-        row = f"| {k} | {median['this'][k]:.2f} |"
-        if args.against:
-            row += f" {median['against'][k]:.2f} | {median['this'][k] / median['against'][k]:.2f} |"
-        lines.append(row)
+    lines += median_rows(runs)
     print("\n".join(lines))
     if args.out:
         write_table(args.out, "bench_cold_start.py", trees, lines)
+
+
+def median_rows(runs: dict[str, list[dict[str, float]]], prefix: str = "", spec: str = ".2f") -> list[str]:
+    """Markdown rows, one per figure of the runs: its median over the runs of "this" tree and, where measured,
+    over those of "against", and their ratio."""
+    keys = list(runs["this"][0])
+    median = {name: {k: float(np.median([m[k] for m in ms])) for k in keys} for name, ms in runs.items()}
+    rows = []
+    for k in keys:
+        row = f"| {prefix}{k} | {median['this'][k]:{spec}} |"
+        if "against" in runs:
+            row += f" {median['against'][k]:{spec}} | {median['this'][k] / median['against'][k]:.2f} |"
+        rows.append(row)
+    return rows
 
 
 def write_table(out: Path, script: str, trees: dict[str, Path], lines: list[str]) -> None:

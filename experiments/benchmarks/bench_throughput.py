@@ -26,10 +26,8 @@ import sys
 import tempfile
 from pathlib import Path
 
-import numpy as np
-
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_cold_start import HERE, _run, write_table  # noqa: E402  (experiments/benchmarks/bench_cold_start.py)
+from bench_cold_start import HERE, _run, median_rows, write_table  # noqa: E402  (experiments/benchmarks/bench_cold_start.py)
 
 PROBE = """
 import json, sys, time
@@ -96,13 +94,7 @@ def main() -> None:
     ]
     lines.append("|---|---|" + ("---|---|" if args.against else ""))
     for part in args.participants:
-        keys = list(runs["this", part][0])
-        median = {name: {k: float(np.median([m[k] for m in runs[name, part]])) for k in keys} for name in trees}
-        for k in keys:
-            row = f"| {part}, {k} | {median['this'][k]:,.1f} |"
-            if args.against:
-                row += f" {median['against'][k]:,.1f} | {median['this'][k] / median['against'][k]:.2f} |"
-            lines.append(row)
+        lines += median_rows({name: runs[name, part] for name in trees}, f"{part}, ", ",.1f")
     print("\n".join(lines))
     if args.out:
         write_table(args.out, "bench_throughput.py", trees, lines)

@@ -23,6 +23,17 @@ def _setting(name: str):
     return bounded_int(name, *BOUNDS[name])
 
 
+SAMPLER_OPTIONS = (
+    ("walkers", f"ensemble walkers (default %(default)s; >= {BOUNDS['walkers'][0]})"),
+    ("steps", f"ensemble steps (default %(default)s, ~12 min a run; >= {BOUNDS['steps'][0]})"),
+    ("particles", f"SMC particles (default %(default)s; >= {BOUNDS['particles'][0]})"),
+    ("mcmc_steps", "SMC random-walk steps per particle and stage (default %(default)s)"),
+    ("map_starts", "Gauss-Newton starts of the MAP search that both samplers start from (default %(default)s)"),
+)
+"""The posterior's integer `SamplerSettings` as options (--walkers ... --map-starts), each bounded as the settings
+are (`BOUNDS`), in the order --help lists them (--sampler after --steps)."""
+
+
 def add_commands(command: Callable[..., object]) -> None:
 
     s = command(
@@ -81,43 +92,17 @@ def add_commands(command: Callable[..., object]) -> None:
         default=1,
         help="runs per participant, seeds 0 .. N-1 (default 1)",
     )
-    s.add_argument(
-        "--walkers",
-        type=_setting("walkers"),
-        default=DEFAULTS.walkers,
-        help=f"ensemble walkers (default %(default)s; >= {BOUNDS['walkers'][0]})",
-    )
-    s.add_argument(
-        "--steps",
-        type=_setting("steps"),
-        default=DEFAULTS.steps,
-        help=f"ensemble steps (default %(default)s, ~12 min a run; >= {BOUNDS['steps'][0]})",
-    )
-    s.add_argument(
-        "--sampler",
-        choices=SAMPLERS,
-        default=DEFAULTS.sampler,
-        help="emcee (ensemble MCMC from the MAP; default) or smc (SMCPy's adaptive tempered SMC from a "
-        "heavy-tailed start around the MAP; files get a _smc suffix)",
-    )
-    s.add_argument(
-        "--particles",
-        type=_setting("particles"),
-        default=DEFAULTS.particles,
-        help=f"SMC particles (default %(default)s; >= {BOUNDS['particles'][0]})",
-    )
-    s.add_argument(
-        "--mcmc-steps",
-        type=_setting("mcmc_steps"),
-        default=DEFAULTS.mcmc_steps,
-        help="SMC random-walk steps per particle and stage (default %(default)s)",
-    )
-    s.add_argument(
-        "--map-starts",
-        type=_setting("map_starts"),
-        default=DEFAULTS.map_starts,
-        help="Gauss-Newton starts of the MAP search that both samplers start from (default %(default)s)",
-    )
+    for name, help in SAMPLER_OPTIONS:
+        flag = "--" + name.replace("_", "-")
+        s.add_argument(flag, type=_setting(name), default=getattr(DEFAULTS, name), help=help)
+        if name == "steps":  # the sampler's choice between its own settings and emcee's
+            s.add_argument(
+                "--sampler",
+                choices=SAMPLERS,
+                default=DEFAULTS.sampler,
+                help="emcee (ensemble MCMC from the MAP; default) or smc (SMCPy's adaptive tempered SMC from a "
+                "heavy-tailed start around the MAP; files get a _smc suffix)",
+            )
     s.add_argument(
         "--prior-refresh",
         type=bounded_float("prior_refresh", 0.0, 1.0),  # 1 itself: SamplerSettings refuses it
