@@ -16,7 +16,7 @@ from __future__ import annotations
 import argparse
 import math
 import numbers
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 from wrist_env.errors import InputError
 
@@ -52,6 +52,8 @@ MAX_FOSSA_SWEEP_DEG = 90.0
 """Half-range, deg, of each axis of the row's sweep that shapes the radius fossae (`--fossa-sweep`,
 `BuildParams.fossa_sweep_deg`; default 20 and 10): the row turns ~0.7x the capitate's +-40, so a right
 angle is past any wrist's reach; a half-range is at least 0 (0 0 moulds the fossae to the neutral row)."""
+SWEEP_WHY = "deg; 0 0 moulds the fossae to the neutral row"
+"""What a fossa sweep's refusal adds after its bounds."""
 MAX_ULNAR_VARIANCE_MM = 5.0
 """|Ulnar variance|, mm, a build may seat the ulna at (`BuildParams.ulnar_variance_mm`, participant.toml's
 `ulnar_variance_mm`; + ulna plus, by `anatomy.ulnar_variance`'s corner rule): adults measure about −4 to
@@ -105,6 +107,22 @@ def check_float(name: str, value: object, low: float, high: float, why: str = ""
             f"{name} must be a finite number in [{low:,g}, {high:,g}]{f' ({why})' if why else ''}, but got {value!r}"
         )
     return float(value)
+
+
+def check_fossa_sweep(sweep_deg: Sequence[float]) -> tuple[float, float]:
+    """(flexion, deviation) half-ranges, deg, as floats, if there are two, each finite and in
+    [0, `MAX_FOSSA_SWEEP_DEG`]; `InputError` naming the value (before a template is swept or a model is
+    built and cached from it)."""
+    try:
+        pair = tuple(sweep_deg)
+    except TypeError:
+        pair = ()
+    if len(pair) != 2:
+        raise InputError(f"fossa_sweep_deg must be two angles (flexion, deviation), deg, but got {sweep_deg!r}")
+    return tuple(
+        check_float(f"fossa_sweep_deg {axis}", a, 0.0, MAX_FOSSA_SWEEP_DEG, SWEEP_WHY)
+        for axis, a in zip(("flexion", "deviation"), pair)
+    )
 
 
 def check_unique(name: str, values) -> list:

@@ -50,7 +50,7 @@ import sys
 
 import numpy as np
 
-from wrist_env.builder.surface import vertex_areas
+from wrist_env.anatomy.template import vertex_areas
 
 RIM_BAND_MM = 2.0
 """A rim: the surface's points within this of its least or greatest coordinate along the axis (mm)."""

@@ -24,8 +24,7 @@ import trimesh
 from wrist_env.anatomy import tendons
 from wrist_env.anatomy.midcarpal import read_seat
 from wrist_env.anatomy.myosim import CHAIN_XML, radius_frame_transforms
-from wrist_env.anatomy.template import load_template
-from wrist_env.builder.surface import vertex_areas
+from wrist_env.anatomy.template import load_template, vertex_areas
 
 DISTAL_CARPALS = ("trapezium", "trapezoid", "capitate", "hamate")
 """The carpals the metacarpals meet (`model.PARTS`)."""

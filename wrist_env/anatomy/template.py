@@ -30,13 +30,21 @@ from wrist_env.anatomy.midcarpal import DISTAL_ROW, read_seat
 from wrist_env.anatomy.myosim import load_myosim_anatomy
 from wrist_env.anatomy.radius_cap import build_radius_cap
 from wrist_env.anatomy.ulnar_variance import ulnar_corner
-from wrist_env.builder.params import check_fossa_sweep
+from wrist_env.limits import check_fossa_sweep
 from wrist_env.model import BODY_PARTS, BONES, CARPALS, CARRIED_WITH, OPTIONAL_BONES, PARTS, SUPPLIED
 
 ROW = ("scaphoid", "lunate")  # the proximal row bones that articulate with the radius
 JOINT_SPACE_MM = 1.5  # radiocarpal bone-to-bone joint space of the rebuilt fossae
 SHAFT_LENGTH_MM = 20.0
 SHAFT_EDGE_MM = 1.5
+
+
+def vertex_areas(vertices: ArrayLike, faces: ArrayLike) -> np.ndarray:
+    """Area (n,) mm² owned by each vertex: a third of each face it is a corner of (they sum to the mesh's)."""
+    v, f = np.asarray(vertices, dtype=np.float64), np.asarray(faces)
+    out = np.zeros(len(v))
+    np.add.at(out, f.ravel(), np.repeat(trimesh.triangles.area(v[f]) / 3.0, 3))
+    return out
 
 
 @dataclass(frozen=True)

@@ -11,8 +11,9 @@ import numpy as np
 import trimesh
 from scipy.spatial import cKDTree
 
+from wrist_env.anatomy.template import vertex_areas
 from wrist_env.builder import sdf
-from wrist_env.builder.surface import displaced_vertices, vertex_areas
+from wrist_env.builder.surface import displaced_vertices
 from wrist_env.errors import BuildError
 from wrist_env.model import BONES, PAIR_BONES, PAIRS, offsets
 

@@ -2,17 +2,21 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from wrist_env.errors import InputError
-from wrist_env.limits import MAX_FOSSA_SWEEP_DEG, MAX_ULNAR_VARIANCE_MM, bounded_float, check_float
+from wrist_env.limits import (
+    MAX_FOSSA_SWEEP_DEG,
+    MAX_ULNAR_VARIANCE_MM,
+    SWEEP_WHY,
+    bounded_float,
+    check_float,
+    check_fossa_sweep,
+)
 
 if TYPE_CHECKING:
     import argparse
 
-SWEEP_WHY = "deg; 0 0 moulds the fossae to the neutral row"
 VARIANCE_WHY = "mm, + ulna plus; adults measure about -4 to +5"
 
 
@@ -20,22 +24,6 @@ def check_ulnar_variance(variance_mm: object, name: str = "ulnar_variance_mm") -
     """The ulnar variance (mm) as a float if it is finite and within ±`MAX_ULNAR_VARIANCE_MM`; `InputError`
     naming the value."""
     return check_float(name, variance_mm, -MAX_ULNAR_VARIANCE_MM, MAX_ULNAR_VARIANCE_MM, VARIANCE_WHY)
-
-
-def check_fossa_sweep(sweep_deg: Sequence[float]) -> tuple[float, float]:
-    """(flexion, deviation) half-ranges, deg, as floats, if there are two, each finite and in
-    [0, `MAX_FOSSA_SWEEP_DEG`]; `InputError` naming the value (before a template is swept or a model is
-    built and cached from it)."""
-    try:
-        pair = tuple(sweep_deg)
-    except TypeError:
-        pair = ()
-    if len(pair) != 2:
-        raise InputError(f"fossa_sweep_deg must be two angles (flexion, deviation), deg, but got {sweep_deg!r}")
-    return tuple(
-        check_float(f"fossa_sweep_deg {axis}", a, 0.0, MAX_FOSSA_SWEEP_DEG, SWEEP_WHY)
-        for axis, a in zip(("flexion", "deviation"), pair)
-    )
 
 
 TFC_MODULUS_RATIO = 0.25 / 0.64

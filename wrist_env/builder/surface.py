@@ -92,14 +92,6 @@ def grnn_smooth(
     return out
 
 
-def vertex_areas(vertices: ArrayLike, faces: ArrayLike) -> np.ndarray:
-    """Area (n,) mm² owned by each vertex: a third of each face it is a corner of (they sum to the mesh's)."""
-    v, f = np.asarray(vertices, dtype=np.float64), np.asarray(faces)
-    out = np.zeros(len(v))
-    np.add.at(out, f.ravel(), np.repeat(trimesh.triangles.area(v[f]) / 3.0, 3))
-    return out
-
-
 def vertex_normals(vertices: ArrayLike, faces: ArrayLike) -> np.ndarray:
     """Area-weighted unit vertex normals, shape (n, 3); zero at vertices no face uses."""
     v = _vertices(vertices, "mesh")
