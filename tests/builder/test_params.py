@@ -5,8 +5,8 @@ import math
 import pytest
 
 from wrist_env.builder.params import BuildParams
-from wrist_env.limits import check_fossa_sweep
 from wrist_env.errors import InputError
+from wrist_env.limits import check_fossa_sweep
 
 
 @pytest.mark.parametrize(

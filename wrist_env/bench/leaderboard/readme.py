@@ -29,16 +29,24 @@ def md_table(frame: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
-def _median_iqr(frame: pd.DataFrame, participants: list, labels: list) -> pd.DataFrame:
-    """A column of labels (calibrators), then one per participant: its row's "median [q25, q75]" in `frame`, or —."""
+def _wide(frame: pd.DataFrame, columns: dict[str, pd.Series], labels: list, cell) -> pd.DataFrame:
+    """A column of labels (calibrators), then one per entry of `columns` (its title → a mask of `frame`'s rows):
+    `cell` of the label's first row there, or — where it has none."""
     wide = {"calibrator": labels}
-    for p in participants:
+    for title, mask in columns.items():
+        rows = frame[mask]
         col = []
         for label in labels:
-            r = frame[(frame.participant == p) & (frame.calibrator == label)]
-            col.append("—" if r.empty else f"{fmt(r['median'].iloc[0])} [{fmt(r.q25.iloc[0])}, {fmt(r.q75.iloc[0])}]")
-        wide[p] = col
+            r = rows[rows.calibrator == label]
+            col.append("—" if r.empty else cell(r.iloc[0]))
+        wide[title] = col
     return pd.DataFrame(wide)
+
+
+def _median_iqr(frame: pd.DataFrame, participants: list, labels: list) -> pd.DataFrame:
+    """A column of labels (calibrators), then one per participant: its row's "median [q25, q75]" in `frame`, or —."""
+    columns = {p: frame.participant == p for p in participants}
+    return _wide(frame, columns, labels, lambda r: f"{fmt(r['median'])} [{fmt(r.q25)}, {fmt(r.q75)}]")
 
 
 def spread_cell(median: float, q25: float, q75: float, runs: int) -> str:
@@ -224,14 +232,8 @@ def readme(board: Leaderboard, title: str | None = None) -> str:
     ]
     for p in subjects:
         ts = list(dict.fromkeys(ert.target[ert.participant == p]))
-        wide = {"calibrator": labels}
-        for t in ts:
-            col = []
-            for label in labels:
-                r = ert[(ert.participant == p) & (ert.calibrator == label) & (ert.target == t)]
-                col.append("—" if r.empty else ert_cell(r.iloc[0]))
-            wide[f"{p} {t}"] = col
-        lines += [md_table(pd.DataFrame(wide)), ""]
+        columns = {f"{p} {t}": (ert.participant == p) & (ert.target == t) for t in ts}
+        lines += [md_table(_wide(ert, columns, labels, ert_cell)), ""]
     lines += [
         "![ECDF](ecdf.png)",
         "",
