@@ -15,8 +15,22 @@ from wrist_env.task import task
 
 @dataclass
 class Reference:
-    """A problem's population (and, if built in, hidden-truth) design scored on both trials: a participant's
-    instance (0: the shipped truth and trials)."""
+    """A problem's population (and, if built in, hidden-truth) design scored on both trials.
+
+    A problem is a participant's instance (0: the shipped truth and trials).
+
+    Parameters
+    ----------
+    participant : str
+        The participant's name.
+    population : dict
+        ``{"calibrate": score, "validate": score}`` of the population design; score = ``{"cost", "failed",
+        "rmse"}`` (rmse: ``{bone: {DOF: mm or deg}}``).
+    truth : dict or None
+        The same for the hidden truth; None for a participant without one.
+    instance : int, default 0
+        The problem instance.
+    """
 
     participant: str
     population: dict  # {"calibrate": score, "validate": score}; score = {"cost", "failed", "rmse"}
