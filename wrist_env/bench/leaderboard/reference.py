@@ -43,8 +43,25 @@ def _score(evaluation) -> dict:
 
 
 def reference(participant: str, instance: int = 0) -> Reference:
-    """Simulate the population design (and the instance's hidden truth) on the instance's calibration and
-    held-out trials."""
+    """Simulate the population design (and the instance's hidden truth) on the calibration and held-out trials.
+
+    Parameters
+    ----------
+    participant : str
+        A registered participant's name.
+    instance : int, default 0
+        The problem instance (`participants.instances`; 0: the shipped truth and trials).
+
+    Returns
+    -------
+    Reference
+        The designs' scores (cost, failed, RMSE in mm and deg) on both of the instance's trials.
+
+    Raises
+    ------
+    ParticipantError
+        An unknown participant, or an instance k ≥ 1 of a folder participant.
+    """
 
     tasks = {m: task(participant, m, instance=instance) for m in TRIAL_MOTIONS}
     designs = {"population": design.population()}
