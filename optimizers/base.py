@@ -28,14 +28,18 @@ __all__ = [
 
 
 class OptionError(InputError):
-    """An option a calibrator does not have (the message lists the ones it has)."""
+    """An option a calibrator does not have (the message lists the ones it has).
+
+    Raised by an `Optimizer`'s constructor (so by `make` and the benchmark) for an option name not in the
+    calibrator's ``OPTIONS``; an `InputError`, so also a `ValueError`.
+    """
 
 
 @dataclass(frozen=True)
 class OptimizeResult:
     """What every calibrator returns: SciPy's `OptimizeResult` field names plus the history.
 
-    Attributes
+    Parameters
     ----------
     x : ndarray of shape (dim,)
         The best point told.

@@ -33,7 +33,12 @@ _UNAVAILABLE: dict[str, str] = {}  # name -> why it is not registered here (what
 
 
 class UnknownOptimizerError(WristEnvError, KeyError):
-    """An optimizer name that is not registered (the message lists the valid ones)."""
+    """An optimizer name that is not registered (the message lists the valid ones).
+
+    Raised by `get` and `make` (so by the benchmark and ``wrist-bench calibrate``); for a calibrator whose
+    optional library is missing, the message says what to install. A `KeyError` too, printed without
+    KeyError's quotes.
+    """
 
     def __str__(self) -> str:
         return str(self.args[0])
@@ -95,13 +100,36 @@ def _load_plugins() -> None:
 
 
 def available() -> tuple[str, ...]:
-    """Names of all registered calibrators: built-in and from the entry-point group, sorted."""
+    """Names of all registered calibrators: built-in and from the entry-point group, sorted.
+
+    Returns
+    -------
+    tuple of str
+        The names, sorted.
+    """
     _load_plugins()
     return tuple(sorted(_REGISTRY))
 
 
 def get(name: str) -> type:
-    """The calibrator class registered as `name`."""
+    """The calibrator class registered as `name`.
+
+    Parameters
+    ----------
+    name : str
+        A registered calibrator's name (`available()`).
+
+    Returns
+    -------
+    type
+        The `Optimizer` subclass.
+
+    Raises
+    ------
+    UnknownOptimizerError
+        `name` is not registered (the message lists the registered ones), or its optional library is not
+        installed here.
+    """
     if name not in _REGISTRY:
         _load_plugins()
     if name in _UNAVAILABLE and name not in _REGISTRY:
@@ -112,5 +140,40 @@ def get(name: str) -> type:
 
 
 def make(name: str, dim: int, budget: int, seed: int = 0, **options: Any) -> Optimizer:
-    """An instance of the calibrator `name`."""
+    """An instance of the calibrator `name`.
+
+    Parameters
+    ----------
+    name : str
+        A registered calibrator's name (`available()`).
+    dim : int
+        The number of variables (22 normalized materials in the benchmark).
+    budget : int
+        Evaluations allowed.
+    seed : int, default 0
+        The calibrator's seed.
+    **options
+        The calibrator's options, names from its ``OPTIONS``.
+
+    Returns
+    -------
+    Optimizer
+        A fresh calibrator over the box [-1, 1]^dim.
+
+    Raises
+    ------
+    UnknownOptimizerError
+        `name` is not registered (the message lists the registered ones).
+    OptionError
+        An option the calibrator does not declare.
+    ValueError
+        dim or budget below 1.
+
+    Examples
+    --------
+    >>> from optimizers import make
+    >>> opt = make("random", dim=3, budget=8, seed=0)
+    >>> opt.ask().shape[1]
+    3
+    """
     return get(name)(dim=dim, budget=budget, seed=seed, **options)

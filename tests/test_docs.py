@@ -284,3 +284,69 @@ def test_no_docstring_writes_a_model_count_as_a_literal_shape():
                         if "," in m.group()
                     ]
     assert not found, "shapes written in today's counts:\n" + "\n".join(found)
+
+
+NUMPYDOC_CHECKED = {
+    "GL08": "no docstring",
+    "SS01": "no one-line summary",
+    "SS03": "the summary does not end with a period",
+    "SS06": "the summary does not fit on one line",
+    "PR01": "a parameter not documented",
+    "PR02": "a documented parameter the signature does not have",
+    "PR03": "the parameters documented in another order than the signature's",
+    "PR04": "a parameter without its type",
+    "PR05": "a parameter's type ending with a period",
+    "PR06": 'a type written "integer", "boolean" or "string"',
+    "PR07": "a parameter without a description",
+    "PR10": "no space before the colon after a parameter's name",
+    "RT01": "no Returns section in a function that returns something",
+    "RT03": "a return value without a description",
+    "YD01": "no Yields section in a generator",
+}
+"""The numpydoc validation codes the public API is held to (`numpydoc.validate.ERROR_MSGS`). Not checked:
+ES01 (an extended summary: many one-line summaries say all), EX01 (an Examples section: most entry points build
+a model or simulate, which takes minutes; a doctest is given where one runs fast), SA01-SA04 (a See Also
+section), SS05 (a summary starting with an infinitive verb: the summaries here are noun phrases, "The Gymnasium
+id of a participant's motion.", as much of the code's are), SS02, PR08, PR09, RT04, RT05 (capitals and final
+periods of descriptions: prose style, not content), GL01, GL02 (where the quotes sit: ruff format's), GL06,
+GL07 (sections numpydoc does not know, and their order: the env's docstring has Gymnasium's, rendered by
+napoleon's custom sections, docs/conf.py)."""
+_ERROR_BASES = (BaseException,)
+
+
+def public_api() -> list[tuple[str, object]]:
+    """Every function and class named in the `__all__` of a package of `wrist_env` or `optimizers` (its
+    `__init__`), but `wrist_env.solver`'s (the kernels' own docstrings: shapes in symbols, their own tests),
+    once each, by the qualified name of where it is defined."""
+    import importlib
+    import inspect
+
+    found = {}
+    for top in ("wrist_env", "optimizers"):
+        for init in sorted((ROOT / top).rglob("__init__.py")):
+            name = ".".join(init.parent.relative_to(ROOT).parts)
+            if name == "wrist_env.solver" or name.startswith("wrist_env.solver."):
+                continue
+            module = importlib.import_module(name)
+            for public in getattr(module, "__all__", ()):
+                obj = getattr(module, public)
+                if inspect.isfunction(obj) or inspect.isclass(obj):
+                    found.setdefault(f"{obj.__module__}.{obj.__qualname__}", obj)
+    return sorted(found.items())
+
+
+def test_the_public_api_has_numpydoc_sections():
+    """Each public function and class passes numpydoc's validation on the codes of `NUMPYDOC_CHECKED`: a
+    parameter added without documenting it, or a function that returns without a Returns section, fails here.
+    An exception (`*Error`) needs only its docstring's summary (GL08, SS01, SS03, SS06)."""
+    from numpydoc.validate import validate
+
+    api = public_api()
+    assert len(api) >= 50, [name for name, _ in api]
+    failures = []
+    for name, obj in api:
+        codes = set(NUMPYDOC_CHECKED)
+        if isinstance(obj, type) and issubclass(obj, _ERROR_BASES):
+            codes = {"GL08", "SS01", "SS03", "SS06"}
+        failures += [f"{name}: {code} {message}" for code, message in validate(name)["errors"] if code in codes]
+    assert not failures, "docstrings short of the numpydoc sections:\n" + "\n".join(failures)

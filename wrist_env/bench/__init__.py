@@ -15,8 +15,24 @@ from wrist_env.bench.schema import RunKey
 
 
 def write_leaderboard(runs: str | Path, out: str | Path, **kwargs: Any) -> Path:
-    """Write the leaderboards of the run log in `runs` to the folder `out` (see `leaderboard`); loaded when
-    called, so that running a benchmark does not load matplotlib."""
+    """Write the leaderboards of the run log in `runs` to the folder `out` (see `leaderboard`).
+
+    The leaderboard module is loaded when called, so that running a benchmark does not load matplotlib.
+
+    Parameters
+    ----------
+    runs : str or Path
+        The run log's folder (`RunLog`).
+    out : str or Path
+        The folder the tables, figures and README are written to (made if missing).
+    **kwargs
+        ``references`` and ``title``, as `wrist_env.bench.leaderboard.write_leaderboard` takes them.
+
+    Returns
+    -------
+    Path
+        ``out/README.md``.
+    """
     from wrist_env.bench.leaderboard import write_leaderboard as write
 
     return write(runs, out, **kwargs)

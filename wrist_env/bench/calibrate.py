@@ -74,14 +74,38 @@ def accepts_storage(cls) -> bool:
 class CalibrationRun:
     """One calibration: the calibrator's result, the calibrated design and how good it is.
 
-    result: the OptimizeResult (x: the best 22 normalized materials).
-    design: the calibrated design (injury intact); `design.as_dict()` in physical units.
-    calibrate / validate: {"cost", "failed", "rmse", "error_p75", "unsettled_frames"} of the calibrated
-        design on the calibration trial and on the held-out resisted trial (rmse, error_p75: {bone: {DOF:
-        mm or deg}}; unsettled_frames: frames whose hold ran out before equilibrium, None if failed).
-    recovery_z: RMS of z(calibrated) − z(truth) over the 22 materials (Table 2 SD units); None
-        without a hidden truth. recovery_z_population: the same for the population design.
-    replayed: evaluations taken from the log instead of simulated (a resumed run).
+    Parameters
+    ----------
+    key : RunKey
+        The cell: participant, calibrator, seed, budget and instance.
+    result : OptimizeResult
+        The calibrator's result (``x`` of shape (22,): the best 22 normalized materials).
+    design : Design
+        The calibrated design (injury intact); ``design.as_dict()`` in physical units.
+    calibrate, validate : dict
+        ``{"cost", "failed", "rmse", "error_p75", "unsettled_frames"}`` of the calibrated design on the
+        calibration trial and on the held-out resisted trial (rmse, error_p75: ``{bone: {DOF: mm or
+        deg}}``; unsettled_frames: frames whose hold ran out before equilibrium, None if failed).
+    recovery_z : float or None
+        RMS of z(calibrated) − z(truth) over the 22 materials (Table 2 SD units); None without a hidden
+        truth.
+    recovery_z_population : float or None
+        The same for the population design.
+    best_eval : int
+        The 0-based index of the best evaluation in the run.
+    replayed : int
+        Evaluations taken from the log instead of simulated (a resumed run).
+    wall_seconds : float
+        Wall time of the calibration, s.
+    options : dict, default {}
+        The calibrator's options the run was made with.
+
+    Attributes
+    ----------
+    cost : float
+        ``calibrate["cost"]``, the calibrated design's cost on the calibration trial.
+    validate_cost : float
+        ``validate["cost"]``, its cost on the held-out trial.
     """
 
     key: RunKey

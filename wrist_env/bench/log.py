@@ -74,7 +74,7 @@ def _span(m: re.Match) -> tuple[int, int]:
 
 
 class DuplicateEvaluationError(WristEnvError, RuntimeError):
-    """An attempt to log an evaluation that is already in the log."""
+    """An attempt to log an evaluation that is already in the log (`RunLog.append`: never twice)."""
 
 
 class IncompleteCellError(StoreError):
@@ -82,7 +82,13 @@ class IncompleteCellError(StoreError):
 
 
 class RunLog:
-    """The run log under `root` (created on first write)."""
+    """The run log under `root` (created on first write); its layout is the module's docstring.
+
+    Parameters
+    ----------
+    root : str or Path
+        The run directory (kept as ``root``, a Path; its `RunStore` is ``store``).
+    """
 
     def __init__(self, root):
         self.root = Path(root)

@@ -30,7 +30,12 @@ REPLAY_TOLERANCE = 1e-9
 
 
 class ResumeError(WristEnvError, RuntimeError):
-    """A calibrator did not ask again for the points it asked before (it is not deterministic)."""
+    """A calibrator did not ask again for the points it asked before (it is not deterministic).
+
+    Raised when a cell cut short is resumed by replay (`Replayed`) and the fresh calibrator, seeded as the
+    logged run, asks for points other than the logged ones, stops before the logged evaluations are
+    replayed, or the log holds more evaluations than the budget.
+    """
 
 
 @dataclass(frozen=True)

@@ -48,7 +48,34 @@ if TYPE_CHECKING:
 
 @dataclass
 class BenchmarkReport:
-    """What a `benchmark` call did: cells run, skipped (already finished) and failed (with the error)."""
+    """What a `benchmark` call did: cells run, skipped (already finished) and failed (with the error).
+
+    Parameters
+    ----------
+    out_dir : Path
+        The run log's folder (resolved).
+    cells : list of RunKey, length n_cells
+        Every cell asked for.
+    ran : list of RunKey
+        The cells run (or resumed) to their end by this call.
+    skipped : list of RunKey
+        The cells finished before this call, or found finished by their worker.
+    failed : list of (RunKey, str)
+        The cells that raised, each with its error described in one line.
+    wall_seconds : float
+        Wall time of the call, s.
+    workers : int, default 1
+        The local processes the executor ran.
+    threads : int or None
+        Numba threads per local process (None: not set by the executor).
+    scheduler : str or None
+        The dask.distributed scheduler's address, or None for local processes.
+
+    Attributes
+    ----------
+    evaluations : int
+        Evaluations the run log holds for these cells (read from the log when asked).
+    """
 
     out_dir: Path
     cells: list[RunKey]

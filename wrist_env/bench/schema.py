@@ -116,8 +116,27 @@ def summary_cell(summary: dict) -> str:
 
 @dataclass(frozen=True, order=True)
 class RunKey:
-    """One benchmark cell: a calibrator run on a problem instance of a participant (`participants.instances`;
-    0, the default, its shipped truth and trials) with a seed and a budget."""
+    """One benchmark cell: a calibrator run on a problem instance of a participant with a seed and a budget.
+
+    Parameters
+    ----------
+    participant : str
+        The participant's name.
+    optimizer : str
+        The calibrator's name, optionally with ``+prior``.
+    seed : int
+        The calibrator's seed, in [0, `limits.MAX_SEED`].
+    budget : int
+        Evaluations allowed, in [1, `limits.MAX_BUDGET`].
+    instance : int, default 0
+        The problem instance (`participants.instances`; 0, the default, its shipped truth and trials), in
+        [0, `limits.MAX_INSTANCE`].
+
+    Raises
+    ------
+    InputError
+        seed, budget or instance not an int in its range (the message names the field, range and value).
+    """
 
     participant: str
     optimizer: str

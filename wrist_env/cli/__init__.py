@@ -69,9 +69,20 @@ class _Parser(argparse.ArgumentParser):
 
 
 def parser(selected: str | None = None) -> argparse.ArgumentParser:
-    """The `wrist-bench` argument parser, every command with `--folder`: each command's own arguments
-    from its module, for every command (`selected` None) or only for the commands of `selected`'s module
-    (the others listed by name and help alone, their modules not imported; "" for none)."""
+    """The `wrist-bench` argument parser, every command with `--folder`.
+
+    Parameters
+    ----------
+    selected : str, optional
+        A command's name: only the commands of its module get their own arguments (from the module), the
+        others are listed by name and help alone, their modules not imported; "" for none; None (the
+        default) gives every command its arguments.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The parser, one subcommand per entry of `COMMANDS`.
+    """
     p = _Parser(prog="wrist-bench", description=__doc__)
     sub = p.add_subparsers(dest="command", required=True)
     folders = argparse.ArgumentParser(add_help=False)
@@ -105,8 +116,22 @@ def _named(argv: Sequence[str]) -> str | None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run one `wrist-bench` command; returns the exit status (2 for a usage, project or file-system error, 130
-    for Ctrl-C: one line on stderr)."""
+    """Run one `wrist-bench` command; returns the exit status.
+
+    A project error (`WristEnvError`), a usage error or a file-system error is one line on stderr, not a
+    traceback.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        The command line after ``wrist-bench`` (default: ``sys.argv[1:]``).
+
+    Returns
+    -------
+    int
+        The exit status: the command's (0 on success; ``validate`` 1 if a check fails), 2 for a usage,
+        project or file-system error, 130 for Ctrl-C.
+    """
     argv = list(sys.argv[1:] if argv is None else argv)
     name = _named(argv)
     try:

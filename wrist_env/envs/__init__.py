@@ -20,15 +20,50 @@ __all__ = ["MOTION_PREFIX", "NAMESPACE", "env_id", "register_ids", "register_par
 
 
 def register_ids(participant: str, motions: Iterable[str] = MOTIONS) -> tuple[str, ...]:
-    """Register (once) and return the ids of a known participant's motions."""
+    """Register (once) and return the ids of a known participant's motions.
+
+    Parameters
+    ----------
+    participant : str
+        A known participant's name (built-in or registered from a folder).
+    motions : iterable of str, default `motions.MOTIONS`
+        The motions to register ids for.
+
+    Returns
+    -------
+    tuple of str, shape (n_motions,)
+        The ids, ``wrist_env/<Motion>-<participant>-v0``, in the order of `motions`.
+
+    Examples
+    --------
+    >>> from wrist_env.envs import register_ids
+    >>> register_ids("P1", ["calibrate"])
+    ('wrist_env/Calibrate-P1-v0',)
+    """
     return ids.register_ids(gym, participant, motions)
 
 
 def register_participant(folder: str | Path) -> tuple[str, ...]:
-    """Validate a participant folder (its format: docs/participants.md, "Registering your own participant") and register its ids.
+    """Validate a participant folder and register its Gymnasium ids.
 
-    Returns the new ids: Calibrate and Idealized always, Validate when the folder
-    has a trial with role "validate".
+    The folder's format is described in docs/participants.md, "Registering your own participant".
+
+    Parameters
+    ----------
+    folder : str or Path
+        The participant folder.
+
+    Returns
+    -------
+    tuple of str
+        The new ids: Calibrate and Idealized always, Validate when the folder has a trial with role
+        "validate".
+
+    Raises
+    ------
+    ParticipantError
+        The folder does not hold a valid participant (the message names the file and the rule), or its
+        name is taken by a built-in participant or by another folder.
     """
     from wrist_env.participants import registry  # the model builder: heavy, needed only here
 
@@ -39,5 +74,11 @@ def register_participant(folder: str | Path) -> tuple[str, ...]:
 
 
 def registered_ids() -> tuple[str, ...]:
-    """All wrist-env ids in the Gymnasium registry."""
+    """All wrist-env ids in the Gymnasium registry.
+
+    Returns
+    -------
+    tuple of str
+        The ids in the ``wrist_env`` namespace, in the registry's order.
+    """
     return tuple(i for i in gym.registry if i.startswith(NAMESPACE + "/"))

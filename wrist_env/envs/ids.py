@@ -13,7 +13,30 @@ MOTION_PREFIX = {m: m.capitalize() for m in MOTIONS}
 
 
 def env_id(participant: str, motion: str) -> str:
-    """The Gymnasium id of a participant's motion (`motions.MOTIONS`)."""
+    """The Gymnasium id of a participant's motion.
+
+    Parameters
+    ----------
+    participant : str
+        The participant's name.
+    motion : str
+        One of `motions.MOTIONS`.
+
+    Returns
+    -------
+    str
+        ``wrist_env/<Motion>-<participant>-v0``.
+
+    Raises
+    ------
+    KeyError
+        `motion` is not one of `motions.MOTIONS`.
+
+    Examples
+    --------
+    >>> env_id("P1", "calibrate")
+    'wrist_env/Calibrate-P1-v0'
+    """
     return f"{NAMESPACE}/{MOTION_PREFIX[motion]}-{participant}-v0"
 
 

@@ -68,8 +68,25 @@ def _bone_polygons(surfaces: list, poses_frame: np.ndarray) -> tuple[np.ndarray,
 
 
 def animation_figure(model: Model, sweep: SweepFrames, out: Path | None = None, *, fps: float = 4.0) -> Path:
-    """Write a GIF of `sweep`, the population design's idealized sweep of `model` (radial view): returns its
-    path."""
+    """Write a GIF of `sweep`, the population design's idealized sweep of `model` (radial view).
+
+    Parameters
+    ----------
+    model : Model
+        The participant's model (its bone meshes and contact samples).
+    sweep : SweepFrames
+        The sweep simulated: poses of shape (n_frames, n_bodies, 4, 4), mm; bundle forces, N; radiocarpal
+        pressures, MPa.
+    out : Path, optional
+        The GIF's path (default ``FIGURES / "animation_<name>.gif"``; its folder is made if missing).
+    fps : float, default 4.0
+        Frames per second of the GIF.
+
+    Returns
+    -------
+    Path
+        The GIF's path.
+    """
     name, n_frames = sweep.name, len(sweep.angle_deg)
     out = Path(out) if out else draw.FIGURES / f"animation_{name}.gif"
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -32,8 +32,22 @@ def _display_faces(bone: str, vertices, faces, thickness):
 
 
 def model_figure(model: Model, name: str, out: Path | None = None) -> Path:
-    """Bones, cartilage coloured by thickness, ligament fibres and the RSC membrane of `model`, participant
-    `name`'s."""
+    """Draw the bones, cartilage coloured by thickness, ligament fibres and the RSC membrane of a model.
+
+    Parameters
+    ----------
+    model : Model
+        Participant `name`'s model (meshes in mm, cartilage thickness in mm).
+    name : str
+        The participant, for the title and the default file name.
+    out : Path, optional
+        The PNG's path (default ``FIGURES / "model_<name>.png"``).
+
+    Returns
+    -------
+    Path
+        The PNG's path.
+    """
 
     out = out or draw.FIGURES / f"model_{name}.png"
     norm = matplotlib.colors.Normalize(0.0, 1.1)
@@ -109,12 +123,24 @@ PAIR_COLOURS = dict(
 
 
 def annotations_figure(bones: dict, annotations, out: Path | None = None) -> Path:
-    """The template with its cartilage coverage and ligament attachment sites, for review.
+    """Draw the template with its cartilage coverage and ligament attachment sites, for review.
 
-    bones: bone name -> its surface (`anatomy.template.BoneSurface`: vertices (n, 3) mm, faces (m, 3), the
-    radius's `solid` vertex indices); annotations: the template's (`anatomy.annotations.Annotations`:
-    `coverage`, articulation -> (bone a, bone b, vertex mask of a, of b); `sites`, ligament -> sites with
-    `bone` and vertex `mask`)."""
+    Parameters
+    ----------
+    bones : dict of str to BoneSurface
+        Bone name -> its surface (`anatomy.template.BoneSurface`: vertices of shape (n, 3), mm; faces of
+        shape (m, 3); the radius's `solid` vertex indices).
+    annotations : Annotations
+        The template's (`anatomy.annotations.Annotations`: `coverage`, articulation -> (bone a, bone b,
+        vertex mask of a, of b); `sites`, ligament -> sites with `bone` and vertex `mask`).
+    out : Path, optional
+        The PNG's path (default ``FIGURES / "template_annotations.png"``).
+
+    Returns
+    -------
+    Path
+        The PNG's path.
+    """
 
     ann = annotations
     out = out or draw.FIGURES / "template_annotations.png"

@@ -92,12 +92,26 @@ _BONE_FILL, _CARTILAGE_FILL, _OUTLINE = "#e6e1d8", "#c9d3de", "#4d4d4d"
 
 
 def pressure_figure(model: Model, frame: PressureFrame, out: Path | None = None) -> Path:
-    """Contact pressure at the neutral pose, viewed from distal (preprint Figure 3's pressure plot).
+    """Draw the contact pressure at the neutral pose, viewed from distal (preprint Figure 3's pressure plot).
 
-    `frame`: the population design's frame at neutral, simulated (`cli.run.figure_data.pressure_frame`:
-    the 0° frame of the idealized ±40° sweep, or the capitate held at neutral). Samples are drawn at
-    their world positions projected on the RCS x–z plane (radial to the right, volar down: the view from
-    distal, not mirrored).
+    Samples are drawn at their world positions projected on the RCS x–z plane (radial to the right, volar
+    down: the view from distal, not mirrored).
+
+    Parameters
+    ----------
+    model : Model
+        The participant's model (its bone meshes and contact samples).
+    frame : PressureFrame
+        The population design's frame at neutral, simulated (`cli.run.figure_data.pressure_frame`: the 0°
+        frame of the idealized ±40° sweep, or the capitate held at neutral): poses of shape
+        (n_bodies, 4, 4), mm; pressure per sample of shape (n_samples,), MPa.
+    out : Path, optional
+        The PNG's path (default ``FIGURES / "pressure_<name>.png"``).
+
+    Returns
+    -------
+    Path
+        The PNG's path.
     """
     from scipy.spatial import cKDTree
 
@@ -227,9 +241,28 @@ KINEMATIC_ANGLES = (
 
 
 def kinematics_figure(name: str, angle_deg: np.ndarray, runs: Sequence[RowKinematics], out: Path | None = None) -> Path:
-    """Scaphoid and lunate rotations (Cardan Z-X-Y) against the capitate angle `angle_deg` (n_frames,) over
-    the idealized ±40° sweep of participant `name`: one line style per run (`cli.run.figure_data.row_kinematics`:
-    the population design, and for built-in participants also the hidden truth)."""
+    """Draw the scaphoid and lunate rotations against the capitate angle over the idealized ±40° sweep.
+
+    The rotations are Cardan Z-X-Y angles; one line style per run.
+
+    Parameters
+    ----------
+    name : str
+        The participant, for the title and the default file name.
+    angle_deg : ndarray, shape (n_frames,)
+        The capitate's angle per frame, deg.
+    runs : sequence of RowKinematics
+        The runs drawn (`cli.run.figure_data.row_kinematics`: the population design, and for built-in
+        participants also the hidden truth), each with angles of shape (n_frames, n_bodies, 3), deg, or
+        None when it failed.
+    out : Path, optional
+        The PNG's path (default ``FIGURES / "kinematics_<name>.png"``).
+
+    Returns
+    -------
+    Path
+        The PNG's path.
+    """
 
     out = out or draw.FIGURES / f"kinematics_{name}.png"
     colours = {"scaphoid": "#1f77b4", "lunate": "#d62728"}

@@ -29,12 +29,42 @@ FIT_RUNS_WHY = (
 
 
 class StudyError(WristEnvError):
-    """A study that cannot run: a folder holding another study, a duplicated run, no successes."""
+    """A study that cannot run: a folder holding another study, a duplicated run, no successes.
+
+    Also raised for a `StudyConfig` that cannot be a study (no participant, a tear probability outside [0, 1],
+    an unknown load direction) and when a participant's runs reach the attempt limit; the message names the
+    folder or part and the rule.
+    """
 
 
 @dataclass(frozen=True)
 class StudyConfig:
-    """What a study is: these decide every run (how it is run does not)."""
+    """What a study is: these decide every run (how it is run does not).
+
+    Parameters
+    ----------
+    participants : tuple of str, length n_participants
+        The participants, each named once (a list is stored as a tuple).
+    n : int
+        Successful runs per participant, in [1, `limits.MAX_RUNS`] (a round's draws are held in memory).
+    seed : int, default 0
+        The study's seed: a run is a pure function of seed, participant and block.
+    tear_probability : float, default `TEAR_PROBABILITY`
+        Chance that each injurable ligament is torn in a run, in [0, 1].
+    exclude_above_mpa : float, default `EXCLUDE_ABOVE_MPA`
+        A run is excluded when its radioscaphoid mean pressure exceeds this at any frame of the sweep, MPa.
+    max_attempts : int, optional
+        Give up (`StudyError`) after this many runs of one participant; default 5 n + 100.
+    load_direction : str, default `solver.settings.DEFAULT_LOADS`
+        The sweeps' load direction (`LOAD_DIRECTIONS`): along the radius, or a tendon rig's.
+
+    Raises
+    ------
+    StudyError
+        No participant, a tear probability outside [0, 1], or an unknown load direction.
+    InputError
+        A participant named twice, or n or seed not an int in its range.
+    """
 
     participants: tuple[str, ...]
     n: int

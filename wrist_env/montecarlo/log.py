@@ -163,7 +163,28 @@ def _stray_parts(store: RunStore) -> list[tuple[str, str]]:
 
 def read_runs(out: str | Path, columns: list[str] | None = None) -> pa.Table | None:
     """Every logged run of the study in `out`, sorted by (participant, sample_id); None if empty.
-    StudyError naming both parts if a run is logged twice; StoreError naming a damaged part."""
+
+    Parameters
+    ----------
+    out : str or Path
+        The study's folder.
+    columns : list of str, optional
+        The columns to read (default: all of `sampler.SCHEMA`). Without both "participant" and
+        "sample_id" the table is returned in the parts' order, unsorted and unchecked for duplicates.
+
+    Returns
+    -------
+    pyarrow.Table or None
+        One row per run (n_runs rows; the columns of `sampler.SCHEMA`: per-frame outputs as lists of
+        n_frames), or None if nothing is logged.
+
+    Raises
+    ------
+    StudyError
+        A run is logged twice (the message names both parts).
+    StoreError
+        A damaged part (the message names it).
+    """
     store = runs_log(out)
     names = store.part_names()
     if not names:

@@ -179,12 +179,38 @@ def run_study(
 ) -> StudySummary:
     """Run (or resume) a study into the folder `out`; returns the counts and the wall time.
 
-    batch: runs per chunk (one vector-env step, one log part). scheduler: a dask.distributed
-    address or Client (default: local). workers: local worker processes (0 or 1: this process).
-    folders: user participant folders (registered here and on every worker). progress: a tqdm
-    bar of successful runs (postfix: excluded and failed so far). A second run on the same `out`
-    while this one is running is refused (`StoreBusyError`), and so is an empty `out` (it would be the
-    current folder).
+    Parameters
+    ----------
+    config : StudyConfig
+        The study: participants, n, seed, tear probability, exclusion threshold, load direction.
+    out : str or Path
+        The study's folder (made if missing); a study already logged there resumes.
+    batch : int, default 64
+        Runs per chunk (one vector-env step, one log part), in [1, `limits.MAX_BATCH`].
+    scheduler : str or distributed.Client, optional
+        A dask.distributed address or Client (default: local).
+    workers : int, default 0
+        Local worker processes (0 or 1: this process).
+    folders : iterable of str or Path, default ()
+        User participant folders (registered here and on every worker).
+    progress : bool, default False
+        A tqdm bar of successful runs (postfix: excluded and failed so far).
+
+    Returns
+    -------
+    StudySummary
+        Per participant its attempts, successes, exclusions and failures (``counts``), the runs simulated by
+        this call (``simulated``), the wall time (``wall_seconds``, s) and whether the study is done.
+
+    Raises
+    ------
+    StoreBusyError
+        A second run on the same `out` while this one is running.
+    InputError
+        An empty `out` (it would be the current folder), or batch or workers out of range.
+    StudyError
+        `out` holds runs made with other settings or on another model, or a participant reached its attempt
+        limit.
     """
     if not str(out).strip():
         raise InputError("out is empty; give the study's folder (run_study(config, 'runs/montecarlo'))")

@@ -62,7 +62,22 @@ def describe(error: BaseException) -> str:
 
 
 class Executor:
-    """Base: `submit` tasks, then iterate `results`; `close` when done (or use `with`)."""
+    """Base: `submit` tasks, then iterate `results`; `close` when done (or use `with`).
+
+    The subclasses are `Inline` (this process), `Processes` (spawned local processes) and `Dask` (a
+    dask.distributed scheduler); `executor` picks one.
+
+    Attributes
+    ----------
+    workers : int
+        The processes tasks run on (1 for this process).
+    threads : int or None
+        Numba threads per local process (None: not set here).
+    scheduler : str or None
+        A dask.distributed scheduler's address, or None for local processes.
+    inline : bool
+        Whether tasks run in this process (a progress bar can then follow each batch).
+    """
 
     workers: int = 1
     threads: int | None = None
@@ -282,7 +297,30 @@ def _connect(address: str) -> distributed.Client:
 def executor(
     scheduler: str | distributed.Client | None = None, workers: int = 0, threads: int | None = None
 ) -> Executor:
-    """Dask if `scheduler` is given, else `workers` local processes (≥ 2), else this process."""
+    """Dask if `scheduler` is given, else `workers` local processes (≥ 2), else this process.
+
+    Parameters
+    ----------
+    scheduler : str or distributed.Client, optional
+        A dask.distributed scheduler's address, or a client the caller keeps.
+    workers : int, default 0
+        Local worker processes; 0 or 1 run the tasks in this process.
+    threads : int, optional
+        Numba threads per local process (default ⌊cores / workers⌋ for processes).
+
+    Returns
+    -------
+    Executor
+        `Dask`, `Processes` or `Inline`; use it with ``with`` so that it is closed.
+
+    Examples
+    --------
+    >>> from wrist_env.runs import executor
+    >>> with executor(workers=0) as ex:
+    ...     handles = [ex.submit(pow, 2, k) for k in range(3)]
+    ...     sorted(value for _, value, _ in ex.results(handles))
+    [1, 2, 4]
+    """
     if scheduler is not None:
         return Dask(scheduler)
     if workers and int(workers) > 1:

@@ -50,11 +50,18 @@ leaves other JSON (a study's manifest, a report's summary) alone."""
 
 
 class PartExistsError(StoreError, FileExistsError):
-    """A part of that name is already in the store (parts are written once)."""
+    """A part of that name is already in the store (parts are written once).
+
+    Raised by `RunStore.write_part`; a `StoreError` and a `FileExistsError`.
+    """
 
 
 class StoreBusyError(StoreError):
-    """Another process holds a lock this one was not allowed to wait for."""
+    """Another process holds a lock this one was not allowed to wait for.
+
+    Raised by `RunStore.lock` when told not to wait, e.g. for a second Monte Carlo study started on a folder
+    while one runs there; the message names the holder.
+    """
 
 
 def checksum_path(path: str | Path) -> Path:
@@ -153,7 +160,25 @@ def add_checksums(root: str | Path) -> list[Path]:
 
 
 class RunStore:
-    """Parts, records and locks under `root` (folders created on the first write)."""
+    """Parts, records and locks under `root` (folders created on the first write).
+
+    The layout of the folder and the rules it keeps are the module's docstring.
+
+    Parameters
+    ----------
+    root : str or Path
+        The store's folder.
+    parts : str, default "parts"
+        The folder of the write-once Parquet parts, under `root`.
+    records : str, default "records"
+        The folder of the JSON records, under `root`.
+
+    Attributes
+    ----------
+    root, parts_dir, records_dir, locks_dir, damaged_dir : Path
+        The store's folder, and under it the parts, the records, the locks (``locks/``) and the files moved
+        aside (``damaged/``).
+    """
 
     def __init__(self, root, *, parts: str = "parts", records: str = "records"):
         self.root = Path(root)

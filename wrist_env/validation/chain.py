@@ -30,11 +30,29 @@ from wrist_env.validation.simulations import LOAD_MODES, RL, RS, Simulations
 class CheckSpec:
     """One check: what it measures, against which published band, on which runs.
 
-    description: what the value is, as the record and the table say it; "{neutral}" and "{ulnar_variance}"
-        are filled in from the runs (`Simulations.words`). band: (low, high), low <= value <= high passes
-        (inf: unbounded). load: a key of `simulations.LOAD_MODES`, the runs it reads. value: the measure, a
-        pure function of the runs; not called when they failed (the check then fails, NaN, with the
-        solver's status).
+    Parameters
+    ----------
+    id : str
+        The check's id, as the record and the table name it.
+    description : str
+        What the value is, as the record and the table say it; "{neutral}" and "{ulnar_variance}" are filled
+        in from the runs (`Simulations.words`).
+    band : tuple of (float, float)
+        (low, high), in `unit`: low <= value <= high passes (inf: unbounded).
+    unit : str
+        The unit of the value and the band ("deg", "mm", "%", ...).
+    source : str
+        The publication the band comes from.
+    load : str
+        A key of `simulations.LOAD_MODES`, the runs it reads.
+    value : callable
+        ``value(s: Simulations) -> float``, the measure in `unit`, a pure function of the runs; not called
+        when they failed (the check then fails, NaN, with the solver's status).
+
+    Raises
+    ------
+    ValueError
+        An unknown load mode, or a band whose low is above its high.
     """
 
     id: str
@@ -241,7 +259,20 @@ def _row(check_id, description, value, band, unit, failed=None, source=None) -> 
 
 
 def run_chain(s: Simulations, checks: tuple[CheckSpec, ...] = CHECKS) -> tuple[Check, ...]:
-    """Each check of `checks` measured on the runs `s`, in order."""
+    """Each check of `checks` measured on the runs `s`, in order.
+
+    Parameters
+    ----------
+    s : Simulations
+        The population design's runs and shared measures (`run_simulations`).
+    checks : tuple of CheckSpec, default `CHECKS`
+        The chain.
+
+    Returns
+    -------
+    tuple of Check, length n_checks
+        One row per check; a check whose runs failed has value NaN, fails, and says the solver's status.
+    """
     words = s.words
     rows = []
     for c in checks:

@@ -31,15 +31,54 @@ def validate(
 ) -> Report:
     """Run the published-measurement checks on participant `name` (population design by default).
 
-    params: build parameters (`BuildParams`; the anatomy variant), default the default build.
-    load_n: the compressive load (N) of the sweeps; the neutral pose takes `NEUTRAL_LOAD_N`.
-    load_direction: the loads' direction in the sweeps (`settings.LOAD_DIRECTIONS`).
-    neutral_load: the load at neutral, where RS/RL and the midcarpal and ulnar shares are measured: by
-        default their experiments' (`settings.JIG`: the hand loaded axially in a jig, as Palmer & Werner
-        1984, Tencer 1988, Hara 1992 and Viegas 1993 loaded it), not the tendons'.
-    settings: the solver's (`settings.SolverSettings`), default its defaults.
     The load and the frames are checked before the model loads (a NaN load used to fail the whole run).
-    The runs are simulated once (`simulations.run_simulations`); the checks, `chain.CHECKS` in order, read them.
+    The runs are simulated once (`simulations.run_simulations`); the checks, `chain.CHECKS` in order, read
+    them.
+
+    Parameters
+    ----------
+    name : str
+        A registered participant's name.
+    model : Model, optional
+        The model to check (default: the participant's, built or loaded with `params`).
+    d : Design, optional
+        The design simulated (default: the population design, `design.population()`).
+    n_frames : int, default 17
+        Frames of the idealized sweep, in [1, `limits.MAX_FRAMES`].
+    params : BuildParams, optional
+        Build parameters (the anatomy variant), default the default build.
+    load_n : float, default `drivers.IDEALIZED_LOAD_N`
+        The compressive load of the sweeps, N; the neutral pose takes `NEUTRAL_LOAD_N`.
+    load_direction : str, default `settings.DEFAULT_LOADS`
+        The loads' direction in the sweeps (`settings.LOAD_DIRECTIONS`).
+    neutral_load : str, default `settings.JIG`
+        The load at neutral, where RS/RL and the midcarpal and ulnar shares are measured: by default their
+        experiments' (`settings.JIG`: the hand loaded axially in a jig, as Palmer & Werner 1984, Tencer
+        1988, Hara 1992 and Viegas 1993 loaded it), not the tendons'.
+    settings : SolverSettings, optional
+        The solver's settings (`settings.SolverSettings`), default its defaults.
+
+    Returns
+    -------
+    Report
+        The checks (value, band, unit, source, pass), the series behind them, the conditions and the wall
+        time.
+
+    Raises
+    ------
+    InputError
+        `load_n` not a finite number in [0, `limits.MAX_LOAD_N`] N, or `n_frames` out of range.
+    ParticipantError
+        An unknown participant (when no `model` is given).
+
+    Examples
+    --------
+    .. code-block:: python
+
+        from wrist_env.validation import format_table, validate
+
+        report = validate("P1")
+        print(format_table(report))
     """
 
     start = time.perf_counter()

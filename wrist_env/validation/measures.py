@@ -22,18 +22,57 @@ def rotation_from_capitate_deg(poses: np.ndarray, body: int) -> np.ndarray:
 
 
 def column_rotation_deg(poses: np.ndarray) -> float:
-    """The radial column's largest rotation (deg) relative to the capitate over a run's poses (n_frames, n_bodies, 4, 4)."""
+    """The radial column's largest rotation (deg) relative to the capitate over a run's poses.
+
+    Parameters
+    ----------
+    poses : ndarray, shape (n_frames, n_bodies, 4, 4)
+        The bodies' poses per frame (neutral → frame; mm).
+
+    Returns
+    -------
+    float
+        The trapezium's largest rotation relative to the capitate over the frames, deg.
+    """
     return float(rotation_from_capitate_deg(poses, TRAPEZIUM).max())
 
 
 def hamate_rotation_deg(poses: np.ndarray) -> float:
-    """The hamate's largest rotation (deg) relative to the capitate over a run's poses (n_frames, n_bodies, 4, 4): the
-    distal row moves rigidly together, < 3 deg (Akhbari 2019, J Orthop Res 37:2661)."""
+    """The hamate's largest rotation (deg) relative to the capitate over a run's poses.
+
+    The distal row moves rigidly together, < 3 deg (Akhbari 2019, J Orthop Res 37:2661).
+
+    Parameters
+    ----------
+    poses : ndarray, shape (n_frames, n_bodies, 4, 4)
+        The bodies' poses per frame (neutral → frame; mm).
+
+    Returns
+    -------
+    float
+        The hamate's largest rotation relative to the capitate over the frames, deg.
+    """
     return float(rotation_from_capitate_deg(poses, HAMATE).max())
 
 
 def slope(x: ArrayLike, y: ArrayLike) -> float:
-    """Least-squares slope of y against x over the finite pairs; NaN if x does not vary."""
+    """Least-squares slope of y against x over the finite pairs; NaN if x does not vary.
+
+    Parameters
+    ----------
+    x, y : array_like, shape (n,)
+        The paired values; a pair where either is not finite is left out.
+
+    Returns
+    -------
+    float
+        The slope, in y's unit per x's; NaN with fewer than two finite pairs or a constant x.
+
+    Examples
+    --------
+    >>> slope([0.0, 1.0, 2.0, float("nan")], [1.0, 3.0, 5.0, 0.0])
+    2.0
+    """
     x, y = np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64)
     ok = np.isfinite(x) & np.isfinite(y)
     x, y = x[ok], y[ok]
@@ -48,10 +87,20 @@ def surface_gap_mm(
 ) -> np.ndarray:
     """Minimum distance (mm) between two posed triangle surfaces at each frame.
 
-    a_mesh, b_mesh: (vertices (n, 3), faces (m, 3)) at the neutral pose; a_poses, b_poses (n_frames, 4, 4)
-    neutral → frame. Each surface's vertices are taken into the other's neutral frame and their closest
-    points on the other's triangles found (libigl's point–mesh distance); the smaller of both directions.
-    0 where the surfaces touch; NaN where a pose is not finite.
+    Each surface's vertices are taken into the other's neutral frame and their closest points on the
+    other's triangles found (libigl's point–mesh distance); the smaller of both directions.
+
+    Parameters
+    ----------
+    a_mesh, b_mesh : tuple of (array_like, array_like)
+        (vertices of shape (n, 3), mm; faces of shape (m, 3), vertex indices) at the neutral pose.
+    a_poses, b_poses : array_like, shape (n_frames, 4, 4)
+        Each surface's pose per frame, neutral → frame (mm).
+
+    Returns
+    -------
+    ndarray, shape (n_frames,)
+        The gap, mm: 0 where the surfaces touch; NaN where a pose is not finite.
     """
     import igl
 
@@ -77,13 +126,44 @@ def surface_gap_mm(
 
 
 def sl_gap_mm(model: Model, poses: np.ndarray) -> np.ndarray:
-    """Scapholunate gap (mm) per frame of a Result's poses (n_frames, n_bodies, 4, 4): bone surface to bone surface."""
+    """Scapholunate gap (mm) per frame of a Result's poses: bone surface to bone surface.
+
+    Parameters
+    ----------
+    model : Model
+        The participant's model (its scaphoid and lunate meshes).
+    poses : ndarray, shape (n_frames, n_bodies, 4, 4)
+        The bodies' poses per frame (a `Result`'s ``poses``; mm).
+
+    Returns
+    -------
+    ndarray, shape (n_frames,)
+        The gap per frame, mm (`surface_gap_mm`).
+    """
     s, l = BONES.index("scaphoid"), BONES.index("lunate")
     return surface_gap_mm(model.part_mesh("scaphoid"), model.part_mesh("lunate"), poses[:, s], poses[:, l])
 
 
 def with_tears(d: design_mod.Design, names: Iterable[str]) -> design_mod.Design:
-    """A copy of the design with the named injurable ligaments torn (injury scalar −1)."""
+    """A copy of the design with the named injurable ligaments torn (injury scalar −1).
+
+    Parameters
+    ----------
+    d : Design
+        The design; not changed.
+    names : iterable of str
+        Names of injurable ligaments (`design.INJURABLE`).
+
+    Returns
+    -------
+    Design
+        `d` with those ligaments' injury scalars set to −1.
+
+    Raises
+    ------
+    ValueError
+        A name that is not an injurable ligament.
+    """
     injury = np.array(d.injury, dtype=np.float64)
     for n in names:
         injury[design_mod.INJURABLE.index(n)] = -1.0
@@ -91,7 +171,27 @@ def with_tears(d: design_mod.Design, names: Iterable[str]) -> design_mod.Design:
 
 
 def at_angle(angle_deg: ArrayLike, values: ArrayLike, target_deg: float) -> float:
-    """`values` at the capitate angle `target_deg`, linear between the sweep's frames (NaN outside)."""
+    """`values` at the capitate angle `target_deg`, linear between the sweep's frames (NaN outside).
+
+    Parameters
+    ----------
+    angle_deg : array_like, shape (n_frames,)
+        The capitate's angle per frame of the sweep, deg (any order).
+    values : array_like, shape (n_frames,)
+        A measure per frame, any unit.
+    target_deg : float
+        The angle to read the measure at, deg.
+
+    Returns
+    -------
+    float
+        The measure at `target_deg`, linearly interpolated; NaN outside the sweep's angles.
+
+    Examples
+    --------
+    >>> at_angle([-10.0, 0.0, 10.0], [1.0, 2.0, 4.0], 5.0)
+    3.0
+    """
     a, v = np.asarray(angle_deg, dtype=np.float64), np.asarray(values, dtype=np.float64)
     order = np.argsort(a)
     a, v = a[order], v[order]
@@ -101,8 +201,24 @@ def at_angle(angle_deg: ArrayLike, values: ArrayLike, target_deg: float) -> floa
 
 
 def load_shares_pct(model: Model, result) -> dict[str, float]:
-    """Load shares (%) at a run's first frame: each midcarpal articulation's (`model.MIDCARPAL`) of their
-    sum, and "ulnocarpal": the ulnar path's of radiocarpal + ulnocarpal (NaN for a failed run)."""
+    """Load shares (%) at a run's first frame.
+
+    Each midcarpal articulation's share (`model.MIDCARPAL`) of their sum, and "ulnocarpal": the ulnar path's
+    of radiocarpal + ulnocarpal.
+
+    Parameters
+    ----------
+    model : Model
+        The participant's model.
+    result : Result
+        A simulation's result (`solver.simulate`).
+
+    Returns
+    -------
+    dict of str to float
+        ``{articulation: share, %}`` for each of `model.MIDCARPAL` and "ulnocarpal"; NaN for a failed run
+        (or where the forces summed over are 0).
+    """
     if not result.ok:
         return {name: math.nan for name in (*MIDCARPAL, "ulnocarpal")}
     f = articulation_forces(model, result.poses[0])

@@ -13,7 +13,25 @@ from wrist_env.validation.bands import HAUG_2021_GAP_MM, RAINBOW_LUNATE, RAINBOW
 
 @dataclass(frozen=True)
 class Check:
-    """One row: a model output against a published band (low <= value <= high passes; inf: unbounded)."""
+    """One row: a model output against a published band (low <= value <= high passes; inf: unbounded).
+
+    Parameters
+    ----------
+    id : str
+        The check's id (`CheckSpec.id`).
+    description : str
+        What the value is, filled in from the runs.
+    value : float
+        The model's output, in `unit`; NaN when its runs failed.
+    band : tuple of (float, float)
+        (low, high), in `unit`; inf: unbounded.
+    unit : str
+        The unit of value and band ("deg", "mm", "%", ...).
+    source : str
+        The publication the band comes from.
+    passed : bool
+        Whether low <= value <= high.
+    """
 
     id: str
     description: str
@@ -37,7 +55,27 @@ class Check:
 
 @dataclass(frozen=True)
 class Report:
-    """The checks of one participant, the series behind them (for the figure) and the wall time."""
+    """The checks of one participant, the series behind them (for the figure) and the wall time.
+
+    Parameters
+    ----------
+    participant : str
+        The participant's (model's) name.
+    rows : tuple of Check, length n_checks
+        The checks, in the chain's order.
+    series : dict
+        The per-frame series behind the checks and the figure (`Simulations.series`: arrays of shape
+        (n_frames,) or (n_frames, k), and each run's status).
+    wall_seconds : float, default NaN
+        Wall time of the validation, s.
+    conditions : dict, default {}
+        The anatomy variant (build parameters) and the compressive load (N) of the runs.
+
+    Attributes
+    ----------
+    passed : bool
+        Whether every check passed.
+    """
 
     participant: str
     rows: tuple[Check, ...]
@@ -85,7 +123,19 @@ def band_text(low: float, high: float) -> str:
 
 
 def format_table(report: Report) -> str:
-    """The checks as a plain-text table: check, value, band, unit, pass/FAIL, source."""
+    """The checks as a plain-text table: check, value, band, unit, pass/FAIL, source.
+
+    Parameters
+    ----------
+    report : Report
+        A validation's report (`validate`).
+
+    Returns
+    -------
+    str
+        The table, a line per check under a title line naming the participant and the conditions, then
+        the notes of checks not measured.
+    """
     c = report.conditions
     lines = [
         f"{report.participant}, population design: the model against published measurements"

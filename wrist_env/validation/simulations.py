@@ -37,13 +37,25 @@ RUNS = {"sweep": ("intact",), "torn sweep": ("intact", "torn"), "jig": ("neutral
 class Simulations:
     """The population design's three runs and the measures several checks or the figure share.
 
-    intact, torn: the idealized flexion–extension sweep, intact and with all three SLIL bundles torn (one
-        batched call); neutral: the capitate held at neutral under `NEUTRAL_LOAD_N`, loaded as
-        `neutral_load` (the jig by default).
-    flexion_deg (n_frames, 3): capitate, scaphoid and lunate flexion (+) over the intact sweep (Cardan,
-        about the RCS z axis); sl_gap_intact_mm, sl_gap_torn_mm (n_frames,): the scapholunate gap, bone
-        surface to bone surface; slil_force_n (n_frames,): SLIL_v + SLIL_p + SLIL_d tension, intact;
-        shares_pct: `measures.load_shares_pct` of the neutral run.
+    Parameters
+    ----------
+    model : Model
+        The participant's model.
+    intact, torn : Result
+        The idealized flexion–extension sweep, intact and with all three SLIL bundles torn (one batched
+        call).
+    neutral : Result
+        The capitate held at neutral under `NEUTRAL_LOAD_N` N, loaded as `neutral_load`.
+    neutral_load : str
+        How the neutral run was loaded (`settings.LOAD_DIRECTIONS`; the jig by default).
+    flexion_deg : ndarray, shape (n_frames, 3)
+        Capitate, scaphoid and lunate flexion (+) over the intact sweep (Cardan, about the RCS z axis), deg.
+    sl_gap_intact_mm, sl_gap_torn_mm : ndarray, shape (n_frames,)
+        The scapholunate gap, bone surface to bone surface, mm.
+    slil_force_n : ndarray, shape (n_frames,)
+        SLIL_v + SLIL_p + SLIL_d tension, intact, N.
+    shares_pct : dict of str to float
+        `measures.load_shares_pct` of the neutral run, %.
     """
 
     model: Model
@@ -103,9 +115,34 @@ def run_simulations(
     neutral_load: str,
     settings=None,
 ) -> Simulations:
-    """Simulate `intact_design` on `model` three times: the idealized sweep (`n_frames`, `load_n` N along
-    `load_direction`) intact and SLIL-torn in one batch, and the neutral pose under `NEUTRAL_LOAD_N` N
-    loaded as `neutral_load`; then measure what the checks share."""
+    """Simulate a design three times for the checks, then measure what the checks share.
+
+    The idealized sweep intact and SLIL-torn in one batch, and the neutral pose under `NEUTRAL_LOAD_N` N
+    loaded as `neutral_load`.
+
+    Parameters
+    ----------
+    model : Model
+        The participant's model.
+    intact_design : Design
+        The design simulated (the population design in `validate`); the torn run tears its three SLIL
+        bundles.
+    n_frames : int
+        Frames of the idealized sweep.
+    load_n : float
+        The sweeps' compressive load, N.
+    load_direction : str
+        The sweeps' load direction (`settings.LOAD_DIRECTIONS`).
+    neutral_load : str
+        The load at neutral (`settings.LOAD_DIRECTIONS`; `settings.JIG` for the jig).
+    settings : SolverSettings, optional
+        The solver's settings (default: its defaults).
+
+    Returns
+    -------
+    Simulations
+        The three runs and the shared measures.
+    """
     torn_design = with_tears(intact_design, SLIL)
     sweep = drivers.idealized(model, n_frames=n_frames, load_n=load_n, direction=load_direction)
     intact, torn = sim.simulate_batch(model, [intact_design, torn_design], sweep, settings)

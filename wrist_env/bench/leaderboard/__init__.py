@@ -62,10 +62,34 @@ __all__ = ["TARGETS", "Leaderboard", "Reference", "build", "load_runs", "referen
 def write_leaderboard(
     runs: str | Path, out: str | Path, *, references: dict[str, Reference] | None = None, title: str | None = None
 ) -> Path:
-    """Write the leaderboards of the run log in `runs` into the folder `out`; returns out/README.md.
+    """Write the leaderboards of the run log in `runs` into the folder `out`.
 
-    references: {problem (the participant for instance 0): `Reference`} already simulated (the others are
-    simulated here)."""
+    The CSV tables (`board.CSV_FILES`), the convergence, ECDF and (when the ranking is tested) ranking
+    figures, and a README that shows them.
+
+    Parameters
+    ----------
+    runs : str or Path
+        The run log's folder (`RunLog`).
+    out : str or Path
+        The folder written to (made if missing).
+    references : dict of str to Reference, optional
+        ``{problem (the participant for instance 0): Reference}`` already simulated (the others are
+        simulated here).
+    title : str, optional
+        The README's title.
+
+    Returns
+    -------
+    Path
+        ``out/README.md``.
+
+    Raises
+    ------
+    StoreError
+        The run log has no finished cell, a damaged file, or a cell made on another model or trials than
+        today's.
+    """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     board = build(runs, references)

@@ -33,10 +33,62 @@ from wrist_env.runs import provenance
 
 @dataclass(frozen=True)
 class Leaderboard:
-    """Everything a leaderboard shows, computed once from a run log (`build`). Per problem (a participant's
-    instance): targets, ecdf_targets, best, recovery, heldout, table3, table4 (columns participant, instance,
-    problem); per participant, pooled over its instances: best_pooled, ert, recovery_pooled; over all
-    problems: ranking."""
+    """Everything a leaderboard shows, computed once from a run log (`build`).
+
+    Per problem (a participant's instance): targets, ecdf_targets, best, recovery, heldout, table3, table4
+    (columns participant, instance, problem); per participant, pooled over its instances: best_pooled, ert,
+    recovery_pooled; over all problems: ranking. `CSV_FILES` names the file each table is written to. Costs
+    are the kinematic cost (dimensionless); RMSEs are mm and deg.
+
+    Parameters
+    ----------
+    runs : str
+        The run log's folder.
+    summaries : list of dict, length n_runs
+        The finished cells' summaries (`bench.schema.SUMMARY_KEYS`), "participant" the problem's name.
+    unfinished : int
+        Cells of the log without a summary (left out).
+    participants : list of str, length n_problems
+        The problems: the participant, ``"<participant>.i<k>"`` for instance k ≥ 1.
+    subjects : list of str
+        The participants (the functions whose instances the problems are), in the problems' order.
+    labels : list of str
+        The calibrators' labels (the name, with its budget when the log has several budgets).
+    budgets : set of int
+        The budgets of the runs.
+    refs : dict of str to Reference
+        ``{problem: Reference}``: the population and hidden-truth designs scored.
+    curves : dict
+        ``{(participant, optimizer, seed, budget): best-so-far cost, shape (nfev,)}``.
+    targets : pandas.DataFrame
+        The cost targets (`TARGETS`) per problem.
+    ecdf_targets : pandas.DataFrame
+        The log-spaced cost targets of the ECDF per problem.
+    runs_frame : pandas.DataFrame
+        One row per run: its key, costs (`relative_cost`: over the hidden-truth cost), recovery, held-out
+        RMSE and evaluations to each target.
+    best : pandas.DataFrame
+        The best calibration cost at the budget per problem and calibrator.
+    ert : pandas.DataFrame
+        Expected running time (evaluations) to each target per participant and calibrator.
+    recovery : pandas.DataFrame
+        Parameter-recovery error (`recovery_z`, Table 2 SD units) per problem and calibrator.
+    heldout : pandas.DataFrame
+        The held-out trial's cost and RMSE per problem and calibrator.
+    chosen : dict of str to dict
+        Per problem, the summary of the run with the lowest calibration cost.
+    table3, table4 : pandas.DataFrame
+        RMSE per bone and DOF (mm, deg) of the chosen run, the population and the truth, on the calibration
+        trial (table3) and the held-out trial (table4).
+    improved : pandas.DataFrame
+        The DOFs the calibrated designs improve over the population design.
+    best_pooled : pandas.DataFrame
+        The best cost relative to the truth's per participant and calibrator, pooled over its instances.
+    recovery_pooled : pandas.DataFrame
+        The recovery error per participant and calibrator, pooled over its instances.
+    ranking : Ranking
+        The calibrators ranked over the problems (Friedman and Nemenyi when there are enough).
+    """
 
     runs: str
     summaries: list
@@ -64,10 +116,29 @@ class Leaderboard:
 
 
 def build(runs: str | Path, references: dict[str, Reference] | None = None) -> Leaderboard:
-    """The leaderboard of the finished cells of the run log in `runs`: tables per problem (`tables.by_problem`:
-    named by the participant for instance 0, "P1.i3" for instance 3), per participant pooled over its
-    instances, and the ranking over problems (`references`: {problem: `Reference`} already simulated; the
-    others are simulated here)."""
+    """The leaderboard of the finished cells of the run log in `runs`.
+
+    Tables per problem (`tables.by_problem`: named by the participant for instance 0, "P1.i3" for instance
+    3), per participant pooled over its instances, and the ranking over problems.
+
+    Parameters
+    ----------
+    runs : str or Path
+        The run log's folder.
+    references : dict of str to Reference, optional
+        ``{problem: Reference}`` already simulated; the others are simulated here.
+
+    Returns
+    -------
+    Leaderboard
+        Every table, curve and the ranking.
+
+    Raises
+    ------
+    StoreError
+        No finished benchmark cell in the run log, a damaged file, or a cell made on another model or
+        trials than today's.
+    """
     evals, summaries, unfinished = load_runs(runs)
     if not summaries:
         raise StoreError(f"{runs}: no finished benchmark cell in this run log")

@@ -15,8 +15,22 @@ from wrist_env.task import task
 
 @dataclass
 class Reference:
-    """A problem's population (and, if built in, hidden-truth) design scored on both trials: a participant's
-    instance (0: the shipped truth and trials)."""
+    """A problem's population (and, if built in, hidden-truth) design scored on both trials.
+
+    A problem is a participant's instance (0: the shipped truth and trials).
+
+    Parameters
+    ----------
+    participant : str
+        The participant's name.
+    population : dict
+        ``{"calibrate": score, "validate": score}`` of the population design; score = ``{"cost", "failed",
+        "rmse"}`` (rmse: ``{bone: {DOF: mm or deg}}``).
+    truth : dict or None
+        The same for the hidden truth; None for a participant without one.
+    instance : int, default 0
+        The problem instance.
+    """
 
     participant: str
     population: dict  # {"calibrate": score, "validate": score}; score = {"cost", "failed", "rmse"}
@@ -29,8 +43,25 @@ def _score(evaluation) -> dict:
 
 
 def reference(participant: str, instance: int = 0) -> Reference:
-    """Simulate the population design (and the instance's hidden truth) on the instance's calibration and
-    held-out trials."""
+    """Simulate the population design (and the instance's hidden truth) on the calibration and held-out trials.
+
+    Parameters
+    ----------
+    participant : str
+        A registered participant's name.
+    instance : int, default 0
+        The problem instance (`participants.instances`; 0: the shipped truth and trials).
+
+    Returns
+    -------
+    Reference
+        The designs' scores (cost, failed, RMSE in mm and deg) on both of the instance's trials.
+
+    Raises
+    ------
+    ParticipantError
+        An unknown participant, or an instance k ≥ 1 of a folder participant.
+    """
 
     tasks = {m: task(participant, m, instance=instance) for m in TRIAL_MOTIONS}
     designs = {"population": design.population()}

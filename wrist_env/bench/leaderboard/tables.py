@@ -65,7 +65,27 @@ def problem_columns(problem: str) -> dict:
 
 
 def load_runs(runs: str | Path) -> tuple[pd.DataFrame, list[dict], int]:
-    """(evaluations of finished cells, their summaries, number of unfinished cells) of a run log."""
+    """Read the evaluations of a run log's finished cells, their summaries and the count of unfinished cells.
+
+    Parameters
+    ----------
+    runs : str or Path
+        The run log's folder.
+
+    Returns
+    -------
+    evals : pandas.DataFrame
+        The finished cells' evaluations, one row each (the columns of `bench.schema.SCHEMA`).
+    summaries : list of dict
+        The finished cells' summaries.
+    unfinished : int
+        The number of cells with evaluations but no summary.
+
+    Raises
+    ------
+    StoreError
+        A damaged file in the log (the message names it).
+    """
     log = RunLog(runs)
     evals = log.read()
     summaries = log.summaries()
