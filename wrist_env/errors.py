@@ -13,6 +13,8 @@ __all__ = [
     "DesignError",
     "BuildError",
     "StoreError",
+    "DuplicateEvaluationError",
+    "IncompleteCellError",
     "UsageError",
     "Interrupted",
 ]
@@ -48,6 +50,14 @@ class BuildError(WristEnvError, RuntimeError):
 
 class StoreError(InputError):
     """A saved file (a cached model, a run log) that is damaged, tampered with or not what it claims."""
+
+
+class DuplicateEvaluationError(WristEnvError, RuntimeError):
+    """An evaluation already in a benchmark's run log, logged again (`bench.RunLog.append` logs each once)."""
+
+
+class IncompleteCellError(StoreError):
+    """A benchmark cell whose summary says it finished, but whose evaluations are not all in the run log."""
 
 
 class UsageError(InputError):

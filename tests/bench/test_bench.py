@@ -234,7 +234,7 @@ def test_a_participant_changed_since_its_cells_ran_runs_them_again(p1, finished,
 
 
 def test_a_finished_cell_without_its_evaluations_is_an_error_then_rerun(p1, finished, tmp_path):
-    from wrist_env.bench.log import IncompleteCellError
+    from wrist_env.errors import IncompleteCellError
 
     runs = _copy_runs(finished, tmp_path)
     evals = sorted((runs / "evals").glob("cell-*seed0*.parquet"))

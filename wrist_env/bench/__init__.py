@@ -9,9 +9,10 @@ from typing import Any
 
 from wrist_env.bench.calibrate import CalibrationRun, ResumeError, calibrate
 from wrist_env.bench.cells import SEED_IS_INSTANCE, make_cells
-from wrist_env.bench.log import DuplicateEvaluationError, RunLog
+from wrist_env.bench.log import RunLog
 from wrist_env.bench.runner import BenchmarkReport, benchmark
 from wrist_env.bench.schema import RunKey
+from wrist_env.errors import DuplicateEvaluationError
 
 
 def write_leaderboard(runs: str | Path, out: str | Path, **kwargs: Any) -> Path:

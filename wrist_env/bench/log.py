@@ -52,7 +52,7 @@ from wrist_env.bench.schema import (
     summary_instance,
     with_instance,
 )
-from wrist_env.errors import StoreError, WristEnvError
+from wrist_env.errors import DuplicateEvaluationError, IncompleteCellError, StoreError
 from wrist_env.io import read_json
 from wrist_env.runs import provenance
 from wrist_env.runs.store import RunStore, read_parquet, remove_file, write_parquet
@@ -71,14 +71,6 @@ def _match(name: str) -> re.Match | None:
 def _span(m: re.Match) -> tuple[int, int]:
     """(first, end) evaluation of a batch or compacted cell file, from its name's match."""
     return (int(m["start"]), int(m["end"])) if "start" in m.groupdict() else (0, int(m["n"]))
-
-
-class DuplicateEvaluationError(WristEnvError, RuntimeError):
-    """An attempt to log an evaluation that is already in the log (`RunLog.append`: never twice)."""
-
-
-class IncompleteCellError(StoreError):
-    """A cell whose summary says it finished, but whose evaluations are not all in the log."""
 
 
 class RunLog:
