@@ -49,32 +49,20 @@ def _force_pass(n, state, work, system, design_arrays, load):
 
 @njit(cache=True, error_model="numpy")
 def _contact(n, state, work, system):
-    bod, grids, law, _, _, st = system
     for _ in range(n):
-        contact_forces(
-            state.R, state.x, bod.com0, grids, law, st.active_band_mm, work.active, work.n_active, work.ref,
-            work.F, work.T, work.stats, np.bool_(False), True,
-        )  # fmt: skip
+        contact_forces(state, system, work, system.settings.active_band_mm, np.bool_(False), True)
 
 
 @njit(cache=True, error_model="numpy")
 def _fibres(n, state, work, system, d):
-    bod, _, _, fib, _, st = system
     for _ in range(n):
-        fibre_forces(
-            state.R, state.x, state.v, state.w, bod.com0, fib, d.f_l0, d.f_K, st.fibre_damping_s, work.F, work.T,
-            work.bundle, np.bool_(False),
-        )  # fmt: skip
+        fibre_forces(state, system, d, work, np.bool_(False))
 
 
 @njit(cache=True, error_model="numpy")
 def _membrane(n, state, work, system, d):
-    bod, _, _, _, mem, st = system
     for _ in range(n):
-        membrane_forces(
-            state.R, state.x, bod.com0, mem, state.nodes, d.m_l0, d.m_K, st.membrane_contact_stiffness, work.F,
-            work.T, work.node_force, np.bool_(False), True,
-        )  # fmt: skip
+        membrane_forces(state, system, d, work, np.bool_(False), True)
 
 
 @njit(cache=True, error_model="numpy")
@@ -86,9 +74,8 @@ def _rebuild(n, state, work, system, d, m):
 
 @njit(cache=True, error_model="numpy")
 def _substeps(n, state, system, d, scratch):
-    bod, _, _, _, mem, st = system
     for _ in range(n):
-        substep(state.R, state.x, bod.com0, mem, state.nodes, state.nv, d.m_l0, d.m_K, d.node_mass, st, scratch, True)
+        substep(state, system, d, scratch, True)
 
 
 @njit(cache=True, error_model="numpy")

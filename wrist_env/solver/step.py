@@ -34,23 +34,19 @@ def net_forces(state, work, system, stiffness, load, rebuild, want_energy, smoot
     (`State`) of `system` (`arrays.System`) under a design's `stiffness` and the driver's `load`; with
     `rebuild`, every pair's active contact samples are refilled first (otherwise a pair refills when
     its samples may have moved half the band); returns internal energy (N·mm; 0 unless `want_energy`)."""
-    bod, grids, law, fib, mem, st = system
-    R, x, v, w, nodes, _ = state
-    active, n_active, ref, F, T, node_force, stats, bundle = work
-    f_l0, f_K, m_l0, m_K, _ = stiffness
-    com0 = bod.com0
+    R, x, nodes = state.R, state.x, state.nodes
+    F, T, bundle = work.F, work.T, work.bundle
+    com0 = system.bodies.com0
     if rebuild:
-        ref[:] = np.nan
-    place_nodes(R, x, com0, mem, nodes)
+        work.ref[:] = np.nan
+    place_nodes(R, x, com0, system.membrane, nodes)
     F[:] = 0.0
     T[:] = 0.0
     bundle[:] = 0.0
-    band = st.active_band_mm
-    energy = contact_forces(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, want_energy, smooth)
-    energy += fibre_forces(R, x, v, w, com0, fib, f_l0, f_K, st.fibre_damping_s, F, T, bundle, want_energy)
-    energy += joint_forces(R, x, com0, bod, F, T, want_energy)
-    k_mem = st.membrane_contact_stiffness
-    e_mem, rsc = membrane_forces(R, x, com0, mem, nodes, m_l0, m_K, k_mem, F, T, node_force, want_energy, smooth)
+    energy = contact_forces(state, system, work, system.settings.active_band_mm, want_energy, smooth)
+    energy += fibre_forces(state, system, stiffness, work, want_energy)
+    energy += joint_forces(state, system.bodies, work, want_energy)
+    e_mem, rsc = membrane_forces(state, system, stiffness, work, want_energy, smooth)
     energy += e_mem
     bundle[RSC] += rsc
     tension = load.tension
@@ -58,8 +54,8 @@ def net_forces(state, work, system, stiffness, load, rebuild, want_energy, smoot
         if tension[i] != 0.0:
             b = load.body[i]
             p, u = load.point[i], load.direction[i]
-            px, py, pz = to_world(R, x, com0, b, p[0], p[1], p[2])
-            apply_force(F, T, x, b, tension[i] * u[0], tension[i] * u[1], tension[i] * u[2], px, py, pz)
+            at = to_world(R, x, com0, b, p[0], p[1], p[2])
+            apply_force(F, T, x, b, (tension[i] * u[0], tension[i] * u[1], tension[i] * u[2]), at)
     return energy
 
 
@@ -104,20 +100,7 @@ def explicit_step(
         if preconditioned:
             if st.membrane_substeps > 0:
                 place_nodes(R, x, bod.com0, mem, nodes)
-                substep(
-                    R,
-                    x,
-                    bod.com0,
-                    mem,
-                    nodes,
-                    nv,
-                    stiffness.m_l0,
-                    stiffness.m_K,
-                    stiffness.node_mass,
-                    st,
-                    scratch,
-                    smooth,
-                )
+                substep(state, system, stiffness, scratch, smooth)
     if step_index % 100 == 0:
         for b in FREE:
             orthonormalize(R[b])
