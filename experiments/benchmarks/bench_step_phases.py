@@ -80,12 +80,12 @@ def _substeps(n, state, system, d, scratch):
 
 @njit(cache=True, error_model="numpy")
 def _update(n, state, work, system, m, blocks):
-    R, x, v, w = state.R.copy(), state.x.copy(), state.v.copy(), state.w.copy()
+    moved = step.State(state.R.copy(), state.x.copy(), state.v.copy(), state.w.copy(), state.nodes, state.nv)
     for _ in range(n):
         if blocks:
-            move_blocks(R, x, v, w, work.F, work.T, system.settings, m)
+            move_blocks(moved, work, system.settings, m)
         else:
-            move_diagonal(R, x, v, w, work.F, work.T, system.bodies, system.settings)
+            move_diagonal(moved, work, system.bodies, system.settings)
 
 
 def median_us(fn, n: int) -> float:

@@ -104,7 +104,7 @@ def test_the_secant_predictor_continues_a_screw_path_exactly():
         R, x = _rigid_path(1.0)
         nodes = nodes0 + np.array([0.1, 0.2, 0.3])
         v, w, nv = np.ones((N_BODIES, 3)), np.ones((N_BODIES, 3)), np.ones((4, 3))
-        assert predict(h, R, x, v, w, nodes, nv, _Membrane, st, move)
+        assert predict(h, State(R, x, v, w, nodes, nv), _Membrane, st, move)
         R_expect, x_expect = _rigid_path(t_next)
         for b in FREE:
             np.testing.assert_allclose(R[b], R_expect[b], atol=1e-12)
@@ -121,12 +121,12 @@ def test_the_predictor_needs_two_equilibria_and_a_moving_capitate():
     st = _LOADED
     h = history(N_BODIES, np.zeros((4, 3)))
     R, x = _rigid_path(0.0)
-    args = (np.zeros((N_BODIES, 3)), np.zeros((N_BODIES, 3)), np.zeros((4, 3)), np.zeros((4, 3)), _Membrane, st, 1.0)
-    assert not predict(h, R, x, *args)
+    state = State(R, x, np.zeros((N_BODIES, 3)), np.zeros((N_BODIES, 3)), np.zeros((4, 3)), np.zeros((4, 3)))
+    assert not predict(h, state, _Membrane, st, 1.0)
     record(h, R, x, np.zeros((4, 3)), 1.0)
-    assert not predict(h, R, x, *args)
+    assert not predict(h, state, _Membrane, st, 1.0)
     record(h, R, x, np.zeros((4, 3)), 0.0)  # the last stage held the capitate still: no direction
-    assert not predict(h, R, x, *args)
+    assert not predict(h, state, _Membrane, st, 1.0)
     assert np.isclose(capitate_move(np.array([0.0, 0.1, 0.0]), np.array([3.0, 4.0, 0.0])), 1.0 + 5.0)
 
 

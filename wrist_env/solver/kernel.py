@@ -288,7 +288,7 @@ def _record(f, state, work, system, stiffness, load, m, out, taken, settled, smo
     """Fill frame f of `out` at the state reached (the last step's forces were those before it, so they
     are evaluated again here under the stage's end `load`); `taken` steps since the previous frame."""
     bod, st = system.bodies, system.settings
-    R, x, v, w, nodes, nv = state
+    R, x, nodes = state.R, state.x, state.nodes
     F, T, stats = work.F, work.T, work.stats
     com0 = bod.com0
     energy = net_forces(state, work, system, stiffness, load, np.bool_(False), np.bool_(True), smooth)
@@ -310,7 +310,7 @@ def _record(f, state, work, system, stiffness, load, m, out, taken, settled, smo
         contact[f, p, R_AREA] = area
         contact[f, p, R_FORCE] = stats[p, C_FORCE]
     copy_into(out.bundle[f], work.bundle)
-    out.energy[f, 0] = kinetic_energy(R, v, w, nv, bod, st, stiffness.node_mass, m, preconditioned)
+    out.energy[f, 0] = kinetic_energy(state, bod, st, stiffness.node_mass, m, preconditioned)
     out.energy[f, 1] = energy
     out.residual[f, 0] = 0.0
     out.residual[f, 1] = 0.0

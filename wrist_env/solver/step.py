@@ -84,13 +84,13 @@ def explicit_step(
             tangent(R, x, nodes, system, stiffness, active, n_active, m, smooth)
             block_mass(R, bod, st, m)
     if st.fire_alpha0 > 0.0:
-        fire_step(v, w, nv, F, T, node_force, mem, st, fire, m, preconditioned)
+        fire_step(state, work, st, fire, m, preconditioned)
     dt = st.dt
     lin = 1.0 / (1.0 + st.damping * dt)
     if blocks:
-        move_blocks(R, x, v, w, F, T, st, m)
+        move_blocks(state, work, st, m)
     else:
-        move_diagonal(R, x, v, w, F, T, bod, st)
+        move_diagonal(state, work, bod, st)
     if stiffness.node_mass > 0.0:
         for i in range(nodes.shape[0]):
             if mem.bone[i] < 0:
@@ -114,14 +114,14 @@ def predicted_start(state, work, system, stiffness, hist, capR, capx, load, move
     the prediction), False if not (the positions are restored; the velocities, ~0 at the end of a
     hold, stay zeroed)."""
     mem, st = system.membrane, system.settings
-    R, x, v, w, nodes, nv = state
+    R, x, nodes = state.R, state.x, state.nodes
     keep_R, keep_x, keep_nodes = R.copy(), x.copy(), nodes.copy()
     copy_into(R[CAPITATE], capR)
     if st.driver == EXPERIMENTAL:
         copy_into(x[CAPITATE], capx)
     net_forces(state, work, system, stiffness, load, np.bool_(False), np.bool_(False), smooth)
     before = residual(work.F, work.T, st)
-    if not predict(hist, R, x, v, w, nodes, nv, mem, st, move):
+    if not predict(hist, state, mem, st, move):
         restore(R, x, nodes, keep_R, keep_x, keep_nodes)
         return False
     net_forces(state, work, system, stiffness, load, np.bool_(False), np.bool_(False), smooth)
