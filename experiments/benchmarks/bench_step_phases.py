@@ -68,7 +68,7 @@ def _membrane(n, state, work, system, d):
 @njit(cache=True, error_model="numpy")
 def _rebuild(n, state, work, system, d, m):
     for _ in range(n):
-        tangent(state.R, state.x, state.nodes, system, d, work.active, work.n_active, m, True)
+        tangent(state, system, d, work, m, True)
         block_mass(state.R, system.bodies, system.settings, m)
 
 

@@ -40,7 +40,7 @@ def part_signatures(settings: SolverSettings) -> list[tuple[object, tuple]]:
         return tuple(a if isinstance(a, types.Type) else typeof(a) for a in args)
 
     return [
-        (tangent.tangent, typed(R, x, nodes, p.system, design, work.active, work.n_active, m, smooth)),
+        (tangent.tangent, typed(state, p.system, design, work, m, smooth)),
         (membrane.substep, typed(state, p.system, design, membrane.new_scratch(nodes), smooth)),
         (preconditioner.block_mass, typed(R, p.bodies, p.settings, m)),
     ]  # fmt: skip

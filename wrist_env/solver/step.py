@@ -81,7 +81,7 @@ def explicit_step(
     if preconditioned:  # a compile-time constant: see `_run`
         blocks = st.block_mass
         if blocks and refresh:
-            tangent(R, x, nodes, system, stiffness, active, n_active, m, smooth)
+            tangent(state, system, stiffness, work, m, smooth)
             block_mass(R, bod, st, m)
     if st.fire_alpha0 > 0.0:
         fire_step(state, work, st, fire, m, preconditioned)
