@@ -49,56 +49,43 @@ def _force_pass(n, state, work, system, design_arrays, load):
 
 @njit(cache=True, error_model="numpy")
 def _contact(n, state, work, system):
-    bod, grids, law, _, _, st = system
     for _ in range(n):
-        contact_forces(
-            state.R, state.x, bod.com0, grids, law, st.active_band_mm, work.active, work.n_active, work.ref,
-            work.F, work.T, work.stats, np.bool_(False), True,
-        )  # fmt: skip
+        contact_forces(state, system, work, system.settings.active_band_mm, np.bool_(False), True)
 
 
 @njit(cache=True, error_model="numpy")
 def _fibres(n, state, work, system, d):
-    bod, _, _, fib, _, st = system
     for _ in range(n):
-        fibre_forces(
-            state.R, state.x, state.v, state.w, bod.com0, fib, d.f_l0, d.f_K, st.fibre_damping_s, work.F, work.T,
-            work.bundle, np.bool_(False),
-        )  # fmt: skip
+        fibre_forces(state, system, d, work, np.bool_(False))
 
 
 @njit(cache=True, error_model="numpy")
 def _membrane(n, state, work, system, d):
-    bod, _, _, _, mem, st = system
     for _ in range(n):
-        membrane_forces(
-            state.R, state.x, bod.com0, mem, state.nodes, d.m_l0, d.m_K, st.membrane_contact_stiffness, work.F,
-            work.T, work.node_force, np.bool_(False), True,
-        )  # fmt: skip
+        membrane_forces(state, system, d, work, np.bool_(False), True)
 
 
 @njit(cache=True, error_model="numpy")
 def _rebuild(n, state, work, system, d, m):
     for _ in range(n):
-        tangent(state.R, state.x, state.nodes, system, d, work.active, work.n_active, m, True)
+        tangent(state, system, d, work, m, True)
         block_mass(state.R, system.bodies, system.settings, m)
 
 
 @njit(cache=True, error_model="numpy")
 def _substeps(n, state, system, d, scratch):
-    bod, _, _, _, mem, st = system
     for _ in range(n):
-        substep(state.R, state.x, bod.com0, mem, state.nodes, state.nv, d.m_l0, d.m_K, d.node_mass, st, scratch, True)
+        substep(state, system, d, scratch, True)
 
 
 @njit(cache=True, error_model="numpy")
 def _update(n, state, work, system, m, blocks):
-    R, x, v, w = state.R.copy(), state.x.copy(), state.v.copy(), state.w.copy()
+    moved = step.State(state.R.copy(), state.x.copy(), state.v.copy(), state.w.copy(), state.nodes, state.nv)
     for _ in range(n):
         if blocks:
-            move_blocks(R, x, v, w, work.F, work.T, system.settings, m)
+            move_blocks(moved, work, system.settings, m)
         else:
-            move_diagonal(R, x, v, w, work.F, work.T, system.bodies, system.settings)
+            move_diagonal(moved, work, system.bodies, system.settings)
 
 
 def median_us(fn, n: int) -> float:

@@ -84,7 +84,8 @@ def response(t: Task, d: design.Design, result) -> np.ndarray:
     D, out, h, eps = np.zeros((t.driver.n_frames, 12, 6)), np.zeros(n), 1e-6, 1e-3
     for f in range(t.driver.n_frames):
         args = equilibrium._frame_args(p, k_design, free, t.driver, result, f)
-        R0, x0, nodes0 = args[:3]
+        start = args[0]
+        R0, x0 = start.R, start.x
         K = equilibrium._jacobian(np.zeros(n), *args, equilibrium.JACOBIAN_STEP)
         T = result.poses[f, cap]
         centroid = T[:3, :3] @ t.model.centroid[cap] + T[:3, 3]
@@ -92,10 +93,12 @@ def response(t: Task, d: design.Design, result) -> np.ndarray:
         for k in range(6):
             for sign in (1.0, -1.0):
                 R, x = moved(R0, x0, centroid, sign * h * np.eye(6)[k])
-                dF[:, k] += sign * equilibrium._residual(np.zeros(n), R, x, *args[2:], out) / (2 * h)
+                dF[:, k] += (
+                    sign * equilibrium._residual(np.zeros(n), start._replace(R=R, x=x), *args[1:], out) / (2 * h)
+                )
         dq = -np.linalg.lstsq(K, dF * AXIS_SD, rcond=1e-10)[0]
         for k in range(6):
-            R, x, _ = equilibrium.moved_state(eps * dq[:, k], R0, x0, nodes0, free, False)
+            R, x, _ = equilibrium.moved_state(eps * dq[:, k], start, False)
             poses = result.poses.copy()
             poses[f, :, :3, :3] = R
             poses[f, :, :3, 3] = pose_translation(R, x, p.bodies.com0)

@@ -133,8 +133,10 @@ def test_the_capitohamate_joint_resists_a_shift_and_a_turn_in_its_plane_by_ritts
     shift = 0.5 * axes[0] + 0.3 * axes[1] + 0.2 * axes[2]
     # the hamate's centre point (its neutral place of the joint's centre) at centre + shift
     x[HAMATE] = centre + shift - R[HAMATE] @ (centre - bod.com0[HAMATE])
-    F, T = np.zeros((len(BONES), 3)), np.zeros((len(BONES), 3))
-    energy = joint_forces(R, x, bod.com0, bod, F, T, True)
+    state = step.State(R, x, np.zeros_like(x), np.zeros_like(x), np.zeros((0, 3)), np.zeros((0, 3)))
+    work = step.new_work(p.grids, np.zeros((0, 3)))
+    energy = joint_forces(state, bod, work, True)
+    F, T = work.F, work.T
     k = CH_JOINT_STIFFNESS
     force = -(k[0] * 0.5 * axes[0] + k[1] * 0.3 * axes[1])
     np.testing.assert_allclose(F[HAMATE], force, atol=1e-9)

@@ -13,6 +13,7 @@ from wrist_env.solver.membrane import _gaps, _substep_forces, membrane_forces, n
 from wrist_env.solver.predictor import MAX_RATIO, capitate_move, history, predict, record
 from wrist_env.solver.settings import SolverSettings
 from wrist_env.solver.simulate import prepare, simulate, stiffness
+from wrist_env.solver.step import State, new_work
 
 PRECONDITIONED = SolverSettings()
 
@@ -31,28 +32,19 @@ def _shaken_neutral(model, shake_mm, seed):
     free = np.asarray(model.membrane_bone) < 0
     nodes[free] += np.random.default_rng(seed).uniform(-shake_mm, shake_mm, (free.sum(), 3))
     place_nodes(R, x, model.com, p.membrane, nodes)
-    k = PRECONDITIONED.membrane_contact_stiffness
 
     def exact():
-        force = np.zeros_like(nodes)
-        membrane_forces(
-            R,
-            x,
-            model.com,
-            p.membrane,
-            nodes,
-            s.m_l0,
-            s.m_K,
-            k,
-            np.zeros((N_BODIES, 3)),
-            np.zeros((N_BODIES, 3)),
-            force,
-            False,
-            True,
-        )
-        return force
+        work = new_work(p.grids, nodes)
+        membrane_forces(_state(R, x, nodes), p.system, s, work, False, True)
+        return work.node_force
 
     return R, x, nodes, free, p, s, exact
+
+
+def _state(R, x, nodes, nv=None):
+    """A `step.State` at rest at (R, x, nodes) (nv: the nodes' velocities, zeros unless given)."""
+    nv = np.zeros_like(nodes) if nv is None else nv
+    return State(R, x, np.zeros((N_BODIES, 3)), np.zeros((N_BODIES, 3)), nodes, nv)
 
 
 def test_a_substep_feels_the_force_kernels_membrane_forces(p1):
@@ -62,10 +54,9 @@ def test_a_substep_feels_the_force_kernels_membrane_forces(p1):
     balance (a node is looked up where gap − √3·travel < 0: here every travel is 0)."""
     R, x, nodes, free, p, s, exact = _shaken_neutral(p1, 0.3, 0)
     gap, travel = np.zeros(len(nodes)), np.zeros(len(nodes))
-    _gaps(R, x, p1.com, p.membrane, nodes, gap, travel)
+    _gaps(_state(R, x, nodes), p.system, gap, travel)
     force = np.zeros_like(nodes)
-    k = PRECONDITIONED.membrane_contact_stiffness
-    _substep_forces(R, x, p1.com, p.membrane, nodes, s.m_l0, s.m_K, k, gap, travel, force, True)
+    _substep_forces(_state(R, x, nodes), p.system, s, gap, travel, force, True)
     assert (gap < 0).sum() > 0 and np.abs(exact()[free]).max() > 0.1
     np.testing.assert_allclose(force[free], exact()[free], rtol=1e-12, atol=1e-12)
 
@@ -76,9 +67,9 @@ def test_substeps_relax_the_nodes_to_their_equilibrium(p1):
     1e-3 N from over 1 N): the damping takes the shake's energy out, it does not pump it."""
     R, x, nodes, free, p, s, exact = _shaken_neutral(p1, 0.2, 1)
     before = np.abs(exact()[free]).max()
-    nv, scratch = np.zeros_like(nodes), new_scratch(nodes)
+    state, scratch = _state(R, x, nodes), new_scratch(nodes)
     for _ in range(300):
-        substep(R, x, p1.com, p.membrane, nodes, nv, s.m_l0, s.m_K, s.node_mass, p.settings, scratch, True)
+        substep(state, p.system, s, scratch, True)
     after = np.abs(exact()[free]).max()
     assert before > 1.0 and after < 1e-3, (before, after)
 
@@ -113,7 +104,7 @@ def test_the_secant_predictor_continues_a_screw_path_exactly():
         R, x = _rigid_path(1.0)
         nodes = nodes0 + np.array([0.1, 0.2, 0.3])
         v, w, nv = np.ones((N_BODIES, 3)), np.ones((N_BODIES, 3)), np.ones((4, 3))
-        assert predict(h, R, x, v, w, nodes, nv, _Membrane, st, move)
+        assert predict(h, State(R, x, v, w, nodes, nv), _Membrane, st, move)
         R_expect, x_expect = _rigid_path(t_next)
         for b in FREE:
             np.testing.assert_allclose(R[b], R_expect[b], atol=1e-12)
@@ -130,12 +121,12 @@ def test_the_predictor_needs_two_equilibria_and_a_moving_capitate():
     st = _LOADED
     h = history(N_BODIES, np.zeros((4, 3)))
     R, x = _rigid_path(0.0)
-    args = (np.zeros((N_BODIES, 3)), np.zeros((N_BODIES, 3)), np.zeros((4, 3)), np.zeros((4, 3)), _Membrane, st, 1.0)
-    assert not predict(h, R, x, *args)
+    state = State(R, x, np.zeros((N_BODIES, 3)), np.zeros((N_BODIES, 3)), np.zeros((4, 3)), np.zeros((4, 3)))
+    assert not predict(h, state, _Membrane, st, 1.0)
     record(h, R, x, np.zeros((4, 3)), 1.0)
-    assert not predict(h, R, x, *args)
+    assert not predict(h, state, _Membrane, st, 1.0)
     record(h, R, x, np.zeros((4, 3)), 0.0)  # the last stage held the capitate still: no direction
-    assert not predict(h, R, x, *args)
+    assert not predict(h, state, _Membrane, st, 1.0)
     assert np.isclose(capitate_move(np.array([0.0, 0.1, 0.0]), np.array([3.0, 4.0, 0.0])), 1.0 + 5.0)
 
 

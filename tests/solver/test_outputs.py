@@ -11,7 +11,8 @@ from wrist_env.solver import arrays, forces
 from wrist_env.solver.contact import sdf_lookup
 from wrist_env.solver.drivers import idealized
 from wrist_env.solver.outputs import pair_slice, pressure_map, result_to_dict
-from wrist_env.solver.simulate import Result, simulate
+from wrist_env.solver.simulate import Result, prepare, simulate
+from wrist_env.solver.step import State, new_work
 
 RS = PAIRS.index("radioscaphoid")
 
@@ -56,33 +57,17 @@ def test_pressure_map_sums_to_the_solver_contact_force_at_the_same_state(p1, swe
     """Area-weighted sums of the map equal the contact kernel's own per-pair force and area
     (all samples active) at the same poses, to rounding."""
     grids = arrays.grids(p1)
-    law = np.ascontiguousarray(p1.contact_law, dtype=np.float64)
+    system = prepare(p1).system._replace(grids=grids)  # the trilinear normals: no nodal normals
     n = len(p1.sample_points)
     for f in range(len(sweep.poses)):
         R, x = _state(p1, sweep.poses[f])
-        stats = np.zeros((len(PAIRS), 3))
-        active = np.zeros(n, dtype=np.int64)
-        n_active = np.zeros(len(PAIRS), np.int64)
-        unset = np.full((len(PAIRS), 12), np.nan)
-        com = np.ascontiguousarray(p1.com)
+        nodes = np.zeros((0, 3))
+        state = State(R, x, np.zeros((N_BODIES, 3)), np.zeros((N_BODIES, 3)), nodes, nodes)
+        work = new_work(grids, nodes)  # its ref unset: every pair refills
         every = 1e9  # a band holding every sample
-        forces.contact_forces(
-            R,
-            x,
-            com,
-            grids,
-            law,
-            every,
-            active,
-            n_active,
-            unset,
-            np.zeros((N_BODIES, 3)),
-            np.zeros((N_BODIES, 3)),
-            stats,
-            True,
-            False,
-        )
-        assert n_active.sum() == n
+        forces.contact_forces(state, system, work, every, True, False)
+        stats = work.stats
+        assert work.n_active.sum() == n
         p = pressure_map(p1, sweep.poses[f])
         for k, pair in enumerate(PAIRS):
             s = pair_slice(p1, pair)

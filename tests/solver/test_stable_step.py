@@ -15,6 +15,7 @@ from wrist_env.solver.ligaments import EPSILON_L
 from wrist_env.solver.membrane import membrane_forces, place_nodes
 from wrist_env.solver.settings import SolverSettings
 from wrist_env.solver.simulate import prepare, simulate, stiffness
+from wrist_env.solver.step import State, Stiffness, new_work
 
 pytestmark = pytest.mark.slow  # builds models or runs simulations/studies (minutes)
 
@@ -41,15 +42,16 @@ def test_membrane_eigenvalue_matches_the_force_kernels_jacobian(p1):
     nodes = mem.rest.copy()
     place_nodes(R, x, p1.com, mem, nodes)
     free = np.flatnonzero(np.asarray(p1.membrane_bone) < 0)
+    no_contact = p.system._replace(settings=p.settings._replace(membrane_contact_stiffness=0.0))
+    connectors = Stiffness(np.zeros(0), np.zeros(0), m_l0, m_K, 0.0)
 
     def forces(q):
         moved = nodes.copy()
         moved[free] += q.reshape(-1, 3)
-        out = np.zeros_like(nodes)
-        membrane_forces(
-            R, x, p1.com, mem, moved, m_l0, m_K, 0.0, np.zeros((N_BODIES, 3)), np.zeros((N_BODIES, 3)), out, False, True
-        )
-        return out[free].ravel()
+        state = State(R, x, np.zeros((N_BODIES, 3)), np.zeros((N_BODIES, 3)), moved, np.zeros_like(moved))
+        work = new_work(p.grids, moved)
+        membrane_forces(state, no_contact, connectors, work, False, True)
+        return work.node_force[free].ravel()
 
     h = 1e-6
     J = np.array([(forces(h * e) - forces(-h * e)) / (2 * h) for e in np.eye(3 * len(free))]).T

@@ -11,6 +11,7 @@ this equilibrium is the explicit solver's error (`experiments/verification/solve
 
 from __future__ import annotations
 
+from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,15 +29,20 @@ from wrist_env.solver.tangent import tangent
 JACOBIAN_STEP = 1e-6  # finite-difference step of the Jacobian (rad, mm)
 MAX_EVALUATIONS = 60  # residual evaluations per frame (each with a Jacobian): where contact stalls it, stop
 
+Start = namedtuple("Start", ["R", "x", "nodes", "free_nodes"])
+"""The state the unknowns move (`moved_state`): rotations (n_bodies, 3, 3), centres of mass (n_bodies, 3) mm,
+RSC membrane nodes (n_nodes, 3) mm, and the indices of the membrane's free nodes (n_free,) int64."""
+
 
 @njit(cache=True, error_model="numpy")
-def moved_state(q, R0, x0, nodes0, free_nodes, loaded):
-    """Rotations, centres of mass (mm) and membrane nodes (mm) of the state (R0, x0, nodes0) moved by
+def moved_state(q, start, loaded):
+    """Rotations, centres of mass (mm) and membrane nodes (mm) of the state `start` (`Start`) moved by
     the unknowns q: rotation vectors (rad) and shifts (mm) of the free bodies (`model.FREE`), the capitate's
-    shift if `loaded`, the free nodes' shifts (mm)."""
-    R = R0.copy()
-    x = x0.copy()
-    nodes = nodes0.copy()
+    shift if `loaded`, the free nodes' (start.free_nodes) shifts (mm)."""
+    R = start.R.copy()
+    x = start.x.copy()
+    nodes = start.nodes.copy()
+    free_nodes = start.free_nodes
     k = 0
     for b in FREE:
         rotate_in_place(R[b], q[k], q[k + 1], q[k + 2])
@@ -55,10 +61,12 @@ def moved_state(q, R0, x0, nodes0, free_nodes, loaded):
 
 
 @njit(cache=True, error_model="numpy")
-def _residual(q, R0, x0, nodes0, free_nodes, system, stiffness, load, out):
-    """Net forces (N) and moments / LEVER_MM (N) on the unknowns (`moved_state`) at the state moved by q."""
+def _residual(q, start, system, stiffness, load, out):
+    """Net forces (N) and moments / LEVER_MM (N) on the unknowns (`moved_state`) at the state `start`
+    (`Start`) moved by q, of `system` under `stiffness` and the driver's `load` (`step.Load`); into out."""
     loaded = system.settings.driver == arrays.LOADED
-    R, x, nodes = moved_state(q, R0, x0, nodes0, free_nodes, loaded)
+    free_nodes = start.free_nodes
+    R, x, nodes = moved_state(q, start, loaded)
     n_bones = R.shape[0]
     state = step.State(R, x, np.zeros((n_bones, 3)), np.zeros((n_bones, 3)), nodes, np.zeros_like(nodes))
     work = step.new_work(system.grids, nodes)
@@ -82,8 +90,8 @@ def _residual(q, R0, x0, nodes0, free_nodes, system, stiffness, load, out):
 
 
 @njit(cache=True, error_model="numpy")
-def _jacobian(q, R0, x0, nodes0, free_nodes, system, stiffness, load, step):
-    """Central-difference Jacobian of `_residual` (n, n) with steps `step` (rad or mm)."""
+def _jacobian(q, start, system, stiffness, load, step):
+    """Central-difference Jacobian of `_residual` (n, n) at `start` (`Start`) with steps `step` (rad or mm)."""
     n = q.shape[0]
     J = np.empty((n, n))
     plus = np.empty(n)
@@ -91,9 +99,9 @@ def _jacobian(q, R0, x0, nodes0, free_nodes, system, stiffness, load, step):
     for j in range(n):
         qj = q[j]
         q[j] = qj + step
-        _residual(q, R0, x0, nodes0, free_nodes, system, stiffness, load, plus)
+        _residual(q, start, system, stiffness, load, plus)
         q[j] = qj - step
-        _residual(q, R0, x0, nodes0, free_nodes, system, stiffness, load, minus)
+        _residual(q, start, system, stiffness, load, minus)
         q[j] = qj
         for i in range(n):
             J[i, j] = (plus[i] - minus[i]) / (2.0 * step)
@@ -135,10 +143,11 @@ def _unknowns(model: Model, driver) -> tuple[np.ndarray, int]:
 
 
 def _frame_args(p, design_stiffness, free_nodes, driver, result, f: int) -> tuple:
-    """`_residual`'s arguments after q for frame f of `result`: its state and the kernel arrays."""
+    """`_residual`'s arguments after q for frame f of `result`: its `Start`, the System, the design's
+    `step.Stiffness` and the driver's `step.Load`."""
     R0, x0 = pose_state(result.poses[f], p.bodies.com0)
     nodes0 = np.ascontiguousarray(result.membrane_nodes[f])
-    return R0, x0, nodes0, free_nodes, p.system, design_stiffness, driver.kernel_load(f)
+    return Start(R0, x0, nodes0, free_nodes), p.system, design_stiffness, driver.kernel_load(f)
 
 
 def nearest(model: Model, design: Design, driver, result, settings: SolverSettings | None = None) -> Equilibrium:
@@ -155,7 +164,6 @@ def nearest(model: Model, design: Design, driver, result, settings: SolverSettin
     out = np.zeros(n_unknown)
     for f in range(driver.n_frames):
         args = _frame_args(p, design_stiffness, free_nodes, driver, result, f)
-        R0, x0, nodes0 = args[:3]
 
         def fun(q):
             return _residual(q, *args, out).copy()
@@ -167,7 +175,7 @@ def nearest(model: Model, design: Design, driver, result, settings: SolverSettin
             fun, np.zeros(n_unknown), jac=jac, method="lm", xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=MAX_EVALUATIONS
         ).x
         r = fun(q)
-        R, x, _ = moved_state(q, R0, x0, nodes0, free_nodes, loaded)
+        R, x, _ = moved_state(q, args[0], loaded)
         poses[f, :, :3, :3] = R
         poses[f, :, :3, 3] = pose_translation(R, x, com0)
         residual[f] = (
@@ -227,7 +235,7 @@ def tangent_stiffness(
     condensed = K[bones, bones]
     if len(free_nodes):  # slack connectors leave nodes without stiffness: pseudo-inverse
         condensed = condensed - K[bones, nodes] @ np.linalg.pinv(K[nodes, nodes], rcond=1e-9) @ K[nodes, bones]
-    R0 = args[0]
+    R0 = args[0].R
     mass = np.zeros((n_bones, n_bones))
     for k, b in enumerate(FREE):
         mass[6 * k : 6 * k + 3, 6 * k : 6 * k + 3] = p.bodies.mass[b] * np.eye(3)
@@ -261,7 +269,7 @@ def block_mass(
     p = prepare(model, settings, driver.mode)
     free_nodes, n_unknown = _unknowns(model, driver)
     st = stiffness(p, design)
-    R0, x0, nodes0 = _frame_args(p, st, free_nodes, driver, result, frame)[:3]
+    R0, x0, nodes0, _ = _frame_args(p, st, free_nodes, driver, result, frame)[0]
     n_bones = n_unknown - 3 * len(free_nodes)
     g = p.grids
     state = step.State(R0.copy(), x0.copy(), np.zeros_like(x0), np.zeros_like(x0), nodes0.copy(), np.zeros_like(nodes0))
@@ -269,6 +277,6 @@ def block_mass(
     load = driver.kernel_load(frame)
     step.net_forces(state, work, p.system, st, load, True, True, p.settings.smooth_normals)
     m = preconditioner.metric()
-    tangent(state.R, state.x, state.nodes, p.system, st, work.active, work.n_active, m, p.settings.smooth_normals)
+    tangent(state, p.system, st, work, m, p.settings.smooth_normals)
     preconditioner.block_mass(state.R, p.bodies, p.settings, m)
     return BlockMass(m.stiffness[:n_bones, :n_bones].copy(), m.mass[:n_bones, :n_bones].copy())

@@ -60,8 +60,10 @@ def rotate(R, b, gx, gy, gz):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def apply_force(F, T, x, b, fx, fy, fz, px, py, pz):
-    """Add force f applied at world point p to body b."""
+def apply_force(F, T, x, b, f, p):
+    """Add force f (N, world) applied at world point p (mm), each a 3-tuple, to body b."""
+    fx, fy, fz = f
+    px, py, pz = p
     rx, ry, rz = px - x[b, 0], py - x[b, 1], pz - x[b, 2]
     F[b, 0] += fx
     F[b, 1] += fy
@@ -184,18 +186,22 @@ def sample_pressures(R, x, com0, grids, law, pressure):
 
 
 @njit(cache=True, error_model="numpy")
-def contact_forces(R, x, com0, grids, law, band_mm, active, n_active, ref, F, T, stats, want_energy, smooth):
-    """Contact forces of all pairs' active samples; returns contact energy (N·mm; 0 unless `want_energy`).
+def contact_forces(state, system, work, band_mm, want_energy, smooth):
+    """Contact forces of all pairs' active samples at `state` (`step.State`) of `system` (`arrays.System`)
+    into work.F (N) and work.T (N·mm) (`step.Work`); returns contact energy (N·mm; 0 unless `want_energy`).
 
-    A pair's active samples (within `band_mm` of contact) are refilled when its
-    samples may have moved band_mm / 2 since the last refill (`_travel`; ref:
+    A pair's active samples (work.active, work.n_active: those within `band_mm` of contact) are
+    refilled when its samples may have moved band_mm / 2 since the last refill (`_travel`; work.ref:
     (n_pairs, 12) pair transforms at the refills, NaN to force one): the
     trilinear distance changes at most √3× as fast as a sample moves, so no
     sample left out can have reached contact. Each pair's forces and moments
     are summed in the grid bone's neutral frame and applied to both bodies
-    once. stats (n_pairs, 3) receives per pair: force (N), contacting area
+    once. work.stats (n_pairs, 3) receives per pair: force (N), contacting area
     (mm²), peak pressure (MPa).
     """
+    R, x = state.R, state.x
+    com0, grids, law = system.bodies.com0, system.grids, system.law
+    active, n_active, ref, F, T, stats = work.active, work.n_active, work.ref, work.F, work.T, work.stats
     energy = 0.0
     stats[:] = 0.0
     for p in range(grids.pair_bones.shape[0]):
@@ -264,12 +270,18 @@ def contact_forces(R, x, com0, grids, law, band_mm, active, n_active, ref, F, T,
 
 
 @njit(cache=True, error_model="numpy")
-def fibre_forces(R, x, v, w, com0, fibres, l0, K, damping_s, F, T, bundle_force, want_energy):
-    """Blankevoort fibre forces; returns strain energy (N·mm; 0 unless `want_energy`).
+def fibre_forces(state, system, stiffness, work, want_energy):
+    """Blankevoort fibre forces at `state` (`step.State`) of `system` (`arrays.System`: its `Fibres`, damped
+    by its settings' fibre_damping_s) into work.F (N) and work.T (N·mm) (`step.Work`); returns strain
+    energy (N·mm; 0 unless `want_energy`).
 
-    l0, K: per-fibre zero-load length (mm) and scale (N per unit strain), K = 0 if torn.
-    bundle_force (n_bundles,) receives the summed tension of each bundle (N).
+    stiffness.f_l0, stiffness.f_K (`step.Stiffness`): per-fibre zero-load length (mm) and scale (N per
+    unit strain), K = 0 if torn. work.bundle (n_bundles,) receives the summed tension of each bundle (N).
     """
+    R, x, v, w = state.R, state.x, state.v, state.w
+    com0, fibres, damping_s = system.bodies.com0, system.fibres, system.settings.fibre_damping_s
+    l0, K = stiffness.f_l0, stiffness.f_K
+    F, T, bundle_force = work.F, work.T, work.bundle
     energy = 0.0
     o, ins = fibres.origin, fibres.insertion
     for i in range(l0.shape[0]):
@@ -297,8 +309,8 @@ def fibre_forces(R, x, v, w, com0, fibres, l0, K, damping_s, F, T, bundle_force,
         rate = (vbx - vax) * ux + (vby - vay) * uy + (vbz - vaz) * uz
         if rate > 0.0:
             tension += damping_s * (K[i] / l0[i]) * rate
-        apply_force(F, T, x, a, tension * ux, tension * uy, tension * uz, ax, ay, az)
-        apply_force(F, T, x, b, -tension * ux, -tension * uy, -tension * uz, bx, by, bz)
+        apply_force(F, T, x, a, (tension * ux, tension * uy, tension * uz), (ax, ay, az))
+        apply_force(F, T, x, b, (-tension * ux, -tension * uy, -tension * uz), (bx, by, bz))
         bundle_force[fibres.ligament[i]] += tension
         if want_energy:
             energy += blankevoort_energy(K[i], l0[i], strain)
@@ -306,13 +318,16 @@ def fibre_forces(R, x, v, w, com0, fibres, l0, K, damping_s, F, T, bundle_force,
 
 
 @njit(cache=True, error_model="numpy")
-def joint_forces(R, x, com0, bod, F, T, want_energy):
+def joint_forces(state, bod, work, want_energy):
     """The capitohamate joint's in-plane constraint (`arrays.capitohamate_joint`, `ligaments.CH_JOINT_STIFFNESS`):
     a linear spring between the hamate and the capitate at the joint's centre, in the joint's axes carried by
     the capitate. The centre's shift on the hamate from the capitate's, d, gives the hamate −Σ kₖ(eₖ·d)eₖ
     at its centre point (the capitate the opposite at its own), the hamate's turn from the capitate θ
-    (`rigid.rotvec_between`) the couple −Σ k₃₊ₖ(eₖ·θ)eₖ (the capitate the opposite); returns the energy
-    (N·mm; 0 unless `want_energy`)."""
+    (`rigid.rotvec_between`) the couple −Σ k₃₊ₖ(eₖ·θ)eₖ (the capitate the opposite), at `state`
+    (`step.State`) of the `arrays.Bodies` bod, into work.F (N) and work.T (N·mm) (`step.Work`); returns
+    the energy (N·mm; 0 unless `want_energy`)."""
+    R, x, com0 = state.R, state.x, bod.com0
+    F, T = work.F, work.T
     k = bod.joint_stiffness
     if k[0] == 0.0 and k[1] == 0.0 and k[2] == 0.0 and k[3] == 0.0 and k[4] == 0.0 and k[5] == 0.0:
         return 0.0
@@ -336,8 +351,8 @@ def joint_forces(R, x, com0, bod, F, T, want_energy):
         mz -= k[3 + a] * r * ez
         if want_energy:
             energy += 0.5 * (k[a] * s * s + k[3 + a] * r * r)
-    apply_force(F, T, x, HAMATE, fx, fy, fz, hx, hy, hz)
-    apply_force(F, T, x, CAPITATE, -fx, -fy, -fz, cx, cy, cz)
+    apply_force(F, T, x, HAMATE, (fx, fy, fz), (hx, hy, hz))
+    apply_force(F, T, x, CAPITATE, (-fx, -fy, -fz), (cx, cy, cz))
     T[HAMATE, 0] += mx
     T[HAMATE, 1] += my
     T[HAMATE, 2] += mz

@@ -73,11 +73,15 @@ def mix_metric(v, w, F, T, st, m, a):
 
 
 @njit(cache=True, error_model="numpy")
-def fire_step(v, w, nv, F, T, node_force, mem, st, fire, m, preconditioned):
-    """FIRE relaxation (Bitzek et al. 2006) at a fixed step: mix velocities towards the
-    forces while the power is positive, stop everything when it turns negative.
-    fire = [alpha, steps with positive power, 1 after a restart (the caller clears it)];
-    `preconditioned` (a compile-time constant, `kernel._run`): whether st.block_mass may be on."""
+def fire_step(state, work, st, fire, m, preconditioned):
+    """FIRE relaxation (Bitzek et al. 2006) at a fixed step: mix the velocities of `state` (`step.State`: the
+    bodies' v, w and the membrane nodes' nv) towards the forces of `work` (`step.Work`: F, T, node_force)
+    while the power is positive, stop everything when it turns negative.
+    fire = [alpha, steps with positive power, 1 after a restart (the caller clears it)]; m the block mass
+    (`preconditioner.Metric`); `preconditioned` (a compile-time constant, `kernel._run`): whether
+    st.block_mass may be on."""
+    v, w, nv = state.v, state.w, state.nv
+    F, T, node_force = work.F, work.T, work.node_force
     power = 0.0
     for k in range(3):
         for b in FREE:
@@ -110,9 +114,11 @@ def fire_step(v, w, nv, F, T, node_force, mem, st, fire, m, preconditioned):
 
 
 @njit(cache=True, error_model="numpy")
-def move_diagonal(R, x, v, w, F, T, bod, st):
-    """Semi-implicit Euler of the free bodies under their (scaled) mass and inertia, with
-    mass-proportional damping."""
+def move_diagonal(state, work, bod, st):
+    """Semi-implicit Euler of the free bodies of `state` (`step.State`) under the forces of `work`
+    (`step.Work`) and their (scaled) mass and inertia (`arrays.Bodies`), with mass-proportional damping."""
+    R, x, v, w = state.R, state.x, state.v, state.w
+    F, T = work.F, work.T
     dt = st.dt
     lin = 1.0 / (1.0 + st.damping * dt)
     rot = 1.0 / (1.0 + st.rot_damping * dt)
@@ -138,11 +144,14 @@ def move_diagonal(R, x, v, w, F, T, bod, st):
 
 
 @njit(cache=True, error_model="numpy")
-def move_blocks(R, x, v, w, F, T, st, m):
-    """Semi-implicit Euler of the free bodies under the block mass: u ← u + dt·M⁻¹g (FIRE damps it),
+def move_blocks(state, work, st, m):
+    """Semi-implicit Euler of the free bodies of `state` (`step.State`) under the forces g of `work`
+    (`step.Work`) and the block mass m (`preconditioner.Metric`): u ← u + dt·M⁻¹g (FIRE damps it),
     the velocity cut where a body's step would move it more than st.block_max_move_mm (its shift
     plus its rotation × LEVER_MM): the mass is a linearization, and a contact that closes between
     refreshes is stiffer than it says."""
+    R, x, v, w = state.R, state.x, state.v, state.w
+    F, T = work.F, work.T
     dt = st.dt
     Minv = m.inverse
     for b in SOLVED:
@@ -172,9 +181,11 @@ def move_blocks(R, x, v, w, F, T, st, m):
 
 
 @njit(cache=True, error_model="numpy")
-def kinetic_energy(R, v, w, nv, bod, st, node_mass, m, preconditioned):
-    """Kinetic energy (N·mm) of the free bodies and membrane nodes of mass `node_mass` (t) (mass-scaled;
-    with st.block_mass, in the block mass m; `preconditioned` as in `fire_step`)."""
+def kinetic_energy(state, bod, st, node_mass, m, preconditioned):
+    """Kinetic energy (N·mm) of the free bodies (`arrays.Bodies` bod) and membrane nodes of mass `node_mass`
+    (t) at `state` (`step.State`) (mass-scaled; with st.block_mass, in the block mass m; `preconditioned`
+    as in `fire_step`)."""
+    R, v, w, nv = state.R, state.v, state.w, state.nv
     ke = 0.0
     if preconditioned and st.block_mass:
         for b in SOLVED:

@@ -11,9 +11,9 @@ The free bones' masses are their (scaled) physical ones or, with
 (`preconditioner`): the answer is the same equilibrium, reached in fewer steps.
 
 Read `run` → `_run`: per stage (settle, move, each frame) it stages the capitate's targets
-(`_stage`, or the secant predictor's state: `_predicted`), holds (`_ramp_and_hold`, which calls
-`_step`, which calls `net_forces`), checks (`_failure`) and records the frame (`_record`). `_run`
-and those it calls once per stage or step are inlined into the entry point: each separately
+(`_stage`, a `Stage`, or the secant predictor's state: `step.predicted_start`), holds (`_ramp_and_hold`,
+which calls `step.explicit_step`, which calls `net_forces`), checks (`_failure`) and records the frame
+(`_record`). `_run` and those it calls once per stage or step are inlined into the entry point: each separately
 compiled layer over the force kernels made Numba optimize and emit their code once more (issue 52;
 `experiments/benchmarks/bench_cold_start.py` times a cold first simulation). The entry points
 (`run`, and `entry(settings)` for the other three) take the model's `arrays.System` flat, as they
@@ -44,7 +44,7 @@ from wrist_env.solver.membrane import new_scratch
 from wrist_env.solver.preconditioner import SOLVED, metric
 from wrist_env.solver.predictor import capitate_move, history, record
 from wrist_env.solver.rigid import copy_into, interpolate_pose, rotvec_between, smoothstep
-from wrist_env.solver.step import Load, State, explicit_step, net_forces, new_work, predicted_start
+from wrist_env.solver.step import Carry, Load, State, Target, explicit_step, net_forces, new_work, predicted_start
 from wrist_env.solver.stopping import converged, displacement
 
 N_BONES = len(BONES)
@@ -65,6 +65,11 @@ bundle forces (n_frames, n_bundles) N; kinetic and internal energy (n_frames, 2)
 force (N) and moment (N·mm) on the free bones (n_frames, 2); steps per frame (n_frames,); 1 where the
 frame's hold ended in equilibrium, 0 where it ran out of hold steps (n_frames,); RSC membrane
 node positions (n_frames, M, 3) mm; status (1,)."""
+
+Stage = namedtuple("Stage", ["Ra", "xa", "la", "axis", "shift", "lb", "ramp", "most", "start"])
+"""One stage's capitate motion (`_ramp_and_hold`): from rotation Ra (3, 3) and centre xa (3,) mm by the
+rotation vector axis (3,) rad and the shift (3,) mm, the lines' tensions from la to lb (n_lines,) N, over
+`ramp` steps, then a hold of at most `most` steps; start: the run's steps before the stage."""
 
 SETTLE, MOVE = -2, -1
 """The stages before frame 0: settle with the capitate at its static pose, then move it to the first pose."""
@@ -152,8 +157,7 @@ def _run(system, stiffness, frames, out, R, x, nodes, first, smooth, preconditio
     x0 = system.bodies.com0[CAPITATE].copy()
     fire = np.array([st.fire_alpha0, 0.0, 0.0])
     load = Load(body, point, direction, np.zeros(frame_load.shape[1]))
-    m = metric()
-    scratch = new_scratch(nodes)
+    carry = Carry(fire, metric(), new_scratch(nodes))
     hist = history(N_BONES, nodes)
     taken = 0
     for f in range(first, n_frames):
@@ -167,31 +171,12 @@ def _run(system, stiffness, frames, out, R, x, nodes, first, smooth, preconditio
                 st.predict
                 and st.driver == LOADED
                 and f > 0
-                and predicted_start(state, work, system, stiffness, hist, Rb, xb, at_end, move, smooth)
+                and predicted_start(state, work, system, stiffness, hist, Target(Rb, xb, at_end), move, smooth)
             ):
                 ramp = st.predict_ramp_steps
                 fire[0], fire[1], fire[2] = st.fire_alpha0, 0.0, 1.0
-        k, settled = _ramp_and_hold(
-            state,
-            work,
-            system,
-            stiffness,
-            Ra,
-            xa,
-            la,
-            axis,
-            shift,
-            lb,
-            ramp,
-            most,
-            load,
-            step,
-            fire,
-            m,
-            scratch,
-            smooth,
-            preconditioned,
-        )
+        stage = Stage(Ra, xa, la, axis, shift, lb, ramp, most, step)
+        k, settled = _ramp_and_hold(state, work, system, stiffness, stage, load, carry, smooth, preconditioned)
         step += k
         taken += k
         status[0] = _failure(state.R, state.x, system.bodies.com0, st)
@@ -202,37 +187,20 @@ def _run(system, stiffness, frames, out, R, x, nodes, first, smooth, preconditio
         if preconditioned:
             if st.predict:
                 record(hist, R, x, nodes, move)
-        _record(f, state, work, system, stiffness, at_end, m, out, taken, settled, smooth, preconditioned)
+        _record(f, state, work, system, stiffness, at_end, carry.metric, out, taken, settled, smooth, preconditioned)
         taken = 0
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _ramp_and_hold(
-    state,
-    work,
-    system,
-    stiffness,
-    Ra,
-    xa,
-    la,
-    axis,
-    shift,
-    lb,
-    ramp,
-    most,
-    load,
-    step,
-    fire,
-    m,
-    scratch,
-    smooth,
-    preconditioned,
-):
-    """One stage's steps: the capitate ramps from (Ra, xa) by the rotation vector `axis` and `shift`
-    (mm), the lines' tensions from la to lb (N), over `ramp` steps, then holds until `converged` (after
-    at least min_hold_steps, at most `most`); `step` the run's steps before it. Returns the steps taken
-    and whether the hold ended in equilibrium."""
+def _ramp_and_hold(state, work, system, stiffness, stage, load, carry, smooth, preconditioned):
+    """One stage's steps (`Stage`): the capitate ramps from (Ra, xa) by the rotation vector `axis` and
+    `shift` (mm), the lines' tensions from la to lb (N; written into load.tension, `Load`), over `ramp`
+    steps, then holds until `converged` (after at least min_hold_steps, at most `most`); stage.start the
+    run's steps before it; `carry` what the steps carry (`step.Carry`). Returns the steps taken and
+    whether the hold ended in equilibrium."""
     st = system.settings
+    Ra, xa, la, axis, shift, lb, ramp, most, step = stage
+    fire = carry.fire
     capR = np.eye(3)
     k = 0
     while k < ramp + most:
@@ -242,22 +210,8 @@ def _ramp_and_hold(
             load.tension[i] = la[i] + s * (lb[i] - la[i])
         refresh = k % st.block_refresh_steps == 0 or (st.block_refresh_restart and fire[2] > 0.0)
         fire[2] = 0.0
-        explicit_step(
-            state,
-            work,
-            system,
-            stiffness,
-            capR,
-            capx,
-            load,
-            step + k,
-            fire,
-            m,
-            refresh,
-            scratch,
-            smooth,
-            preconditioned,
-        )
+        target = Target(capR, capx, load)
+        explicit_step(state, work, system, stiffness, target, step + k, refresh, carry, smooth, preconditioned)
         k += 1
         if k >= ramp + st.min_hold_steps and converged(work.F, work.T, work.bundle, st):
             return k, True
@@ -288,7 +242,7 @@ def _record(f, state, work, system, stiffness, load, m, out, taken, settled, smo
     """Fill frame f of `out` at the state reached (the last step's forces were those before it, so they
     are evaluated again here under the stage's end `load`); `taken` steps since the previous frame."""
     bod, st = system.bodies, system.settings
-    R, x, v, w, nodes, nv = state
+    R, x, nodes = state.R, state.x, state.nodes
     F, T, stats = work.F, work.T, work.stats
     com0 = bod.com0
     energy = net_forces(state, work, system, stiffness, load, np.bool_(False), np.bool_(True), smooth)
@@ -310,7 +264,7 @@ def _record(f, state, work, system, stiffness, load, m, out, taken, settled, smo
         contact[f, p, R_AREA] = area
         contact[f, p, R_FORCE] = stats[p, C_FORCE]
     copy_into(out.bundle[f], work.bundle)
-    out.energy[f, 0] = kinetic_energy(R, v, w, nv, bod, st, stiffness.node_mass, m, preconditioned)
+    out.energy[f, 0] = kinetic_energy(state, bod, st, stiffness.node_mass, m, preconditioned)
     out.energy[f, 1] = energy
     out.residual[f, 0] = 0.0
     out.residual[f, 1] = 0.0

@@ -55,11 +55,14 @@ def connector_pull(nodes, i, j, l0, K):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def node_contact(R, x, com0, mem, px, py, pz, contact_stiffness, smooth):
-    """The scaphoid's push (N, world) on a membrane node at world point p, the node's signed distance (mm)
+def node_contact(state, system, i, smooth):
+    """The scaphoid's push (N, world) on membrane node i of `state` (`step.State`) of `system`
+    (`arrays.System`: its settings' membrane_contact_stiffness, N/mm), the node's signed distance (mm)
     and whether it touches (a negative distance with a normal; else no push)."""
+    R, x, nodes = state.R, state.x, state.nodes
+    com0, mem, contact_stiffness = system.bodies.com0, system.membrane, system.settings.membrane_contact_stiffness
     s = mem.scaphoid
-    qx, qy, qz = to_local(R, x, com0, s, px, py, pz)
+    qx, qy, qz = to_local(R, x, com0, s, nodes[i, 0], nodes[i, 1], nodes[i, 2])
     if smooth:
         d, gx, gy, gz = sdf_lookup_smooth(
             mem.grid_values,
@@ -112,42 +115,52 @@ def connector_forces(mem, nodes, l0, K, force, want_energy):
 
 
 @njit(cache=True, error_model="numpy")
-def membrane_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, F, T, node_force, want_energy, smooth):
-    """RSC membrane: connector tension and node–scaphoid contact.
+def membrane_forces(state, system, stiffness, work, want_energy, smooth):
+    """RSC membrane (system.membrane, `arrays.System`): connector tension (stiffness.m_l0, stiffness.m_K,
+    `step.Stiffness`) and node–scaphoid contact (the settings' membrane_contact_stiffness, N/mm).
 
-    nodes (M, 3): world positions (attached nodes already placed on their bones).
-    node_force (M, 3) receives forces on the free nodes; forces on attached
-    nodes go to their bones. Returns (energy N·mm, tension N of the membrane's
-    radial row of along connectors).
+    state.nodes (n_nodes, 3): world positions (attached nodes already placed on their bones).
+    work.node_force (n_nodes, 3) receives forces (N) on the free nodes; forces on attached
+    nodes go to their bones (work.F, work.T: `step.Work`). Returns (energy N·mm, tension N of
+    the membrane's radial row of along connectors).
     """
+    x, nodes = state.x, state.nodes
+    mem, contact_stiffness = system.membrane, system.settings.membrane_contact_stiffness
+    l0, K = stiffness.m_l0, stiffness.m_K
+    F, T, node_force = work.F, work.T, work.node_force
     node_force[:] = 0.0
     energy, along = connector_forces(mem, nodes, l0, K, node_force, want_energy)
     for i in range(nodes.shape[0]):
         if mem.bone[i] >= 0:
             continue
-        fx, fy, fz, d, touching = node_contact(
-            R, x, com0, mem, nodes[i, 0], nodes[i, 1], nodes[i, 2], contact_stiffness, smooth
-        )
+        fx, fy, fz, d, touching = node_contact(state, system, i, smooth)
         if touching:
             node_force[i, 0] += fx
             node_force[i, 1] += fy
             node_force[i, 2] += fz
-            apply_force(F, T, x, mem.scaphoid, -fx, -fy, -fz, nodes[i, 0], nodes[i, 1], nodes[i, 2])
+            apply_force(F, T, x, mem.scaphoid, (-fx, -fy, -fz), (nodes[i, 0], nodes[i, 1], nodes[i, 2]))
             energy += 0.5 * contact_stiffness * d * d
     for i in range(nodes.shape[0]):
         b = mem.bone[i]
         if b >= 0:
             apply_force(
-                F, T, x, b, node_force[i, 0], node_force[i, 1], node_force[i, 2], nodes[i, 0], nodes[i, 1], nodes[i, 2]
+                F,
+                T,
+                x,
+                b,
+                (node_force[i, 0], node_force[i, 1], node_force[i, 2]),
+                (nodes[i, 0], nodes[i, 1], nodes[i, 2]),
             )
             node_force[i, 0] = node_force[i, 1] = node_force[i, 2] = 0.0
     return energy, along
 
 
 @njit(cache=True, error_model="numpy")
-def _gaps(R, x, com0, mem, nodes, gap, travel):
-    """gap (M,) ← each free node's signed distance (mm) to the scaphoid (+inf for an attached node);
-    travel (M,) ← 0."""
+def _gaps(state, system, gap, travel):
+    """gap (n_nodes,) ← each free node of `state` (`step.State`)'s signed distance (mm) to the scaphoid
+    of `system` (`arrays.System`) (+inf for an attached node); travel (n_nodes,) ← 0."""
+    R, x, nodes = state.R, state.x, state.nodes
+    com0, mem = system.bodies.com0, system.membrane
     s = mem.scaphoid
     for i in range(nodes.shape[0]):
         travel[i] = 0.0
@@ -160,17 +173,17 @@ def _gaps(R, x, com0, mem, nodes, gap, travel):
 
 
 @njit(cache=True, error_model="numpy")
-def _substep_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, gap, travel, force, smooth):
-    """force (M, 3) N ← connector tensions and the scaphoid's contact, looked up only on the free nodes that
-    may touch it (gap − √3·travel < 0: `LIPSCHITZ`), whose gap and travel then restart there."""
+def _substep_forces(state, system, stiffness, gap, travel, force, smooth):
+    """force (n_nodes, 3) N ← connector tensions (stiffness.m_l0, stiffness.m_K) and the scaphoid's contact
+    on the nodes of `state`, looked up only on the free nodes that may touch it (gap − √3·travel < 0:
+    `LIPSCHITZ`), whose gap and travel (n_nodes,) then restart there."""
+    nodes = state.nodes
     force[:] = 0.0
-    connector_forces(mem, nodes, l0, K, force, np.bool_(False))
+    connector_forces(system.membrane, nodes, stiffness.m_l0, stiffness.m_K, force, np.bool_(False))
     for i in range(nodes.shape[0]):
         if not gap[i] - LIPSCHITZ * travel[i] < 0.0:
             continue
-        fx, fy, fz, gap[i], _ = node_contact(
-            R, x, com0, mem, nodes[i, 0], nodes[i, 1], nodes[i, 2], contact_stiffness, smooth
-        )
+        fx, fy, fz, gap[i], _ = node_contact(state, system, i, smooth)
         travel[i] = 0.0
         force[i, 0] += fx
         force[i, 1] += fy
@@ -178,16 +191,21 @@ def _substep_forces(R, x, com0, mem, nodes, l0, K, contact_stiffness, gap, trave
 
 
 @njit(cache=True, error_model="numpy")
-def substep(R, x, com0, mem, nodes, nv, l0, K, node_mass, st, scratch, smooth):
-    """Move the free nodes (M, 3) mm, velocities nv (M, 3) mm/s, through st.membrane_substeps steps of
-    st.dt with the bones held; scratch: (2, M, 3) arrays (`new_scratch`)."""
+def substep(state, system, stiffness, scratch, smooth):
+    """Move the free nodes state.nodes (n_nodes, 3) mm, velocities state.nv (n_nodes, 3) mm/s (`step.State`),
+    through st.membrane_substeps steps of st.dt (st: system.settings) with the bones held, under the
+    connectors and node mass (t) of `stiffness` (`step.Stiffness`); scratch: (2, n_nodes, 3) arrays
+    (`new_scratch`)."""
+    nodes, nv = state.nodes, state.nv
+    mem, st = system.membrane, system.settings
+    node_mass = stiffness.node_mass
     force = scratch[0]
     gap, travel = scratch[1, :, 0], scratch[1, :, 1]
-    _gaps(R, x, com0, mem, nodes, gap, travel)
+    _gaps(state, system, gap, travel)
     dt = st.dt
     lin = 1.0 / (1.0 + st.membrane_substep_damping * dt)
     for _ in range(st.membrane_substeps):
-        _substep_forces(R, x, com0, mem, nodes, l0, K, st.membrane_contact_stiffness, gap, travel, force, smooth)
+        _substep_forces(state, system, stiffness, gap, travel, force, smooth)
         for i in range(nodes.shape[0]):
             if mem.bone[i] < 0:
                 step2 = 0.0
@@ -200,5 +218,5 @@ def substep(R, x, com0, mem, nodes, nv, l0, K, node_mass, st, scratch, smooth):
 
 @njit(cache=True)
 def new_scratch(nodes):
-    """Scratch for `substep`: (2, M, 3)."""
+    """Scratch for `substep`: (2, n_nodes, 3)."""
     return np.zeros((2,) + nodes.shape)

@@ -31,6 +31,7 @@ def part_signatures(settings: SolverSettings) -> list[tuple[object, tuple]]:
     R, x = np.zeros((N_BODIES, 3, 3)), np.zeros((N_BODIES, 3))
     nodes = np.zeros((len(p.model.membrane_nodes), 3))
     design = stiffness(p, population())
+    state = step.State(R, x, np.zeros_like(x), np.zeros_like(x), nodes, np.zeros_like(nodes))
     work = step.new_work(p.grids, nodes)
     m = preconditioner.metric()
     smooth = types.literal(bool(settings.smooth_normals))  # a compile-time constant in the entry point
@@ -39,14 +40,8 @@ def part_signatures(settings: SolverSettings) -> list[tuple[object, tuple]]:
         return tuple(a if isinstance(a, types.Type) else typeof(a) for a in args)
 
     return [
-        (tangent.tangent, typed(R, x, nodes, p.system, design, work.active, work.n_active, m, smooth)),
-        (
-            membrane.substep,
-            typed(
-                R, x, p.bodies.com0, p.membrane, nodes, nodes, design.m_l0, design.m_K, 0.0, p.settings,
-                membrane.new_scratch(nodes), smooth,
-            ),
-        ),
+        (tangent.tangent, typed(state, p.system, design, work, m, smooth)),
+        (membrane.substep, typed(state, p.system, design, membrane.new_scratch(nodes), smooth)),
         (preconditioner.block_mass, typed(R, p.bodies, p.settings, m)),
     ]  # fmt: skip
 

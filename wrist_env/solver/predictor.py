@@ -65,10 +65,12 @@ def record(h, R, x, nodes, move):
 
 
 @njit(cache=True, error_model="numpy")
-def predict(h, R, x, v, w, nodes, nv, mem, st, move):
-    """Put the free bodies and nodes where the secant through the last two equilibria says the next
-    stage, whose capitate moves `move` (mm), ends; velocities zeroed. False (nothing changed) without
-    two equilibria or when the last stage's capitate did not move."""
+def predict(h, state, mem, st, move):
+    """Put the free bodies and nodes of `state` (`step.State`) where the secant through the last two
+    equilibria (`History` h) says the next stage, whose capitate moves `move` (mm), ends; velocities
+    zeroed. False (nothing changed) without two equilibria or when the last stage's capitate did not move;
+    mem, st: the `arrays.Membrane` (its nodes' bones) and `arrays.Settings` (the driver)."""
+    R, x, v, w, nodes, nv = state
     if h.count[0] < 2 or not h.move[1] > 1e-9:
         return False
     ratio = min(move / h.move[1], MAX_RATIO)

@@ -1,7 +1,7 @@
 """One explicit step of the solver (Numba): the forces at a state (`net_forces`), the step that moves the free
 bodies under them (`explicit_step`), the secant predictor's start of a stage (`predicted_start`), and the
-state, scratch, design and load tuples they read (`State`, `Work`, `Stiffness`, `Load`). `kernel` runs them
-stage by stage; `equilibrium` and `outputs` call `net_forces` alone.
+state, scratch, design, load, target and carried tuples they read (`State`, `Work`, `Stiffness`, `Load`,
+`Target`, `Carry`). `kernel` runs them stage by stage; `equilibrium` and `outputs` call `net_forces` alone.
 """
 
 from __future__ import annotations
@@ -34,23 +34,19 @@ def net_forces(state, work, system, stiffness, load, rebuild, want_energy, smoot
     (`State`) of `system` (`arrays.System`) under a design's `stiffness` and the driver's `load`; with
     `rebuild`, every pair's active contact samples are refilled first (otherwise a pair refills when
     its samples may have moved half the band); returns internal energy (N·mm; 0 unless `want_energy`)."""
-    bod, grids, law, fib, mem, st = system
-    R, x, v, w, nodes, _ = state
-    active, n_active, ref, F, T, node_force, stats, bundle = work
-    f_l0, f_K, m_l0, m_K, _ = stiffness
-    com0 = bod.com0
+    R, x, nodes = state.R, state.x, state.nodes
+    F, T, bundle = work.F, work.T, work.bundle
+    com0 = system.bodies.com0
     if rebuild:
-        ref[:] = np.nan
-    place_nodes(R, x, com0, mem, nodes)
+        work.ref[:] = np.nan
+    place_nodes(R, x, com0, system.membrane, nodes)
     F[:] = 0.0
     T[:] = 0.0
     bundle[:] = 0.0
-    band = st.active_band_mm
-    energy = contact_forces(R, x, com0, grids, law, band, active, n_active, ref, F, T, stats, want_energy, smooth)
-    energy += fibre_forces(R, x, v, w, com0, fib, f_l0, f_K, st.fibre_damping_s, F, T, bundle, want_energy)
-    energy += joint_forces(R, x, com0, bod, F, T, want_energy)
-    k_mem = st.membrane_contact_stiffness
-    e_mem, rsc = membrane_forces(R, x, com0, mem, nodes, m_l0, m_K, k_mem, F, T, node_force, want_energy, smooth)
+    energy = contact_forces(state, system, work, system.settings.active_band_mm, want_energy, smooth)
+    energy += fibre_forces(state, system, stiffness, work, want_energy)
+    energy += joint_forces(state, system.bodies, work, want_energy)
+    e_mem, rsc = membrane_forces(state, system, stiffness, work, want_energy, smooth)
     energy += e_mem
     bundle[RSC] += rsc
     tension = load.tension
@@ -58,43 +54,42 @@ def net_forces(state, work, system, stiffness, load, rebuild, want_energy, smoot
         if tension[i] != 0.0:
             b = load.body[i]
             p, u = load.point[i], load.direction[i]
-            px, py, pz = to_world(R, x, com0, b, p[0], p[1], p[2])
-            apply_force(F, T, x, b, tension[i] * u[0], tension[i] * u[1], tension[i] * u[2], px, py, pz)
+            at = to_world(R, x, com0, b, p[0], p[1], p[2])
+            apply_force(F, T, x, b, (tension[i] * u[0], tension[i] * u[1], tension[i] * u[2]), at)
     return energy
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def explicit_step(
-    state, work, system, stiffness, capR, capx, load, step_index, fire, m, refresh, scratch, smooth, preconditioned
-):
-    """One explicit step with the capitate at target (capR, capx), or, for the loaded
-    driver, at rotation capR; `load` (`Load`) the driver's lines of action at this step's tensions; with st.block_mass and
-    `refresh`, the block mass m (`preconditioner.Metric`) is rebuilt at this state first; with
-    st.membrane_substeps the membrane's free nodes then take that many more steps of their own
-    (`membrane.substep`; scratch its arrays)."""
-    bod, _, _, _, mem, st = system
+def explicit_step(state, work, system, stiffness, target, step_index, refresh, carry, smooth, preconditioned):
+    """One explicit step, the `step_index`-th of the run, with the capitate at `target` (`Target`: its
+    rotation and centre, or, for the loaded driver, its rotation; the driver's lines at this step's
+    tensions); with st.block_mass and `refresh`, the block mass carry.metric (`preconditioner.Metric`) is
+    rebuilt at this state first; FIRE's state is carry.fire; with st.membrane_substeps the membrane's free
+    nodes then take that many more steps of their own (`membrane.substep`; carry.substeps its arrays)."""
+    bod, mem, st = system.bodies, system.membrane, system.settings
     R, x, v, w, nodes, nv = state
-    active, n_active, _, F, T, node_force, _, _ = work
-    copy_into(R[CAPITATE], capR)
+    node_force = work.node_force
+    m = carry.metric
+    copy_into(R[CAPITATE], target.rotation)
     if st.driver == EXPERIMENTAL:
-        x[CAPITATE, 0], x[CAPITATE, 1], x[CAPITATE, 2] = capx
+        x[CAPITATE, 0], x[CAPITATE, 1], x[CAPITATE, 2] = target.centre
         v[CAPITATE] = 0.0
     w[CAPITATE] = 0.0
-    net_forces(state, work, system, stiffness, load, np.bool_(False), np.bool_(False), smooth)
+    net_forces(state, work, system, stiffness, target.load, np.bool_(False), np.bool_(False), smooth)
     blocks = False
     if preconditioned:  # a compile-time constant: see `_run`
         blocks = st.block_mass
         if blocks and refresh:
-            tangent(R, x, nodes, system, stiffness, active, n_active, m, smooth)
+            tangent(state, system, stiffness, work, m, smooth)
             block_mass(R, bod, st, m)
     if st.fire_alpha0 > 0.0:
-        fire_step(v, w, nv, F, T, node_force, mem, st, fire, m, preconditioned)
+        fire_step(state, work, st, carry.fire, m, preconditioned)
     dt = st.dt
     lin = 1.0 / (1.0 + st.damping * dt)
     if blocks:
-        move_blocks(R, x, v, w, F, T, st, m)
+        move_blocks(state, work, st, m)
     else:
-        move_diagonal(R, x, v, w, F, T, bod, st)
+        move_diagonal(state, work, bod, st)
     if stiffness.node_mass > 0.0:
         for i in range(nodes.shape[0]):
             if mem.bone[i] < 0:
@@ -104,41 +99,29 @@ def explicit_step(
         if preconditioned:
             if st.membrane_substeps > 0:
                 place_nodes(R, x, bod.com0, mem, nodes)
-                substep(
-                    R,
-                    x,
-                    bod.com0,
-                    mem,
-                    nodes,
-                    nv,
-                    stiffness.m_l0,
-                    stiffness.m_K,
-                    stiffness.node_mass,
-                    st,
-                    scratch,
-                    smooth,
-                )
+                substep(state, system, stiffness, carry.substeps, smooth)
     if step_index % 100 == 0:
         for b in FREE:
             orthonormalize(R[b])
 
 
 @njit(cache=True, error_model="numpy")
-def predicted_start(state, work, system, stiffness, hist, capR, capx, load, move, smooth):
-    """Start the next stage, whose capitate pose is (capR, capx) under `load`, from the secant
-    predictor's state (`predictor.predict`) if the free bodies' residual there, with the capitate
-    already at that pose, is below their residual left where they are; True if so (the state is
-    the prediction), False if not (the positions are restored; the velocities, ~0 at the end of a
-    hold, stay zeroed)."""
+def predicted_start(state, work, system, stiffness, hist, target, move, smooth):
+    """Start the next stage, whose end puts the capitate and its lines at `target` (`Target`), from the
+    secant predictor's state (`predictor.predict`, from `History` hist; `move` the stage's capitate move,
+    mm) if the free bodies' residual there, with the capitate already at that pose, is below their
+    residual left where they are; True if so (the state is the prediction), False if not (the positions
+    are restored; the velocities, ~0 at the end of a hold, stay zeroed)."""
     mem, st = system.membrane, system.settings
-    R, x, v, w, nodes, nv = state
+    R, x, nodes = state.R, state.x, state.nodes
     keep_R, keep_x, keep_nodes = R.copy(), x.copy(), nodes.copy()
-    copy_into(R[CAPITATE], capR)
+    copy_into(R[CAPITATE], target.rotation)
     if st.driver == EXPERIMENTAL:
-        copy_into(x[CAPITATE], capx)
+        copy_into(x[CAPITATE], target.centre)
+    load = target.load
     net_forces(state, work, system, stiffness, load, np.bool_(False), np.bool_(False), smooth)
     before = residual(work.F, work.T, st)
-    if not predict(hist, R, x, v, w, nodes, nv, mem, st, move):
+    if not predict(hist, state, mem, st, move):
         restore(R, x, nodes, keep_R, keep_x, keep_nodes)
         return False
     net_forces(state, work, system, stiffness, load, np.bool_(False), np.bool_(False), smooth)
@@ -188,3 +171,11 @@ Load = namedtuple("Load", ["body", "point", "direction", "tension"])
 """The driver's loads as lines of action (the tendons where they enter, `drivers.Loads`): each line's
 body (n_lines,) int64, point (n_lines, 3) mm fixed in the body (RCS at neutral), direction (n_lines, 3)
 unit, RCS, and tension N: (n_lines,) at one state, (n_frames, n_lines) per frame in `Frames`."""
+Target = namedtuple("Target", ["rotation", "centre", "load"])
+"""Where a step, or a stage's end, puts the capitate and the driver's lines: its rotation (3, 3), its centre
+of mass (3,) mm (held by the experimental driver only: the loaded driver's centre is free), and the lines
+(`Load`) at that step's tensions (n_lines,) N."""
+Carry = namedtuple("Carry", ["fire", "metric", "substeps"])
+"""What `explicit_step` carries from one step to the next beside the `State`: FIRE's [alpha, steps with
+positive power, 1 after a restart] (3,) (`integrator.fire_step`), the block mass (`preconditioner.Metric`)
+and the membrane substeps' scratch (2, n_nodes, 3) (`membrane.new_scratch`)."""

@@ -46,8 +46,12 @@ def _lever(G, r):
 
 
 @njit(cache=True, error_model="numpy")
-def _add_block(K, i0, ni, Ga, k, j0, nj, Gb, H, sign):
-    """K[i0:i0+ni, j0:j0+nj] += sign · Ga k Gbᵀ (levers (6, 3), k (3, 3)); H (6, 3) scratch."""
+def _add_block(K, rows, Ga, cols, Gb, m, sign):
+    """K[i0:i0+ni, j0:j0+nj] += sign · Ga k Gbᵀ, rows = (i0, ni) and cols = (j0, nj) as `dof` gives them
+    (levers Ga, Gb (6, 3); k = m.coupling (3, 3); m.product (6, 3) scratch)."""
+    i0, ni = rows
+    j0, nj = cols
+    k, H = m.coupling, m.product
     for i in range(ni):
         for q in range(3):
             H[i, q] = Ga[i, 0] * k[0, q] + Ga[i, 1] * k[1, q] + Ga[i, 2] * k[2, q]
@@ -59,20 +63,20 @@ def _add_block(K, i0, ni, Ga, k, j0, nj, Gb, H, sign):
 @njit(cache=True, error_model="numpy")
 def add_point(K, st, a, ra, b, rb, m):
     """A point coupling m.coupling (3×3, N/mm) between body a at lever ra and body b at lever rb (mm,
-    world, from each centre of mass): GₐᵀkGₐ and G_bᵀkG_b on the diagonal, −GₐᵀkG_b and its transpose
-    off it (G = [I, −[r]×]: a body's move at the point)."""
-    ia, na = dof(st, a)
-    ib, nb = dof(st, b)
-    G, H, k = m.lever, m.product, m.coupling
+    world, from each centre of mass; 3-tuples): GₐᵀkGₐ and G_bᵀkG_b on the diagonal, −GₐᵀkG_b and its
+    transpose off it (G = [I, −[r]×]: a body's move at the point)."""
+    A = dof(st, a)
+    B = dof(st, b)
+    G = m.lever
     _lever(G[0], ra)
     _lever(G[1], rb)
-    if ia >= 0:
-        _add_block(K, ia, na, G[0], k, ia, na, G[0], H, 1.0)
-    if ib >= 0:
-        _add_block(K, ib, nb, G[1], k, ib, nb, G[1], H, 1.0)
-    if ia >= 0 and ib >= 0:
-        _add_block(K, ia, na, G[0], k, ib, nb, G[1], H, -1.0)
-        _add_block(K, ib, nb, G[1], k, ia, na, G[0], H, -1.0)
+    if A[0] >= 0:
+        _add_block(K, A, G[0], A, G[0], m, 1.0)
+    if B[0] >= 0:
+        _add_block(K, B, G[1], B, G[1], m, 1.0)
+    if A[0] >= 0 and B[0] >= 0:
+        _add_block(K, A, G[0], B, G[1], m, -1.0)
+        _add_block(K, B, G[1], A, G[0], m, -1.0)
 
 
 @njit(cache=True, error_model="numpy")
@@ -135,9 +139,11 @@ def _add_pair(K, st, a, b, R, x, S):
 
 
 @njit(cache=True, error_model="numpy")
-def _pair_sums(grids, b, M, samples, law, com0, S, J, smooth):
-    """S (6×6) ← Σ κ J Jᵀ over a pair's overclosed samples, J = [n; c×n] in the grid bone b's neutral
-    frame about its centre (κ = p′(ε)·A/h, N/mm); J (6,) scratch."""
+def _pair_sums(system, b, M, samples, S, J, smooth):
+    """S (6×6) ← Σ κ J Jᵀ over a pair's overclosed samples of `system` (`arrays.System`: its grids and
+    contact law), J = [n; c×n] in the grid bone b's neutral frame about its centre (κ = p′(ε)·A/h,
+    N/mm); J (6,) scratch."""
+    grids, law, com0 = system.grids, system.law, system.bodies.com0
     S[:] = 0.0
     for s in samples:
         if smooth:
@@ -160,11 +166,12 @@ def _pair_sums(grids, b, M, samples, law, com0, S, J, smooth):
 
 
 @njit(cache=True, error_model="numpy")
-def tangent(R, x, nodes, system, stiffness, active, n_active, m, smooth):
+def tangent(state, system, stiffness, work, m, smooth):
     """Assemble m.stiffness, the Gauss–Newton tangent of `system` (`arrays.System`) under a design's
-    `stiffness` at the state (R, x, nodes) over the active contact samples (as the last force evaluation
-    left them)."""
-    _, grids, law, fib, mem, st = system
+    `stiffness` (`step.Stiffness`) at `state` (`step.State`: R, x, nodes) over the active contact samples
+    of `work` (`step.Work`: active, n_active, as the last force evaluation left them)."""
+    R, x, nodes = state.R, state.x, state.nodes
+    grids, fib, mem, st = system.grids, system.fibres, system.membrane, system.settings
     com0 = system.bodies.com0
     K, S = m.stiffness, m.block
     K[:] = 0.0
@@ -175,13 +182,11 @@ def tangent(R, x, nodes, system, stiffness, active, n_active, m, smooth):
             continue
         M = pair_transform(R, x, com0, a, b)
         start = grids.sample_offsets[p]
-        _pair_sums(grids, b, M, active[start : start + n_active[p]], law, com0, S, J, smooth)
+        _pair_sums(system, b, M, work.active[start : start + work.n_active[p]], S, J, smooth)
         for u in range(6):
             for v in range(u):
                 S[u, v] = S[v, u]
         _add_pair(K, st, a, b, R, x, S)
-    ra = np.zeros(3)
-    rb = np.zeros(3)
     o, ins = fib.origin, fib.insertion
     for i in range(stiffness.f_l0.shape[0]):
         if stiffness.f_K[i] == 0.0:
@@ -189,7 +194,7 @@ def tangent(R, x, nodes, system, stiffness, active, n_active, m, smooth):
         a, b = fib.bones[i, 0], fib.bones[i, 1]
         pa = to_world(R, x, com0, a, o[i, 0], o[i, 1], o[i, 2])
         pb = to_world(R, x, com0, b, ins[i, 0], ins[i, 1], ins[i, 2])
-        _element(K, st, m, a, pa, b, pb, x, stiffness.f_K[i], stiffness.f_l0[i], ra, rb)
+        _element(K, st, m, x, (a, pa), (b, pb), stiffness.f_K[i], stiffness.f_l0[i])
     for c in range(stiffness.m_l0.shape[0]):
         i, j = mem.connectors[c, 0], mem.connectors[c, 1]
         a, b = mem.bone[i], mem.bone[j]
@@ -197,16 +202,19 @@ def tangent(R, x, nodes, system, stiffness, active, n_active, m, smooth):
             continue
         pa = (nodes[i, 0], nodes[i, 1], nodes[i, 2])
         pb = (nodes[j, 0], nodes[j, 1], nodes[j, 2])
-        _element(K, st, m, a, pa, b, pb, x, stiffness.m_K[c], stiffness.m_l0[c], ra, rb)
-    _membrane_contact(K, st, m, R, x, com0, mem, nodes, ra, rb)
-    _joint(K, st, m, R, x, com0, system.bodies, ra, rb)
+        _element(K, st, m, x, (a, pa), (b, pb), stiffness.m_K[c], stiffness.m_l0[c])
+    _membrane_contact(K, m, state, system)
+    _joint(K, m, state, system)
 
 
 @njit(cache=True, error_model="numpy")
-def _joint(K, st, m, R, x, com0, bod, ra, rb):
-    """The capitohamate joint's spring (`forces.joint_forces`): its shift stiffness between the hamate's and
-    the capitate's centre points, its turn stiffness on the hamate's rotations (the capitate's rotations are
-    prescribed: no unknowns)."""
+def _joint(K, m, state, system):
+    """The capitohamate joint's spring (`forces.joint_forces`) at `state`: its shift stiffness between the
+    hamate's and the capitate's centre points, its turn stiffness on the hamate's rotations (the capitate's
+    rotations are prescribed: no unknowns)."""
+    R, x = state.R, state.x
+    bod, st = system.bodies, system.settings
+    com0 = bod.com0
     k = bod.joint_stiffness
     c, E = bod.joint_centre, bod.joint_axes
     k_shift = m.coupling
@@ -221,16 +229,18 @@ def _joint(K, st, m, R, x, com0, bod, ra, rb):
                     K[i0 + 3 + p, i0 + 3 + q] += k[3 + a] * e[p] * e[q]
     ph = to_world(R, x, com0, HAMATE, c[0], c[1], c[2])
     pc = to_world(R, x, com0, CAPITATE, c[0], c[1], c[2])
-    for e in range(3):
-        ra[e] = ph[e] - x[HAMATE, e]
-        rb[e] = pc[e] - x[CAPITATE, e]
+    ra = (ph[0] - x[HAMATE, 0], ph[1] - x[HAMATE, 1], ph[2] - x[HAMATE, 2])
+    rb = (pc[0] - x[CAPITATE, 0], pc[1] - x[CAPITATE, 1], pc[2] - x[CAPITATE, 2])
     add_point(K, st, HAMATE, ra, CAPITATE, rb, m)
 
 
 @njit(cache=True, error_model="numpy")
-def _element(K, st, m, a, pa, b, pb, x, scale, l0, ra, rb):
-    """A Blankevoort element of scale `scale` (N) and zero-load length l0 (mm) between world points pa on
-    body a and pb on body b (a body < 0: a membrane's free node, not an unknown); nothing if slack."""
+def _element(K, st, m, x, end_a, end_b, scale, l0):
+    """A Blankevoort element of scale `scale` (N) and zero-load length l0 (mm) between its ends (a, pa) and
+    (b, pb): world points pa (mm) on body a and pb on body b (a body < 0: a membrane's free node, not an
+    unknown), bodies' centres of mass x (n_bodies, 3) mm; nothing if slack."""
+    a, pa = end_a
+    b, pb = end_b
     if dof(st, a)[0] < 0 and dof(st, b)[0] < 0:
         return
     dx, dy, dz = pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]
@@ -240,15 +250,17 @@ def _element(K, st, m, a, pa, b, pb, x, scale, l0, ra, rb):
         return
     along = blankevoort_slope(scale, strain) / l0
     _axial(m.coupling, dx / length, dy / length, dz / length, along, blankevoort_force(scale, strain) / length)
-    for e in range(3):
-        ra[e] = pa[e] - x[a, e] if a >= 0 else 0.0
-        rb[e] = pb[e] - x[b, e] if b >= 0 else 0.0
+    ra = (pa[0] - x[a, 0], pa[1] - x[a, 1], pa[2] - x[a, 2]) if a >= 0 else (0.0, 0.0, 0.0)
+    rb = (pb[0] - x[b, 0], pb[1] - x[b, 1], pb[2] - x[b, 2]) if b >= 0 else (0.0, 0.0, 0.0)
     add_point(K, st, max(a, -1), ra, max(b, -1), rb, m)
 
 
 @njit(cache=True, error_model="numpy")
-def _membrane_contact(K, st, m, R, x, com0, mem, nodes, r, node_lever):
-    """The membrane's free nodes pressing on the scaphoid: membrane_contact_stiffness (N/mm) along the normal."""
+def _membrane_contact(K, m, state, system):
+    """The membrane's free nodes of `state` pressing on the scaphoid: membrane_contact_stiffness (N/mm) along
+    the normal."""
+    R, x, nodes = state.R, state.x, state.nodes
+    com0, mem, st = system.bodies.com0, system.membrane, system.settings
     s = mem.scaphoid
     for i in range(nodes.shape[0]):
         if mem.bone[i] >= 0:
@@ -264,6 +276,5 @@ def _membrane_contact(K, st, m, R, x, com0, mem, nodes, r, node_lever):
         ny = (R[s, 1, 0] * gx + R[s, 1, 1] * gy + R[s, 1, 2] * gz) / gn
         nz = (R[s, 2, 0] * gx + R[s, 2, 1] * gy + R[s, 2, 2] * gz) / gn
         _axial(m.coupling, nx, ny, nz, st.membrane_contact_stiffness, 0.0)
-        for e in range(3):
-            r[e] = nodes[i, e] - x[s, e]
-        add_point(K, st, s, r, -1, node_lever, m)  # the node is no unknown: its lever is unused
+        r = (nodes[i, 0] - x[s, 0], nodes[i, 1] - x[s, 1], nodes[i, 2] - x[s, 2])
+        add_point(K, st, s, r, -1, (0.0, 0.0, 0.0), m)  # the node is no unknown: its lever is unused
