@@ -50,19 +50,22 @@ def _force_pass(n, state, work, system, design_arrays, load):
 @njit(cache=True, error_model="numpy")
 def _contact(n, state, work, system):
     for _ in range(n):
-        contact_forces(state, system, work, system.settings.active_band_mm, np.bool_(False), True)
+        band = system.settings.active_band_mm
+        contact_forces(state, system.bodies.com0, system.grids, system.law, work, band, np.bool_(False), True)
 
 
 @njit(cache=True, error_model="numpy")
 def _fibres(n, state, work, system, d):
     for _ in range(n):
-        fibre_forces(state, system, d, work, np.bool_(False))
+        damping_s = system.settings.fibre_damping_s
+        fibre_forces(state, system.bodies.com0, system.fibres, damping_s, d, work, np.bool_(False))
 
 
 @njit(cache=True, error_model="numpy")
 def _membrane(n, state, work, system, d):
     for _ in range(n):
-        membrane_forces(state, system, d, work, np.bool_(False), True)
+        k = system.settings.membrane_contact_stiffness
+        membrane_forces(state, system.bodies.com0, system.membrane, k, d, work, np.bool_(False), True)
 
 
 @njit(cache=True, error_model="numpy")

@@ -35,7 +35,8 @@ def _shaken_neutral(model, shake_mm, seed):
 
     def exact():
         work = new_work(p.grids, nodes)
-        membrane_forces(_state(R, x, nodes), p.system, s, work, False, True)
+        k = p.settings.membrane_contact_stiffness
+        membrane_forces(_state(R, x, nodes), p.bodies.com0, p.membrane, k, s, work, False, True)
         return work.node_force
 
     return R, x, nodes, free, p, s, exact

@@ -65,7 +65,7 @@ def test_pressure_map_sums_to_the_solver_contact_force_at_the_same_state(p1, swe
         state = State(R, x, np.zeros((N_BODIES, 3)), np.zeros((N_BODIES, 3)), nodes, nodes)
         work = new_work(grids, nodes)  # its ref unset: every pair refills
         every = 1e9  # a band holding every sample
-        forces.contact_forces(state, system, work, every, True, False)
+        forces.contact_forces(state, system.bodies.com0, system.grids, system.law, work, every, True, False)
         stats = work.stats
         assert work.n_active.sum() == n
         p = pressure_map(p1, sweep.poses[f])

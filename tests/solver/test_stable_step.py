@@ -42,7 +42,6 @@ def test_membrane_eigenvalue_matches_the_force_kernels_jacobian(p1):
     nodes = mem.rest.copy()
     place_nodes(R, x, p1.com, mem, nodes)
     free = np.flatnonzero(np.asarray(p1.membrane_bone) < 0)
-    no_contact = p.system._replace(settings=p.settings._replace(membrane_contact_stiffness=0.0))
     connectors = Stiffness(np.zeros(0), np.zeros(0), m_l0, m_K, 0.0)
 
     def forces(q):
@@ -50,7 +49,7 @@ def test_membrane_eigenvalue_matches_the_force_kernels_jacobian(p1):
         moved[free] += q.reshape(-1, 3)
         state = State(R, x, np.zeros((N_BODIES, 3)), np.zeros((N_BODIES, 3)), moved, np.zeros_like(moved))
         work = new_work(p.grids, moved)
-        membrane_forces(state, no_contact, connectors, work, False, True)
+        membrane_forces(state, p.bodies.com0, p.membrane, 0.0, connectors, work, False, True)  # no contact
         return work.node_force[free].ravel()
 
     h = 1e-6

@@ -186,9 +186,12 @@ def sample_pressures(R, x, com0, grids, law, pressure):
 
 
 @njit(cache=True, error_model="numpy")
-def contact_forces(state, system, work, band_mm, want_energy, smooth):
-    """Contact forces of all pairs' active samples at `state` (`step.State`) of `system` (`arrays.System`)
-    into work.F (N) and work.T (N·mm) (`step.Work`); returns contact energy (N·mm; 0 unless `want_energy`).
+def contact_forces(state, com0, grids, law, work, band_mm, want_energy, smooth):
+    """Contact forces of all pairs' active samples at `state` (`step.State`) of the bodies whose neutral centres
+    of mass are com0 (n_bodies, 3) mm, on the pairs' `arrays.Grids` under their `arrays.Law`, into work.F (N)
+    and work.T (N·mm) (`step.Work`); returns contact energy (N·mm; 0 unless `want_energy`). It takes the
+    parts of `arrays.System` it reads, not the whole: a call passes each array's fields, and the whole
+    System's cost a measurable share of a step in a kernel called every step.
 
     A pair's active samples (work.active, work.n_active: those within `band_mm` of contact) are
     refilled when its samples may have moved band_mm / 2 since the last refill (`_travel`; work.ref:
@@ -200,7 +203,6 @@ def contact_forces(state, system, work, band_mm, want_energy, smooth):
     (mm²), peak pressure (MPa).
     """
     R, x = state.R, state.x
-    com0, grids, law = system.bodies.com0, system.grids, system.law
     active, n_active, ref, F, T, stats = work.active, work.n_active, work.ref, work.F, work.T, work.stats
     energy = 0.0
     stats[:] = 0.0
@@ -270,16 +272,15 @@ def contact_forces(state, system, work, band_mm, want_energy, smooth):
 
 
 @njit(cache=True, error_model="numpy")
-def fibre_forces(state, system, stiffness, work, want_energy):
-    """Blankevoort fibre forces at `state` (`step.State`) of `system` (`arrays.System`: its `Fibres`, damped
-    by its settings' fibre_damping_s) into work.F (N) and work.T (N·mm) (`step.Work`); returns strain
-    energy (N·mm; 0 unless `want_energy`).
+def fibre_forces(state, com0, fibres, damping_s, stiffness, work, want_energy):
+    """Blankevoort fibre forces at `state` (`step.State`) of the bodies whose neutral centres of mass are com0
+    (n_bodies, 3) mm, on the `arrays.Fibres` damped by damping_s (s), into work.F (N) and work.T (N·mm)
+    (`step.Work`); returns strain energy (N·mm; 0 unless `want_energy`).
 
     stiffness.f_l0, stiffness.f_K (`step.Stiffness`): per-fibre zero-load length (mm) and scale (N per
     unit strain), K = 0 if torn. work.bundle (n_bundles,) receives the summed tension of each bundle (N).
     """
     R, x, v, w = state.R, state.x, state.v, state.w
-    com0, fibres, damping_s = system.bodies.com0, system.fibres, system.settings.fibre_damping_s
     l0, K = stiffness.f_l0, stiffness.f_K
     F, T, bundle_force = work.F, work.T, work.bundle
     energy = 0.0

@@ -55,12 +55,11 @@ def connector_pull(nodes, i, j, l0, K):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def node_contact(state, system, i, smooth):
-    """The scaphoid's push (N, world) on membrane node i of `state` (`step.State`) of `system`
-    (`arrays.System`: its settings' membrane_contact_stiffness, N/mm), the node's signed distance (mm)
-    and whether it touches (a negative distance with a normal; else no push)."""
+def node_contact(state, com0, mem, contact_stiffness, i, smooth):
+    """The scaphoid's push (N, world) on node i of the membrane `mem` (`arrays.Membrane`) at `state`
+    (`step.State`; com0 (n_bodies, 3) mm the bodies' neutral centres of mass) under contact_stiffness (N/mm),
+    the node's signed distance (mm) and whether it touches (a negative distance with a normal; else no push)."""
     R, x, nodes = state.R, state.x, state.nodes
-    com0, mem, contact_stiffness = system.bodies.com0, system.membrane, system.settings.membrane_contact_stiffness
     s = mem.scaphoid
     qx, qy, qz = to_local(R, x, com0, s, nodes[i, 0], nodes[i, 1], nodes[i, 2])
     if smooth:
@@ -115,9 +114,10 @@ def connector_forces(mem, nodes, l0, K, force, want_energy):
 
 
 @njit(cache=True, error_model="numpy")
-def membrane_forces(state, system, stiffness, work, want_energy, smooth):
-    """RSC membrane (system.membrane, `arrays.System`): connector tension (stiffness.m_l0, stiffness.m_K,
-    `step.Stiffness`) and node–scaphoid contact (the settings' membrane_contact_stiffness, N/mm).
+def membrane_forces(state, com0, mem, contact_stiffness, stiffness, work, want_energy, smooth):
+    """RSC membrane (`mem`, `arrays.Membrane`): connector tension (stiffness.m_l0, stiffness.m_K,
+    `step.Stiffness`) and node–scaphoid contact (contact_stiffness, N/mm; com0 (n_bodies, 3) mm the bodies'
+    neutral centres of mass). The parts of `arrays.System` it reads, not the whole (`forces.contact_forces`).
 
     state.nodes (n_nodes, 3): world positions (attached nodes already placed on their bones).
     work.node_force (n_nodes, 3) receives forces (N) on the free nodes; forces on attached
@@ -125,7 +125,6 @@ def membrane_forces(state, system, stiffness, work, want_energy, smooth):
     the membrane's radial row of along connectors).
     """
     x, nodes = state.x, state.nodes
-    mem, contact_stiffness = system.membrane, system.settings.membrane_contact_stiffness
     l0, K = stiffness.m_l0, stiffness.m_K
     F, T, node_force = work.F, work.T, work.node_force
     node_force[:] = 0.0
@@ -133,7 +132,7 @@ def membrane_forces(state, system, stiffness, work, want_energy, smooth):
     for i in range(nodes.shape[0]):
         if mem.bone[i] >= 0:
             continue
-        fx, fy, fz, d, touching = node_contact(state, system, i, smooth)
+        fx, fy, fz, d, touching = node_contact(state, com0, mem, contact_stiffness, i, smooth)
         if touching:
             node_force[i, 0] += fx
             node_force[i, 1] += fy
@@ -155,7 +154,7 @@ def membrane_forces(state, system, stiffness, work, want_energy, smooth):
     return energy, along
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _gaps(state, system, gap, travel):
     """gap (n_nodes,) ← each free node of `state` (`step.State`)'s signed distance (mm) to the scaphoid
     of `system` (`arrays.System`) (+inf for an attached node); travel (n_nodes,) ← 0."""
@@ -172,18 +171,19 @@ def _gaps(state, system, gap, travel):
             )
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _substep_forces(state, system, stiffness, gap, travel, force, smooth):
     """force (n_nodes, 3) N ← connector tensions (stiffness.m_l0, stiffness.m_K) and the scaphoid's contact
     on the nodes of `state`, looked up only on the free nodes that may touch it (gap − √3·travel < 0:
     `LIPSCHITZ`), whose gap and travel (n_nodes,) then restart there."""
-    nodes = state.nodes
+    nodes, com0, mem = state.nodes, system.bodies.com0, system.membrane
+    k = system.settings.membrane_contact_stiffness
     force[:] = 0.0
-    connector_forces(system.membrane, nodes, stiffness.m_l0, stiffness.m_K, force, np.bool_(False))
+    connector_forces(mem, nodes, stiffness.m_l0, stiffness.m_K, force, np.bool_(False))
     for i in range(nodes.shape[0]):
         if not gap[i] - LIPSCHITZ * travel[i] < 0.0:
             continue
-        fx, fy, fz, gap[i], _ = node_contact(state, system, i, smooth)
+        fx, fy, fz, gap[i], _ = node_contact(state, com0, mem, k, i, smooth)
         travel[i] = 0.0
         force[i, 0] += fx
         force[i, 1] += fy

@@ -43,10 +43,13 @@ def net_forces(state, work, system, stiffness, load, rebuild, want_energy, smoot
     F[:] = 0.0
     T[:] = 0.0
     bundle[:] = 0.0
-    energy = contact_forces(state, system, work, system.settings.active_band_mm, want_energy, smooth)
-    energy += fibre_forces(state, system, stiffness, work, want_energy)
+    st, mem = system.settings, system.membrane
+    # each force kernel takes the parts of the System it reads (a whole System's fields cost a call)
+    energy = contact_forces(state, com0, system.grids, system.law, work, st.active_band_mm, want_energy, smooth)
+    energy += fibre_forces(state, com0, system.fibres, st.fibre_damping_s, stiffness, work, want_energy)
     energy += joint_forces(state, system.bodies, work, want_energy)
-    e_mem, rsc = membrane_forces(state, system, stiffness, work, want_energy, smooth)
+    k_mem = st.membrane_contact_stiffness
+    e_mem, rsc = membrane_forces(state, com0, mem, k_mem, stiffness, work, want_energy, smooth)
     energy += e_mem
     bundle[RSC] += rsc
     tension = load.tension
