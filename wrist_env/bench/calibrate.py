@@ -82,10 +82,12 @@ class CalibrationRun:
         The calibrator's result (``x`` of shape (22,): the best 22 normalized materials).
     design : Design
         The calibrated design (injury intact); ``design.as_dict()`` in physical units.
-    calibrate, validate : dict
+    calibrate : dict
         ``{"cost", "failed", "rmse", "error_p75", "unsettled_frames"}`` of the calibrated design on the
-        calibration trial and on the held-out resisted trial (rmse, error_p75: ``{bone: {DOF: mm or
-        deg}}``; unsettled_frames: frames whose hold ran out before equilibrium, None if failed).
+        calibration trial (rmse, error_p75: ``{bone: {DOF: mm or deg}}``; unsettled_frames: frames whose
+        hold ran out before equilibrium, None if failed).
+    validate : dict
+        The same on the held-out resisted trial.
     recovery_z : float or None
         RMS of z(calibrated) − z(truth) over the 22 materials (Table 2 SD units); None without a hidden
         truth.
