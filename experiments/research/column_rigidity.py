@@ -2,7 +2,7 @@
 of the capitate over the sweep (issue 54, step 5).
 
 Akhbari et al. 2019 (J Orthop Res 37:2661) measured the distal row moving as one, each bone within 3°
-of the capitate; `validate` checks it (`column_rotation_deg`, `hamate_rotation_deg`). Neither joint's
+of the capitate; `validate` checks it (`largest_rotation_deg`). Neither joint's
 constraint that would bound that turn is measured for the radial column: no mechanical test of the
 trapezoid–capitate interosseous ligament was found, and the 2nd and 3rd carpometacarpal joints, which
 bind the trapezoid and capitate through the metacarpal bases, are measured only as ranges of motion
@@ -33,7 +33,7 @@ from wrist_env.solver import arrays
 from wrist_env.solver.drivers import idealized
 from wrist_env.solver.simulate import simulate
 from wrist_env.validation.checks import IDEALIZED_LOAD_N
-from wrist_env.validation.measures import column_rotation_deg, hamate_rotation_deg
+from wrist_env.validation.measures import largest_rotation_deg
 
 SCALES = (1.0, 2.0, 4.0, 8.0, 16.0)
 COLUMN_BANDS = ("TZC_p", "TZC_d")
@@ -64,7 +64,7 @@ def turns(model) -> tuple[float, float]:
     result = sweep(model)
     if not result.ok:
         return float("nan"), float("nan")
-    return column_rotation_deg(result.poses), hamate_rotation_deg(result.poses)
+    return largest_rotation_deg(result.poses, TRAPEZIUM), largest_rotation_deg(result.poses, HAMATE)
 
 
 def turn_axis_deg(poses: np.ndarray, body: int) -> np.ndarray:

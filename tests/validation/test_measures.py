@@ -5,7 +5,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from wrist_env.model import CAPITATE, HAMATE, N_BODIES, TRAPEZIUM
-from wrist_env.validation import SOURCES, column_rotation_deg, hamate_rotation_deg
+from wrist_env.validation import SOURCES, largest_rotation_deg
 
 
 def _poses(n_frames: int) -> np.ndarray:
@@ -22,12 +22,14 @@ def test_the_hamates_turn_is_measured_from_the_capitate_not_from_neutral():
         for b in (CAPITATE, HAMATE, TRAPEZIUM):
             poses[f, b, :3, :3] = flex
             poses[f, b, :3, 3] = (0.5 * f, -0.2, 1.0)
-    assert hamate_rotation_deg(poses) < 1e-4 and column_rotation_deg(poses) < 1e-4
+    assert largest_rotation_deg(poses, HAMATE) < 1e-4 and largest_rotation_deg(poses, TRAPEZIUM) < 1e-4
     extra = Rotation.from_rotvec(np.radians(2.5) * np.array([0.6, 0.0, 0.8])).as_matrix()
     poses[3, HAMATE, :3, :3] = extra @ poses[3, CAPITATE, :3, :3]
-    assert np.isclose(hamate_rotation_deg(poses), 2.5) and column_rotation_deg(poses) < 1e-4
+    assert np.isclose(largest_rotation_deg(poses, HAMATE), 2.5) and largest_rotation_deg(poses, TRAPEZIUM) < 1e-4
     poses[1, TRAPEZIUM, :3, :3] = extra @ poses[1, CAPITATE, :3, :3]
-    assert np.isclose(column_rotation_deg(poses), 2.5) and np.isclose(hamate_rotation_deg(poses), 2.5)
+    assert np.isclose(largest_rotation_deg(poses, TRAPEZIUM), 2.5) and np.isclose(
+        largest_rotation_deg(poses, HAMATE), 2.5
+    )
 
 
 def test_the_hamates_check_cites_the_distal_rows_rigidity():

@@ -14,14 +14,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wrist_env.model import MIDCARPAL
+from wrist_env.model import HAMATE, MIDCARPAL, TRAPEZIUM
 from wrist_env.validation.bands import (
     EXTENSION_30_DEG,
     SL_DISSOCIATION_MM,
     ULNAR_SHARE_PCT,
     VIEGAS_1993,
 )
-from wrist_env.validation.measures import at_angle, column_rotation_deg, hamate_rotation_deg, slope
+from wrist_env.validation.measures import at_angle, largest_rotation_deg, slope
 from wrist_env.validation.report import Check
 from wrist_env.validation.simulations import LOAD_MODES, RL, RS, Simulations
 
@@ -97,11 +97,11 @@ def _share_pct(articulation: str) -> Callable[[Simulations], float]:
 
 
 def _column_rotation_deg(s: Simulations) -> float:
-    return column_rotation_deg(s.intact.poses)
+    return largest_rotation_deg(s.intact.poses, TRAPEZIUM)
 
 
 def _hamate_rotation_deg(s: Simulations) -> float:
-    return hamate_rotation_deg(s.intact.poses)
+    return largest_rotation_deg(s.intact.poses, HAMATE)
 
 
 def _sl_gap_growth_mm(s: Simulations) -> float:

@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from wrist_env import design as design_mod
-from wrist_env.model import BONES, CAPITATE, HAMATE, MIDCARPAL, TRAPEZIUM, Model
+from wrist_env.model import BONES, CAPITATE, MIDCARPAL, Model
 from wrist_env.solver.outputs import articulation_forces
 
 
@@ -21,38 +21,25 @@ def rotation_from_capitate_deg(poses: np.ndarray, body: int) -> np.ndarray:
     return np.degrees(np.arccos(cos))
 
 
-def column_rotation_deg(poses: np.ndarray) -> float:
-    """The radial column's largest rotation (deg) relative to the capitate over a run's poses.
+def largest_rotation_deg(poses: np.ndarray, body: int) -> float:
+    """The largest rotation (deg) of `body` relative to the capitate over a run's poses.
+
+    The validation's measure of the distal row's rigidity: the radial column (`model.TRAPEZIUM`) and the
+    hamate each turn < 3 deg from the capitate (Akhbari 2019, J Orthop Res 37:2661).
 
     Parameters
     ----------
     poses : ndarray, shape (n_frames, n_bodies, 4, 4)
         The bodies' poses per frame (neutral → frame; mm).
+    body : int
+        The body's index (`model.BONES`).
 
     Returns
     -------
     float
-        The trapezium's largest rotation relative to the capitate over the frames, deg.
+        Its largest rotation relative to the capitate over the frames, deg.
     """
-    return float(rotation_from_capitate_deg(poses, TRAPEZIUM).max())
-
-
-def hamate_rotation_deg(poses: np.ndarray) -> float:
-    """The hamate's largest rotation (deg) relative to the capitate over a run's poses.
-
-    The distal row moves rigidly together, < 3 deg (Akhbari 2019, J Orthop Res 37:2661).
-
-    Parameters
-    ----------
-    poses : ndarray, shape (n_frames, n_bodies, 4, 4)
-        The bodies' poses per frame (neutral → frame; mm).
-
-    Returns
-    -------
-    float
-        The hamate's largest rotation relative to the capitate over the frames, deg.
-    """
-    return float(rotation_from_capitate_deg(poses, HAMATE).max())
+    return float(rotation_from_capitate_deg(poses, body).max())
 
 
 def slope(x: ArrayLike, y: ArrayLike) -> float:
