@@ -266,12 +266,7 @@ def for_motion(
         return trial_driver(model, trial, direction)
     if trial is not None:
         raise InputError(f"the {motion!r} motion takes no trial")
+    frames = {} if n_frames is None else {"n_frames": n_frames}  # else each driver's own default
     if motion == IDEALIZED:
-        return idealized(
-            model,
-            flexion_deg=flexion_deg,
-            extension_deg=extension_deg,
-            n_frames=17 if n_frames is None else n_frames,
-            direction=direction,
-        )
-    return static(model, 3 if n_frames is None else n_frames)
+        return idealized(model, flexion_deg=flexion_deg, extension_deg=extension_deg, direction=direction, **frames)
+    return static(model, **frames)
