@@ -10,15 +10,21 @@ import tempfile
 
 import pytest
 
-WARM = "from wrist_env.solver.settings import solver_settings\nfrom wrist_env.solver.simulate import warm\nwarm(solver_settings({!r}))\n"
+WARM = (
+    "from wrist_env.participants.registry import warm_solver\n"
+    "from wrist_env.solver.settings import solver_settings\n"
+    "warm_solver(solver_settings({!r}))\n"
+)
 PARTS_PROBE = (
     "import json, sys\n"
+    "from wrist_env.participants.registry import load_model\n"
     "from wrist_env.solver import parts, precompile, simulate\n"
     "from wrist_env.solver.settings import SolverSettings\n"
-    "precompile._start = lambda entry, smooth: None\n"
-    "parts.compile_parts(SolverSettings())\n"
-    "simulate.warm()\n"
-    "found = [d for d, _ in parts.part_signatures(SolverSettings())]\n"
+    "precompile._wanted = lambda entry: False\n"
+    "model = load_model('P1')\n"
+    "parts.compile_parts(model, SolverSettings())\n"
+    "simulate.warm(model)\n"
+    "found = [d for d, _ in parts.part_signatures(model, SolverSettings())]\n"
     "cold = not any(d.stats.cache_hits for d in found)\n"
     "counts = [[d.py_func.__name__, len(d.signatures)] for d in found]\n"
     "json.dump({'cold': cold, 'signatures': counts}, open(sys.argv[1], 'w'))\n"

@@ -36,17 +36,19 @@ def test_a_default_simulation_compiles_one_entry_point_and_workers_compile_none(
     instead of compiling it."""
     (tmp_path / "probe.py").write_text(
         "def first_simulation():\n"
-        "    from wrist_env.solver import kernel, simulate\n"
-        "    simulate.warm()\n"
+        "    from wrist_env.participants.registry import warm_solver\n"
+        "    from wrist_env.solver import kernel\n"
+        "    warm_solver()\n"
         "    entry = kernel.run_preconditioned\n"
         "    return sum(entry.stats.cache_hits.values()), sum(entry.stats.cache_misses.values())\n"
     )
     (tmp_path / "main.py").write_text(
         "from probe import first_simulation\n"
+        "from wrist_env.participants.registry import warm_solver\n"
         "from wrist_env.runs.executor import executor\n"
         "from wrist_env.solver import kernel\n"
         "if __name__ == '__main__':\n"
-        "    with executor(workers=2) as ex:\n"
+        "    with executor(workers=2, warm=warm_solver) as ex:\n"
         "        entries = (kernel.run, kernel.run_preconditioned, kernel.run_trilinear, kernel.run_trilinear_preconditioned)\n"
         "        print(' '.join(f.__name__ for f in entries if f.signatures))\n"
         "        print(*ex.submit(first_simulation).result())\n"
@@ -76,10 +78,12 @@ def test_the_parts_a_second_process_compiles_are_the_ones_the_entry_point_calls(
     probe = (
         "from wrist_env.solver import parts, precompile, simulate\n"
         "from wrist_env.solver.settings import SolverSettings\n"
-        "precompile._start = lambda entry, smooth: None\n"
-        "parts.compile_parts(SolverSettings())\n"
-        "simulate.warm()\n"
-        "for dispatcher, _ in parts.part_signatures(SolverSettings()):\n"
+        "from wrist_env.participants.registry import load_model\n"
+        "precompile._wanted = lambda entry: False\n"
+        "model = load_model('P1')\n"
+        "parts.compile_parts(model, SolverSettings())\n"
+        "simulate.warm(model)\n"
+        "for dispatcher, _ in parts.part_signatures(model, SolverSettings()):\n"
         "    print(dispatcher.py_func.__name__, len(dispatcher.signatures))\n"
     )
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
@@ -89,15 +93,15 @@ def test_the_parts_a_second_process_compiles_are_the_ones_the_entry_point_calls(
 
 
 def test_a_second_process_compiles_only_from_an_empty_cache():
-    """`precompile.start` starts nothing for the diagonal mass's entry point (it has no block mass) nor for
-    one this process has compiled or loaded already."""
+    """`precompile.wanted` is False for the diagonal mass's entry point (it has no block mass) and for one this
+    process has compiled or loaded already."""
+    from wrist_env.participants.registry import warm_solver
     from wrist_env.solver import precompile
-    from wrist_env.solver.simulate import warm
 
-    assert precompile.start(settings_tuple(SolverSettings().diagonal(), EXPERIMENTAL)) is None
-    warm()
+    assert not precompile.wanted(settings_tuple(SolverSettings().diagonal(), EXPERIMENTAL))
+    warm_solver()
     assert kernel.run_preconditioned.signatures
-    assert precompile.start(settings_tuple(SolverSettings(), EXPERIMENTAL)) is None
+    assert not precompile.wanted(settings_tuple(SolverSettings(), EXPERIMENTAL))
 
 
 def test_the_second_process_imports_this_package_not_one_in_the_working_folder(tmp_path, monkeypatch):
@@ -109,9 +113,9 @@ def test_the_second_process_imports_this_package_not_one_in_the_working_folder(t
 
     (tmp_path / "wrist_env").mkdir()
     monkeypatch.chdir(tmp_path)
-    command, home = precompile.helper_command(True)
+    command, home = precompile.helper_command(True, tmp_path / "model")
     probe = "import wrist_env.solver.parts as p; print(p.__file__)"
     done = subprocess.run([command[0], "-c", probe], cwd=home, capture_output=True, text=True)
     assert done.returncode == 0, done.stderr[-2000:]
     assert Path(done.stdout.strip()).resolve().parents[2] == Path(wrist_env.__file__).resolve().parents[1]
-    assert command[1:] == ["-m", "wrist_env.solver.parts", "smooth"]
+    assert command[1:] == ["-m", "wrist_env.solver.parts", "smooth", str(tmp_path / "model")]

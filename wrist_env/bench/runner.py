@@ -264,7 +264,7 @@ def benchmark(
     bar = _bar(progress, total, sum(min(log.progress().get(k.name, 0), k.budget) for k in cells), len(cells), len(done))
     folders = tuple(str(f) for f in folders)
     try:
-        with executor(scheduler, workers, threads) as ex:
+        with executor(scheduler, workers, threads, warm=registry.warm_solver) as ex:
             report.workers, report.threads, report.scheduler = ex.workers, ex.threads, ex.scheduler
             handles = {}
             for key in todo:

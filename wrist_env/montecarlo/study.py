@@ -253,7 +253,7 @@ def _run_locked(
 
         bar = tqdm(total=config.n * len(config.participants), unit="run", desc="Monte Carlo", smoothing=0.05)
     try:
-        with executor(scheduler, workers) as ex:
+        with executor(scheduler, workers, warm=registry.warm_solver) as ex:
             while True:
                 rounds = {}
                 for p in config.participants:

@@ -26,6 +26,7 @@ from wrist_env.participants import folder as folder_module  # by module: tests c
 from wrist_env.participants.bone_mesh import solid_mask
 
 if TYPE_CHECKING:
+    from wrist_env.solver.settings import SolverSettings
     from wrist_env.trial import Trial
 
 _FOLDERS: dict[str, Path] = {}
@@ -217,6 +218,23 @@ def cache_lock(path: Path) -> Iterator[None]:
             fcntl.flock(handle, fcntl.LOCK_UN)
 
 
+def warm_solver(settings: SolverSettings | None = None) -> None:
+    """Compile (or load from Numba's cache) the solver's entry point for `settings`, on built-in P1.
+
+    What a study runs before its local worker processes start (`runs.executor(warm=...)`), so that each loads
+    the compiled kernel instead of compiling it: P1 is shipped with the package, so nothing is built, and the
+    kernel's types do not depend on the participant (`simulate.warm`).
+
+    Parameters
+    ----------
+    settings : SolverSettings, optional
+        The solver's settings (default ``SolverSettings()``).
+    """
+    from wrist_env.solver.simulate import warm  # loads Numba
+
+    warm(load_model("P1"), settings)
+
+
 def check_cache(path: Path) -> None:
     """`StoreError` naming the folder or file unless a model can be cached at `path` (`.npz` + `.json`)."""
     advice = "set WRIST_ENV_CACHE to a writable folder, or load with cache=False"
@@ -246,4 +264,5 @@ __all__ = [
     "require",
     "trial",
     "trials",
+    "warm_solver",
 ]

@@ -146,15 +146,16 @@ class Inline(Executor):
 
 
 class Processes(Executor):
-    """Tasks on `workers` spawned local processes with `threads` Numba threads each (default ⌊cores / workers⌋)."""
+    """Tasks on `workers` spawned local processes with `threads` Numba threads each (default ⌊cores / workers⌋),
+    started after `warm()`, if given, ran here (it compiles the kernels the tasks call: each worker then loads them
+    from Numba's cache instead of compiling them)."""
 
-    def __init__(self, workers: int, threads: int | None = None):
+    def __init__(self, workers: int, threads: int | None = None, warm: Callable[[], object] | None = None):
         import multiprocessing
         from concurrent.futures import ProcessPoolExecutor
 
-        from wrist_env.solver.simulate import warm
-
-        warm()  # compile once here; the workers load it from Numba's cache instead of each compiling it
+        if warm is not None:
+            warm()
         self.workers = max(1, int(workers))
         self.threads = threads if threads is not None else max(1, (os.cpu_count() or 1) // self.workers)
         self.pool = ProcessPoolExecutor(
@@ -295,7 +296,10 @@ def _connect(address: str) -> distributed.Client:
 
 
 def executor(
-    scheduler: str | distributed.Client | None = None, workers: int = 0, threads: int | None = None
+    scheduler: str | distributed.Client | None = None,
+    workers: int = 0,
+    threads: int | None = None,
+    warm: Callable[[], object] | None = None,
 ) -> Executor:
     """Dask if `scheduler` is given, else `workers` local processes (≥ 2), else this process.
 
@@ -307,6 +311,10 @@ def executor(
         Local worker processes; 0 or 1 run the tasks in this process.
     threads : int, optional
         Numba threads per local process (default ⌊cores / workers⌋ for processes).
+    warm : callable, optional
+        Called once, with no arguments, before local processes start: what compiles the kernels their tasks
+        call (`participants.registry.warm_solver`), so that each loads them from Numba's cache instead of
+        compiling them. Not called for dask or this process.
 
     Returns
     -------
@@ -324,5 +332,5 @@ def executor(
     if scheduler is not None:
         return Dask(scheduler)
     if workers and int(workers) > 1:
-        return Processes(int(workers), threads)
+        return Processes(int(workers), threads, warm)
     return Inline(threads)

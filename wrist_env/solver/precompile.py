@@ -11,8 +11,9 @@ compiling it, if it is there by then (a part still compiling is compiled twice: 
 on P1's trial from an empty cache, a warm-up took 38–39 s instead of 57 s on 2 cores (the tangent and the
 substeps loaded, the mass compiled in both).
 
-The second process runs `wrist_env.solver.parts` (`python -m wrist_env.solver.parts {smooth,trilinear}`),
-which holds what it compiles; this module only decides whether to start it, and starts it.
+The second process runs `wrist_env.solver.parts` (`python -m wrist_env.solver.parts {smooth,trilinear} MODEL`)
+on the simulated model, saved for it to a temporary folder (its arrays type the kernels); `parts` holds what it
+compiles, this module only decides whether to start it, and starts it.
 """
 
 from __future__ import annotations
@@ -20,10 +21,15 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import tempfile
 from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from wrist_env.solver import kernel
+
+if TYPE_CHECKING:
+    from wrist_env.model import Model
 
 NORMALS = ("smooth", "trilinear")
 """The two kinds of contact normal, each its own compiled kernels (`SolverSettings.smooth_normals`)."""
@@ -38,39 +44,46 @@ def cold(entry) -> bool:
         return False
 
 
-def start(settings) -> subprocess.Popen | None:
-    """A process compiling the parts for the kernel `Settings` `settings` (`arrays.settings_tuple`), if its
-    entry point is a preconditioned one, not compiled or loaded in this process yet, with nothing in the
-    cache, on a machine with more than one core; else None."""
-    return _start(kernel.entry(settings), bool(settings.smooth_normals))
+def wanted(settings) -> bool:
+    """Whether `compiling` starts a second process for the kernel `Settings` `settings` (`arrays.settings_tuple`):
+    its entry point is a preconditioned one, not compiled or loaded in this process yet, with nothing in the
+    cache, on a machine with more than one core."""
+    return _wanted(kernel.entry(settings))
 
 
-def _start(entry, smooth: bool) -> subprocess.Popen | None:
+def _wanted(entry) -> bool:
     preconditioned = entry in (kernel.run_preconditioned, kernel.run_trilinear_preconditioned)
-    if not preconditioned or entry.signatures or (os.cpu_count() or 1) < 2 or not cold(entry):
-        return None
-    command, home = helper_command(smooth)
+    return preconditioned and not entry.signatures and (os.cpu_count() or 1) >= 2 and cold(entry)
+
+
+def _start(smooth: bool, model: Model, folder: Path) -> subprocess.Popen:
+    """The second process, on `model` saved into `folder`."""
+    model.save(folder / "model")
+    command, home = helper_command(smooth, folder / "model")
     return subprocess.Popen(command, cwd=home, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
 
-def helper_command(smooth: bool) -> tuple[list[str], Path]:
-    """The second process's command and working folder: the folder holding this very package, so that
-    `-m` imports it and not another copy found first from the working folder (a checkout beside an
-    installed copy): its cache is the one this process reads."""
+def helper_command(smooth: bool, model: Path) -> tuple[list[str], Path]:
+    """The second process's command (on the model saved at `model`, without its suffixes) and working folder:
+    the folder holding this very package, so that `-m` imports it and not another copy found first from the
+    working folder (a checkout beside an installed copy): its cache is the one this process reads."""
     normals = NORMALS[0] if smooth else NORMALS[1]
-    return [sys.executable, "-m", "wrist_env.solver.parts", normals], Path(__file__).resolve().parents[2]
+    return [sys.executable, "-m", "wrist_env.solver.parts", normals, str(model)], Path(__file__).resolve().parents[2]
 
 
 @contextmanager
-def compiling(settings):
-    """Around the first calls of the entry point for the kernel `Settings` `settings`: yields the entry
-    point, with the parts compiling in a second process meanwhile where `start` says so; that process
-    ends when the block ends (by then its work is done, or done here too)."""
+def compiling(settings, model: Model):
+    """Around the first calls of the entry point for the kernel `Settings` `settings` on `model`: yields the
+    entry point, with the parts compiling in a second process meanwhile where `wanted` says so; that process
+    ends when the block ends (by then its work is done, or done here too), and the model's copy with it."""
     entry = kernel.entry(settings)
-    helper = _start(entry, bool(settings.smooth_normals))
-    try:
+    if not _wanted(entry):
         yield entry
-    finally:
-        if helper is not None:
+        return
+    with tempfile.TemporaryDirectory(prefix="wrist_env_parts_") as folder:
+        helper = _start(bool(settings.smooth_normals), model, Path(folder))
+        try:
+            yield entry
+        finally:
             helper.terminate()
             helper.wait()

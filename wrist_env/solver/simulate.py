@@ -200,7 +200,7 @@ def simulate(
     """
     p = _prepared(model, settings, driver, prepared)
     out = _outputs(0, len(driver.rotation), len(model.membrane_nodes))
-    with precompile.compiling(p.settings) as entry:
+    with precompile.compiling(p.settings, p.model) as entry:
         _run(entry, p, stiffness(p, design), _frames(driver), out)
     return _result(out, driver, int(out.status[0]))
 
@@ -241,7 +241,7 @@ def simulate_frame(
     out = _outputs(0, 2, len(model.membrane_nodes))
     frames = _frames(two)
     nodes = np.array(nodes, dtype=np.float64)  # a copy: the kernel moves it
-    with precompile.compiling(p.settings) as entry:
+    with precompile.compiling(p.settings, p.model) as entry:
         entry(*p.system, stiffness(p, design), frames, out, R, x, nodes, 1)  # pose_state's own arrays
     return _result(out, two, int(out.status[0]))
 
@@ -262,7 +262,7 @@ def simulate_batch(
     out = _outputs(len(per), len(driver.rotation), len(model.membrane_nodes))
     mine = [kernel.Outputs(*(o[i] for o in out)) for i in range(len(per))]
     threads = max(1, min(numba.get_num_threads(), len(per)))
-    with precompile.compiling(p.settings) as entry, ThreadPoolExecutor(threads) as pool:
+    with precompile.compiling(p.settings, p.model) as entry, ThreadPoolExecutor(threads) as pool:
         list(pool.map(lambda i: _run(entry, p, per[i], frames, mine[i]), range(len(per))))
     return [_result(filled, driver, int(filled.status[0])) for filled in mine]
 
@@ -293,12 +293,10 @@ def _result(out: kernel.Outputs, driver: Driver, status: int) -> Result:
     )
 
 
-def warm(settings: SolverSettings | None = None) -> None:
+def warm(model: Model, settings: SolverSettings | None = None) -> None:
     """Compile (or load from Numba's cache) the kernel entry point for `settings` (default
-    `SolverSettings()`) by simulating built-in P1 held at neutral for one frame: called before local
-    worker processes start, so that they load the compiled kernel instead of each compiling it (from an
-    empty cache, the block mass's kernels compile in a second process meanwhile: `precompile`)."""
-    from wrist_env.participants.registry import load_model  # the registry builds on the solver
-
-    model = load_model("P1")
+    `SolverSettings()`) by simulating `model` held at neutral for one frame (the kernel's types do not depend
+    on the model's sizes): called before local worker processes start, so that they load the compiled kernel
+    instead of each compiling it (from an empty cache, the block mass's kernels compile in a second process
+    meanwhile: `precompile`)."""
     simulate(model, population(), static(model, 1), settings)
