@@ -326,18 +326,56 @@ ONE_LINE_USAGE_ERRORS = {
     "montecarlo n huge": (["montecarlo", "P1", "--n", "10000000000"], r"n must be an integer in \[1, 1,000,000\]"),
     "montecarlo workers -1": (["montecarlo", "P1", "--workers", "-1"], r"workers must be an integer in \[0, 256\]"),
     "leaderboard no log": (["leaderboard", "--runs", "/nonexistent/log"], r"no run log at /nonexistent/log"),
+    "simulate frames 3e6": (
+        ["simulate", "P1", "--frames", "3000000"],
+        r"--frames: frames .* \[1, 10,000\], but got 3000000",
+    ),
+    "simulate frames 1e8": (["simulate", "P1", "--frames", "1e8"], r"--frames: frames .* \[1, 10,000\], but got '1e8'"),
+    "simulate frames 0": (["simulate", "P1", "--frames", "0"], r"--frames: frames .* \[1, 10,000\], but got 0"),
+    "simulate flexion nan": (
+        ["simulate", "P1", "--flexion", "nan"],
+        r"--flexion: .* finite number in \[-90, 90\].* nan",
+    ),
+    "simulate extension inf": (["simulate", "P1", "--extension", "inf"], r"--extension: .* \[-90, 90\].* inf"),
+    "sensitivity n 2e6": (["sensitivity", "P1", "--n", "2000000"], r"--n: n must be an integer in \[2, 4,096\]"),
+    "sensitivity n 0": (["sensitivity", "P1", "--n", "0"], r"--n: n must be an integer in \[2, 4,096\].* got 0"),
+    "sensitivity seed -1": (["sensitivity", "P1", "--seed", "-1"], r"--seed: seed .* \[0, 4,294,967,295\], but got -1"),
+    "sensitivity sobol n 3": (
+        ["sensitivity", "P1", "--method", "sobol", "--n", "3"],
+        r"sobol needs n a power of 2 .* at least 2, but got 3: the nearest are 2 and 4",
+    ),
+    "posterior walkers 5e6": (["posterior", "P1", "--walkers", "5000000"], r"--walkers: walkers .* \[44, 4,096\]"),
+    "posterior steps 4": (["posterior", "P1", "--steps", "4"], r"--steps: steps must be an integer in \[8, 100,000\]"),
+    "validate load nan": (["validate", "P1", "--load", "nan"], r"--load: load .* finite number in \[0, 1,000\].* nan"),
+    "validate load -5": (["validate", "P1", "--load", "-5"], r"--load: load .* \[0, 1,000\] .*but got -5.0"),
+    "validate fossa sweep nan": (
+        ["validate", "P1", "--fossa-sweep", "nan", "nan"],
+        r"--fossa-sweep: fossa sweep half-range .* \[0, 90\].* nan",
+    ),
+    "validate fossa sweep -5": (["validate", "P1", "--fossa-sweep", "-5", "10"], r"--fossa-sweep: .*\[0, 90\]"),
+    "montecarlo-report max-runs 0": (["montecarlo-report", "--max-runs", "0"], r"--max-runs: max_runs .* \[7, "),
+    "montecarlo-report max-runs -5": (["montecarlo-report", "--max-runs", "-5"], r"max_runs .* \[7, .*got -5"),
+    "montecarlo-report max-runs 1": (
+        ["montecarlo-report", "--max-runs", "1"],
+        r"max_runs .* \[7, .*5 tear indicators and the variance between runs need 7 runs.*got 1",
+    ),
+    "montecarlo tear-probability nan": (["montecarlo", "P1", "--tear-probability", "nan"], r"tear probability .* nan"),
+    "montecarlo batch 1e6": (["montecarlo", "P1", "--batch", "1000000"], r"--batch: batch .* \[1, 4,096\]"),
+    "benchmark budget 1e9": (["benchmark", "--budget", "1000000000"], r"--budget: budget .* \[1, 1,000,000\]"),
 }
 
 
 @pytest.mark.parametrize("argv, message", ONE_LINE_USAGE_ERRORS.values(), ids=ONE_LINE_USAGE_ERRORS)
 def test_usage_errors_are_one_line_and_exit_2(argv, message, capsys, tmp_path):
+    """Every size and value a user types is refused with its option, value and limit (issue 53), exit 2,
+    before anything is loaded or written (no model here: a load would take seconds and write nothing)."""
     import re
 
-    out = [] if argv[0] in ("calibrate", "leaderboard") else ["--out", str(tmp_path / "out"), "--no-progress"]
+    out = [] if argv[0] in ("calibrate", "leaderboard") else ["--out", str(tmp_path / "out")]
     assert main(argv + out) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and re.search(message, err), err
-    assert not (tmp_path / "out").exists()  # refused before anything is written
+    assert err.count("\n") == 1 and err.startswith("wrist-bench: error: ") and re.search(message, err), err
+    assert not (tmp_path / "out").exists()
 
 
 def _file(tmp_path):
@@ -567,58 +605,6 @@ def test_posterior_model_trials_of_a_folder_participant_is_refused_saying_why(ca
     registry._FOLDERS["U1"] = tmp_path  # registered (the autouse fixture forgets it)
     err = _one_line_error(capsys, ["posterior", "U1", "--model-trials", "--out", str(tmp_path / "p")])
     assert "--model-trials simulates a participant's hidden truth, which U1 (read from a folder)" in err
-
-
-ISSUE_53 = {
-    "simulate frames 3e6": (
-        ["simulate", "P1", "--frames", "3000000"],
-        r"--frames: frames .* \[1, 10,000\], but got 3000000",
-    ),
-    "simulate frames 1e8": (["simulate", "P1", "--frames", "1e8"], r"--frames: frames .* \[1, 10,000\], but got '1e8'"),
-    "simulate frames 0": (["simulate", "P1", "--frames", "0"], r"--frames: frames .* \[1, 10,000\], but got 0"),
-    "simulate flexion nan": (
-        ["simulate", "P1", "--flexion", "nan"],
-        r"--flexion: .* finite number in \[-90, 90\].* nan",
-    ),
-    "simulate extension inf": (["simulate", "P1", "--extension", "inf"], r"--extension: .* \[-90, 90\].* inf"),
-    "sensitivity n 2e6": (["sensitivity", "P1", "--n", "2000000"], r"--n: n must be an integer in \[2, 4,096\]"),
-    "sensitivity n 0": (["sensitivity", "P1", "--n", "0"], r"--n: n must be an integer in \[2, 4,096\].* got 0"),
-    "sensitivity seed -1": (["sensitivity", "P1", "--seed", "-1"], r"--seed: seed .* \[0, 4,294,967,295\], but got -1"),
-    "sensitivity sobol n 3": (
-        ["sensitivity", "P1", "--method", "sobol", "--n", "3"],
-        r"sobol needs n a power of 2 .* at least 2, but got 3: the nearest are 2 and 4",
-    ),
-    "posterior walkers 5e6": (["posterior", "P1", "--walkers", "5000000"], r"--walkers: walkers .* \[44, 4,096\]"),
-    "posterior steps 4": (["posterior", "P1", "--steps", "4"], r"--steps: steps must be an integer in \[8, 100,000\]"),
-    "validate load nan": (["validate", "P1", "--load", "nan"], r"--load: load .* finite number in \[0, 1,000\].* nan"),
-    "validate load -5": (["validate", "P1", "--load", "-5"], r"--load: load .* \[0, 1,000\] .*but got -5.0"),
-    "validate fossa sweep nan": (
-        ["validate", "P1", "--fossa-sweep", "nan", "nan"],
-        r"--fossa-sweep: fossa sweep half-range .* \[0, 90\].* nan",
-    ),
-    "validate fossa sweep -5": (["validate", "P1", "--fossa-sweep", "-5", "10"], r"--fossa-sweep: .*\[0, 90\]"),
-    "montecarlo-report max-runs 0": (["montecarlo-report", "--max-runs", "0"], r"--max-runs: max_runs .* \[7, "),
-    "montecarlo-report max-runs -5": (["montecarlo-report", "--max-runs", "-5"], r"max_runs .* \[7, .*got -5"),
-    "montecarlo-report max-runs 1": (
-        ["montecarlo-report", "--max-runs", "1"],
-        r"max_runs .* \[7, .*5 tear indicators and the variance between runs need 7 runs.*got 1",
-    ),
-    "montecarlo tear-probability nan": (["montecarlo", "P1", "--tear-probability", "nan"], r"tear probability .* nan"),
-    "montecarlo batch 1e6": (["montecarlo", "P1", "--batch", "1000000"], r"--batch: batch .* \[1, 4,096\]"),
-    "benchmark budget 1e9": (["benchmark", "--budget", "1000000000"], r"--budget: budget .* \[1, 1,000,000\]"),
-}
-
-
-@pytest.mark.parametrize("argv, message", ISSUE_53.values(), ids=ISSUE_53)
-def test_sizes_and_values_out_of_bounds_are_one_line_before_any_work(argv, message, capsys, tmp_path):
-    """Issue 53: every size and value a user types is refused with its option, value and limit, exit 2,
-    before anything is loaded (no model here: a load would take seconds and write nothing)."""
-    import re
-
-    assert main([*argv, "--out", str(tmp_path / "out")]) == 2
-    err = capsys.readouterr().err
-    assert err.count("\n") == 1 and err.startswith("wrist-bench: error: ") and re.search(message, err), err
-    assert not (tmp_path / "out").exists()
 
 
 def test_every_number_a_user_types_is_bounded():
