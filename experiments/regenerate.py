@@ -10,8 +10,8 @@ sensitivity and the Fisher matrix at the hidden truth, P1–P3), the best calibr
 the prior (`leaderboards/prior/`) and the Bayesian calibrator's coverage on the trials and on the
 model's own trials (`leaderboards/posterior/`: emcee at 300 steps with the default 24 MAP starts
 and prior refresh, and on the model's trials at the default 1,200 steps too, ~6-7 h (34-51 min a run measured), in
-`leaderboards/posterior/steps1200/`, its saved runs committed in `steps1200/runs/` so that it resumes
-across sessions; SMC on the model's trials; where the built-in trials' model error comes from,
+`leaderboards/posterior/steps1200/`; SMC on the model's trials; the posterior studies' saved runs are
+committed (`leaderboards/posterior/runs/`, `steps1200/runs/`) so that they resume across sessions; where the built-in trials' model error comes from,
 `experiments/research/model_error.py`, and the truth's standing under other likelihoods,
 `experiments/research/capitate_likelihood.py`). The studies' run logs go to a fresh
 folder `runs/regenerate-<commit>/` (a killed run resumes there when rerun at the same commit: the steps
@@ -32,9 +32,10 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURES = "experiments/figures"  # the committed figures the docs show (the commands' own default is runs/figures)
-# the 1,200-step study's saved runs are committed (0.4-0.5 MB a run, compressed): at 34-51 min a run on the issue-33
-# model (P1-P3, nine runs: 24 MAP starts, then 58,000-63,000 simulations), its 9 runs span sessions,
-# and a saved run is loaded, not rerun, unless it was sampled on another model (`Posterior.model_hash`)
+# the posterior studies' saved runs are committed (0.4-0.5 MB a 1,200-step run, compressed): at 20-51 min a run
+# (24 MAP starts, then 20,000-63,000 simulations), their 36 runs span sessions; a saved run is loaded, not rerun,
+# and one sampled on another model is refused (`Posterior.model_hash`): delete them after a model change
+POSTERIOR_RUNS = "leaderboards/posterior/runs"
 STEPS1200_RUNS = "leaderboards/posterior/steps1200/runs"
 
 
@@ -81,12 +82,12 @@ def steps(runs: Path, figures_only: bool) -> list[list[str]]:
         [
             "posterior",
             *("P1", "P2", "P3", "--seeds", "3", "--steps", "300"),
-            *("--out", str(runs / "posterior"), "--report", "leaderboards/posterior"),
+            *("--out", POSTERIOR_RUNS, "--report", "leaderboards/posterior"),
         ],
         [
             "posterior",
             *("P1", "P2", "P3", "--seeds", "3", "--steps", "300", "--model-trials"),
-            *("--out", str(runs / "posterior"), "--report", "leaderboards/posterior"),
+            *("--out", POSTERIOR_RUNS, "--report", "leaderboards/posterior"),
         ],
         [
             "posterior",
@@ -96,7 +97,7 @@ def steps(runs: Path, figures_only: bool) -> list[list[str]]:
         [
             "posterior",
             *("P1", "P2", "P3", "--seeds", "3", "--sampler", "smc", "--model-trials"),
-            *("--out", str(runs / "posterior"), "--report", "leaderboards/posterior"),
+            *("--out", POSTERIOR_RUNS, "--report", "leaderboards/posterior"),
         ],
         ["python", "experiments/research/model_error.py"],
         ["python", "experiments/research/capitate_likelihood.py"],
