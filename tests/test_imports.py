@@ -265,3 +265,51 @@ def test_the_ligament_catalogue_is_imported_from_its_owner():
     from wrist_env import design
 
     assert not catalogue & set(design.__all__)
+
+
+def _defined(path: Path) -> set[str]:
+    """The names a script defines or imports at its top level (read, not run)."""
+    names = set()
+    for node in ast.parse(path.read_text()).body:
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            names.add(node.name)
+        elif isinstance(node, (ast.Assign, ast.AnnAssign)):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            names.update(n.id for t in targets for n in ast.walk(t) if isinstance(n, ast.Name))
+        elif isinstance(node, (ast.Import, ast.ImportFrom)):
+            names.update((a.asname or a.name).split(".")[0] for a in node.names)
+    return names
+
+
+def test_every_experiment_imports_names_that_exist():
+    """The experiment scripts are run by hand or by `experiments/regenerate.py`, not by the tests: each name one
+    imports from the package or from a sibling script must still be there (a script that imported three names
+    moved out of `make_trials.py` failed only when regenerate reached it, hours into a run). Read, not run: the
+    package's modules are imported, the sibling scripts parsed."""
+    import importlib
+
+    scripts = {p.stem: p for p in (ROOT / "experiments").rglob("*.py")}
+    missing = []
+    for path in scripts.values():
+        for node in ast.walk(ast.parse(path.read_text())):
+            if not isinstance(node, ast.ImportFrom) or node.level or not node.module:
+                continue
+            top = node.module.split(".")[0]
+            if top in ("wrist_env", "optimizers"):
+                module = importlib.import_module(node.module)
+                missing += [
+                    f"{path.relative_to(ROOT)}:{node.lineno} {node.module}.{a.name}"
+                    for a in node.names
+                    if not hasattr(module, a.name)
+                    and not (ROOT / Path(*node.module.split("."), a.name)).exists()
+                    and not (ROOT / Path(*node.module.split("."), f"{a.name}.py")).exists()
+                ]
+            elif node.module in scripts:
+                there = _defined(scripts[node.module])
+                missing += [
+                    f"{path.relative_to(ROOT)}:{node.lineno} {node.module}.{a.name}"
+                    for a in node.names
+                    if a.name not in there
+                ]
+    assert len(scripts) >= 25
+    assert not missing, missing

@@ -28,19 +28,17 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "authoring"))
-from make_trials import HIGH_FIDELITY_BUILD, HIGH_FIDELITY_SOLVER, capitate_motion  # noqa: E402  (experiments/authoring/)
-
-from wrist_env import design  # noqa: E402
-from wrist_env.frames import cardan_rotation  # noqa: E402
-from wrist_env.identification import likelihood  # noqa: E402
-from wrist_env.identification.map import map_estimate  # noqa: E402
-from wrist_env.model import BONES  # noqa: E402
-from wrist_env.participants import builtin  # noqa: E402
-from wrist_env.participants.registry import load_model  # noqa: E402
+from wrist_env import design
+from wrist_env.frames import cardan_rotation
+from wrist_env.identification import likelihood
+from wrist_env.identification.map import map_estimate
+from wrist_env.model import BONES
+from wrist_env.participants import builtin
+from wrist_env.participants.registry import load_model
+from wrist_env.participants.synthetic import HIGH_FIDELITY_BUILD, HIGH_FIDELITY_SOLVER, capitate_motion
 from wrist_env.solver.drivers import experimental, loaded
 from wrist_env.solver.simulate import simulate
-from wrist_env.task import cost_poses, task  # noqa: E402
+from wrist_env.task import cost_poses, task
 
 DRAWS = 16
 OUT = Path(__file__).resolve().parents[2] / "leaderboards" / "posterior" / "model_error.csv"
