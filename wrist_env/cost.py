@@ -136,7 +136,7 @@ class CostReport:
     terms : np.ndarray, shape (2, 6)
         Weighted normalized errors, summing to total.
     error_p75 : np.ndarray, shape (2, 6)
-        75th percentile over frames of |error| (mm, deg).
+        75th percentile over frames of ``|error|`` (mm, deg).
     experimental_range : np.ndarray, shape (2, 6)
         max − min over frames of the experimental DOF (mm, deg), before the floor.
     normalizer : np.ndarray, shape (2, 6)

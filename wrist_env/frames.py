@@ -81,7 +81,7 @@ def validate_poses(
     """The poses, checked, as a float64 array.
 
     Rules: shape (..., 4, 4); finite; bottom row 0 0 0 1; rotation orthonormal
-    (max |RᵀR − I| <= 1e-4) and proper (det > 0).
+    (``max |RᵀR − I| <= 1e-4``) and proper (det > 0).
 
     Parameters
     ----------

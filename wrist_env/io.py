@@ -285,7 +285,7 @@ def atomic_write(path: str | Path, write: Callable[[Path], object]) -> Path:
 
 
 def clean_temporary(folder: str | Path, min_age_s: float = 0.0) -> int:
-    """Remove the temporary files killed `atomic_write`s left in a folder.
+    """Remove the temporary files left in a folder by killed `atomic_write` calls.
 
     Parameters
     ----------

@@ -157,7 +157,7 @@ def mirror_trial(trial: Trial) -> Trial:
 def validate_transforms(array: ArrayLike, source: str, bones: tuple[str, ...] | None = None) -> np.ndarray:
     """The transforms, checked, as a float64 array.
 
-    Rules: finite; bottom row 0 0 0 1; rotation orthonormal (max |RᵀR − I| <= 1e-4) and proper
+    Rules: finite; bottom row 0 0 0 1; rotation orthonormal (``max |RᵀR − I| <= 1e-4``) and proper
     (det > 0); translations in mm, not metres, and within `MAX_TRANSLATION_MM`.
 
     Parameters
