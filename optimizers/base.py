@@ -223,11 +223,25 @@ class Optimizer(ABC):
 
 
 def prior_draw(rng: np.random.Generator, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
-    """A point of the box [lower, upper] drawn from the population prior: each coordinate the box centre plus
-    a normal of SD (upper − lower) / (2·SPAN_SD), truncated at ±SPAN_SD SD — Table 2's normals truncated
-    as `design.sample_materials` draws them, whose ±SPAN_SD SD span the box. On the benchmark's box of 22
-    normalized materials, [-1, 1]^22, and a fresh `np.random.default_rng(seed)` it is exactly
-    `design.sample_materials(1, seed)[0]`."""
+    """A point of the box [lower, upper] drawn from the population prior.
+
+    Each coordinate is the box centre plus a normal of SD (upper − lower) / (2·SPAN_SD), truncated at
+    ±SPAN_SD SD — Table 2's normals truncated as `design.sample_materials` draws them, whose ±SPAN_SD SD span
+    the box. On the benchmark's box of the 22 normalized materials, [-1, 1]^22, and a fresh
+    `np.random.default_rng(seed)` it is exactly `design.sample_materials(1, seed)[0]`.
+
+    Parameters
+    ----------
+    rng : np.random.Generator
+        The generator drawn from (advanced by the draw).
+    lower, upper : np.ndarray, shape (dim,)
+        The box's bounds.
+
+    Returns
+    -------
+    np.ndarray, shape (dim,)
+        The point drawn.
+    """
     z = material_prior().rvs(size=(1, len(lower)), random_state=rng)[0]
     return 0.5 * (lower + upper) + 0.5 * (upper - lower) * z / SPAN_SD
 

@@ -88,7 +88,15 @@ def register(name: str) -> Callable[[type], type]:
 
 
 def unavailable(name: str, reason: str) -> None:
-    """Record a calibrator that exists but cannot run here, and why (e.g. an optional extra to install)."""
+    """Record a calibrator that exists but cannot run here, and why.
+
+    Parameters
+    ----------
+    name : str
+        The calibrator's registry name.
+    reason : str
+        Why it cannot run here (e.g. an optional extra to install).
+    """
     _UNAVAILABLE[name] = reason
 
 

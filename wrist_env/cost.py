@@ -67,6 +67,18 @@ class CostWeights:
     """Per-DOF weights of the cost (dimensionless, >= 0, not all 0), shared by scaphoid and lunate.
 
     Defaults are 1: the preprint weights DOF "based on the relevance of each DOF" without values.
+
+    Parameters
+    ----------
+    vol_dor, pro_dis, rad_uln : float, default 1.0
+        The weights of the translations (Vol/Dor, Pro/Dis, Rad/Uln).
+    flex_ext, ulnd_radd, pro_sup : float, default 1.0
+        The weights of the rotations (Flex/Ext, UlnD/RadD, Pro/Sup).
+
+    Raises
+    ------
+    InputError
+        A weight that is not a finite number >= 0, or all weights 0.
     """
 
     vol_dor: float = 1.0
@@ -111,16 +123,28 @@ class CostWeights:
 
 @dataclass(frozen=True, eq=False)
 class CostReport:
-    """The cost of one run and its parts. Arrays have shape (2, 6): bones COST_BONES × DOF_NAMES.
+    """The cost of one run and its parts.
 
-    total: the cost (dimensionless), FAILED_COST if failed.
-    failed: True if the model poses were not finite (then terms, error_p75 and rmse are NaN).
-    terms: weighted normalized errors, summing to total.
-    error_p75: 75th percentile over frames of |error| (mm, deg).
-    experimental_range: max − min over frames of the experimental DOF (mm, deg), before the floor.
-    normalizer: max(experimental_range, RANGE_FLOOR) (mm, deg).
-    rmse: root mean squared error over frames (mm, deg), as the preprint's Tables 3–4.
-    weights: the CostWeights used.
+    Arrays have shape (2, 6): bones `COST_BONES` × `DOF_NAMES`.
+
+    Parameters
+    ----------
+    total : float
+        The cost (dimensionless), `FAILED_COST` if failed.
+    failed : bool
+        True if the model poses were not finite (then terms, error_p75 and rmse are NaN).
+    terms : np.ndarray, shape (2, 6)
+        Weighted normalized errors, summing to total.
+    error_p75 : np.ndarray, shape (2, 6)
+        75th percentile over frames of ``|error|`` (mm, deg).
+    experimental_range : np.ndarray, shape (2, 6)
+        max − min over frames of the experimental DOF (mm, deg), before the floor.
+    normalizer : np.ndarray, shape (2, 6)
+        max(experimental_range, RANGE_FLOOR) (mm, deg).
+    rmse : np.ndarray, shape (2, 6)
+        Root mean squared error over frames (mm, deg), as the preprint's Tables 3–4.
+    weights : CostWeights
+        The weights used.
     """
 
     total: float
@@ -166,15 +190,31 @@ def kinematic_cost(
 ) -> CostReport:
     """The kinematic cost of model vs experimental scaphoid and lunate poses (see the module docstring).
 
-    model_poses, experimental_poses: arrays (2, n_frames >= 2, 4, 4), bones in COST_BONES order
-    (scaphoid, lunate), or mappings {bone: (n_frames, 4, 4)} (other bones are ignored); 4×4
-    transforms neutral → frame, RCS, mm. Non-finite model poses → a failed report; bad
-    experimental poses → InputError.
-    reference_points: the tracked point of each bone, mm, RCS, neutral pose (the preprint: the
-    centroid): array (2, 3), or {bone: (3,)}; None = the RCS origin for both.
-    weights: CostWeights, or a mapping for CostWeights.from_mapping; None = all 1.
-    range_floor: six floors (mm, mm, mm, deg, deg, deg) of the range normalizer, each > 0.
-    expressed_in: "bone" or "rcs", see frames.error_transform.
+    Parameters
+    ----------
+    model_poses, experimental_poses : np.ndarray, shape (2, n_frames, 4, 4), or dict of str to np.ndarray
+        Bones in COST_BONES order (scaphoid, lunate), n_frames >= 2, or mappings {bone: (n_frames, 4, 4)}
+        (other bones are ignored); 4×4 transforms neutral → frame, RCS, mm. Non-finite model poses → a
+        failed report.
+    reference_points : np.ndarray, shape (2, 3), or dict of str to np.ndarray, optional
+        The tracked point of each bone, mm, RCS, neutral pose (the preprint: the centroid), or
+        {bone: (3,)}; None = the RCS origin for both.
+    weights : CostWeights or dict, optional
+        Weights, or a mapping for `CostWeights.from_mapping`; None = all 1.
+    range_floor : array_like, shape (6,), default RANGE_FLOOR
+        Six floors (mm, mm, mm, deg, deg, deg) of the range normalizer, each > 0.
+    expressed_in : {"bone", "rcs"}, default "bone"
+        The frame the error is expressed in, see `frames.error_transform`.
+
+    Returns
+    -------
+    CostReport
+        The cost and its parts; `failed` if the model poses (or the cost) are not finite.
+
+    Raises
+    ------
+    InputError
+        Bad experimental poses, or an argument of another shape or out of range.
     """
     weights = _weights(weights)
     floor = np.asarray(range_floor, dtype=np.float64)

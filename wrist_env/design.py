@@ -189,8 +189,19 @@ class Design:
 
 
 def read_json(path: str | Path) -> Design:
-    """A Design from a JSON file: {name: value} in physical units (`NAMES`), or an object whose
-    "design" is one (a calibration's `--json` output); `DesignError` naming the file otherwise."""
+    """A Design from a JSON file.
+
+    Parameters
+    ----------
+    path : str or Path
+        A JSON file of {name: value} in physical units (`NAMES`), or of an object whose "design" is one (a
+        calibration's `--json` output).
+
+    Returns
+    -------
+    Design
+        The design; a `DesignError` naming the file otherwise.
+    """
     import json
     from pathlib import Path
 
@@ -210,7 +221,18 @@ def read_json(path: str | Path) -> Design:
 
 
 def check_action(action: ArrayLike) -> np.ndarray:
-    """The action as float64 of shape (27,) in [-1, 1], or a DesignError naming the offending entries."""
+    """The action, checked: a DesignError naming the offending entries unless finite and in [-1, 1].
+
+    Parameters
+    ----------
+    action : array_like, shape (27,)
+        A normalized action, real numbers.
+
+    Returns
+    -------
+    np.ndarray, shape (27,)
+        The action as float64, in [-1, 1].
+    """
     raw = np.asarray(action)
     if not (np.issubdtype(raw.dtype, np.floating) or np.issubdtype(raw.dtype, np.integer)):
         raise DesignError(f"an action must be real numbers, but got dtype {raw.dtype}.")
@@ -225,7 +247,18 @@ def check_action(action: ArrayLike) -> np.ndarray:
 
 
 def from_action(action: ArrayLike) -> Design:
-    """Physical design of a normalized action in [-1, 1]^27."""
+    """Physical design of a normalized action in [-1, 1]^27.
+
+    Parameters
+    ----------
+    action : array_like, shape (27,)
+        The normalized action (`check_action`).
+
+    Returns
+    -------
+    Design
+        Materials mean + 3·SD·a, injury scalars a (the module docstring).
+    """
     a = check_action(action)
     values = MEAN + SPAN_SD * np.nan_to_num(SD) * a
     values[N_MATERIAL:] = a[N_MATERIAL:]
@@ -233,8 +266,19 @@ def from_action(action: ArrayLike) -> Design:
 
 
 def from_actions(actions: ArrayLike) -> list[Design]:
-    """Physical designs of a batch of normalized actions (n, 27) in [-1, 1]; a DesignError names the row.
-    An empty batch, shape (0, 27) (or an empty list), gives no designs; another shape is a DesignError."""
+    """Physical designs of a batch of normalized actions in [-1, 1]; a DesignError names the row.
+
+    Parameters
+    ----------
+    actions : array_like, shape (n, 27)
+        The actions; an empty batch, shape (0, 27) (or an empty list), gives no designs; another shape is
+        a DesignError.
+
+    Returns
+    -------
+    list of Design
+        One design per row (`from_action`).
+    """
     raw = np.asarray(actions)
     if raw.shape == (0,):
         return []
@@ -250,7 +294,18 @@ def from_actions(actions: ArrayLike) -> list[Design]:
 
 
 def to_action(design: Design) -> np.ndarray:
-    """Normalized action of a physical design (injury scalars clipped to [-1, 1])."""
+    """Normalized action of a physical design (injury scalars clipped to [-1, 1]).
+
+    Parameters
+    ----------
+    design : Design
+        The design.
+
+    Returns
+    -------
+    np.ndarray, shape (27,)
+        The action (the inverse of `from_action`).
+    """
     v = design.vector
     a = np.empty(N_DESIGN)
     a[:N_MATERIAL] = (v[:N_MATERIAL] - MEAN[:N_MATERIAL]) / (SPAN_SD * SD[:N_MATERIAL])
@@ -259,10 +314,20 @@ def to_action(design: Design) -> np.ndarray:
 
 
 def split_variables(frozen: dict | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(free indices, frozen indices, frozen values) of the 27 design variables.
+    """The free and the frozen design variables.
 
-    frozen: {variable name (`NAMES`) or index: normalized value in [-1, 1]}; default the
-    five injury scalars at +1 (ligaments intact), as calibration does.
+    Parameters
+    ----------
+    frozen : dict, optional
+        {variable name (`NAMES`) or index: normalized value in [-1, 1]}; default the five injury scalars
+        at +1 (ligaments intact), as calibration does.
+
+    Returns
+    -------
+    free_index, frozen_index : np.ndarray
+        The indices, sorted, of the free and of the frozen variables among the 27.
+    frozen_value : np.ndarray
+        The frozen variables' normalized values, in `frozen_index` order.
     """
     frozen = INTACT_INJURY if frozen is None else frozen
     index = {(NAMES.index(k) if isinstance(k, str) else int(k)): float(v) for k, v in frozen.items()}
@@ -272,9 +337,24 @@ def split_variables(frozen: dict | None = None) -> tuple[np.ndarray, np.ndarray,
 
 
 def full_action(free: ArrayLike, frozen: dict | None = None, dtype: DTypeLike = np.float64) -> np.ndarray:
-    """The 27-variable action(s), shape (..., 27), of the free variables' values (..., n_free) with
-    the `frozen` ones (see `split_variables`) filled in: by default the 22 materials → 27 with the
-    injury scalars intact."""
+    """The 27-variable action(s) of the free variables' values with the frozen ones filled in.
+
+    By default the 22 materials → 27 with the injury scalars intact.
+
+    Parameters
+    ----------
+    free : array_like, shape (..., n_free)
+        The free variables' normalized values.
+    frozen : dict, optional
+        The frozen variables (see `split_variables`).
+    dtype : data-type, default np.float64
+        The result's dtype.
+
+    Returns
+    -------
+    np.ndarray, shape (..., 27)
+        The actions.
+    """
     free_index, frozen_index, frozen_value = split_variables(frozen)
     free = np.asarray(free)
     full = np.empty(free.shape[:-1] + (N_DESIGN,), dtype=dtype)
@@ -284,13 +364,29 @@ def full_action(free: ArrayLike, frozen: dict | None = None, dtype: DTypeLike = 
 
 
 def population() -> Design:
-    """Table 2 means, all ligaments intact."""
+    """Table 2 means, all ligaments intact.
+
+    Returns
+    -------
+    Design
+        The population design.
+    """
     return Design.from_vector(MEAN)
 
 
 def ligament_arrays(design: Design) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(stiffness N/mm, reference strain, torn) of every ligament in `ALL_LIGAMENT_NAMES` order:
-    the design's, then the fixed ligaments' (never torn)."""
+    """Stiffness, reference strain and torn of every ligament, in `ALL_LIGAMENT_NAMES` order.
+
+    Parameters
+    ----------
+    design : Design
+        The design.
+
+    Returns
+    -------
+    stiffness, reference_strain, torn : np.ndarray, shape (n_bundles,)
+        N/mm, dimensionless and bool: the design's, then the fixed ligaments' (never torn).
+    """
     n = len(FIXED_LIGAMENTS)
     return (
         np.concatenate([design.stiffness, [lig.stiffness_mean for lig in FIXED_LIGAMENTS]]),
@@ -300,12 +396,36 @@ def ligament_arrays(design: Design) -> tuple[np.ndarray, np.ndarray, np.ndarray]
 
 
 def z_scores(design: Design) -> np.ndarray:
-    """Material values in Table 2 SD units, array of shape (22,)."""
+    """Material values in Table 2 SD units.
+
+    Parameters
+    ----------
+    design : Design
+        The design.
+
+    Returns
+    -------
+    np.ndarray, shape (22,)
+        Each material's (value − mean) / SD.
+    """
     return (design.vector[:N_MATERIAL] - MEAN[:N_MATERIAL]) / SD[:N_MATERIAL]
 
 
 def with_z(base: Design, z: ArrayLike) -> Design:
-    """`base` with its 22 materials at z (22,) Table 2 SD units from the mean (the inverse of `z_scores`)."""
+    """A design with its 22 materials at given Table 2 SD units from the mean (the inverse of `z_scores`).
+
+    Parameters
+    ----------
+    base : Design
+        The design whose injury scalars are kept.
+    z : array_like, shape (22,)
+        The materials' z scores.
+
+    Returns
+    -------
+    Design
+        `base` with its materials at mean + SD·z.
+    """
     z = np.asarray(z, dtype=np.float64)
     if z.shape != (N_MATERIAL,):
         raise DesignError(f"z must have shape ({N_MATERIAL},), but got {z.shape}.")
@@ -315,18 +435,43 @@ def with_z(base: Design, z: ArrayLike) -> Design:
 
 
 def material_prior(truncate_sd: float = SPAN_SD):
-    """One material's population prior in SD units (z), as a frozen SciPy distribution: Table 2's normal,
-    N(0, 1), truncated at ±`truncate_sd` (the one owner: the Monte Carlo sampler, the instances' truths, the
-    calibrators' start points and the likelihood's prior all draw or weigh with it; `SPAN_SD` spans the action
-    box)."""
+    """One material's population prior in SD units (z), as a frozen SciPy distribution.
+
+    The one owner: the Monte Carlo sampler, the instances' truths, the calibrators' start points and the
+    likelihood's prior all draw or weigh with it.
+
+    Parameters
+    ----------
+    truncate_sd : float, default SPAN_SD
+        The truncation, ±SD (`SPAN_SD` spans the action box).
+
+    Returns
+    -------
+    scipy.stats frozen distribution
+        Table 2's normal, N(0, 1), truncated at ±`truncate_sd` (frozen).
+    """
     from scipy.stats import truncnorm  # here: scipy.stats takes 0.5 s to import
 
     return truncnorm(-truncate_sd, truncate_sd)
 
 
 def sample_materials(n: int, seed: int | None, *, truncate_sd: float = SPAN_SD) -> np.ndarray:
-    """Normalized material actions of shape (n, 22) drawn from Table 2's normals truncated at ±`truncate_sd`
-    (`material_prior`)."""
+    """Normalized material actions drawn from Table 2's normals truncated (`material_prior`).
+
+    Parameters
+    ----------
+    n : int
+        How many.
+    seed : int or None
+        The seed of `np.random.default_rng`.
+    truncate_sd : float, default SPAN_SD
+        The truncation, ±SD.
+
+    Returns
+    -------
+    np.ndarray, shape (n, 22)
+        The actions, in [-truncate_sd / SPAN_SD, truncate_sd / SPAN_SD].
+    """
     rng = np.random.default_rng(seed)
     z = material_prior(truncate_sd).rvs(size=(n, N_MATERIAL), random_state=rng)
     return z / SPAN_SD

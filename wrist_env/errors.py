@@ -65,5 +65,7 @@ class UsageError(InputError):
 
 
 class Interrupted(KeyboardInterrupt):
-    """Ctrl-C during a long command: its message says what was saved and how to resume (the command line
-    prints it in one line and exits 130, the shell's code for SIGINT)."""
+    """Ctrl-C during a long command, with a message saying what was saved and how to resume.
+
+    The command line prints the message in one line and exits 130, the shell's code for SIGINT.
+    """

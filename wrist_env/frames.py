@@ -78,11 +78,26 @@ def validate_poses(
     error: type = InputError,
     where: Callable[[Sequence[int]], str] | None = None,
 ) -> np.ndarray:
-    """The poses as a float64 array of shape (..., 4, 4), or `error` naming `name`, the entry and its value.
+    """The poses, checked, as a float64 array.
 
     Rules: shape (..., 4, 4); finite; bottom row 0 0 0 1; rotation orthonormal
-    (max |RᵀR − I| <= 1e-4) and proper (det > 0). where(index) names an entry
-    (default "entry (i, j)").
+    (``max |RᵀR − I| <= 1e-4``) and proper (det > 0).
+
+    Parameters
+    ----------
+    poses : array_like, shape (..., 4, 4)
+        The poses, mm.
+    name : str, default "poses"
+        What they are, as a message names them.
+    error : type, default InputError
+        The exception raised, naming `name`, the entry and its value.
+    where : callable, optional
+        ``where(index)`` names an entry (default "entry (i, j)").
+
+    Returns
+    -------
+    np.ndarray, shape (..., 4, 4)
+        The poses as float64.
     """
     try:
         t = np.asarray(poses, dtype=np.float64)
@@ -118,7 +133,20 @@ def validate_poses(
 
 
 def validate_points(points: ArrayLike, name: str = "reference_point") -> np.ndarray:
-    """Points (mm) as a float64 array of shape (..., 3), or an InputError naming `name` and the value."""
+    """Points (mm), checked, as a float64 array; an InputError naming `name` and the value otherwise.
+
+    Parameters
+    ----------
+    points : array_like, shape (..., 3)
+        The points, mm.
+    name : str, default "reference_point"
+        What they are, as a message names them.
+
+    Returns
+    -------
+    np.ndarray, shape (..., 3)
+        The points as float64.
+    """
     try:
         p = np.asarray(points, dtype=np.float64)
     except (TypeError, ValueError) as exc:
@@ -132,9 +160,17 @@ def validate_points(points: ArrayLike, name: str = "reference_point") -> np.ndar
 
 
 def cardan_angles(rotations: ArrayLike) -> np.ndarray:
-    """Cardan Z-X-Y angles (degrees) of rotation matrices (..., 3, 3): array (..., 3) = Flex/Ext, UlnD/RadD, Pro/Sup.
+    """Cardan Z-X-Y angles (degrees) of rotation matrices; intrinsic: R = Rz(a)·Rx(b)·Ry(c).
 
-    Matrices are assumed valid (see validate_poses). Intrinsic: R = Rz(a)·Rx(b)·Ry(c).
+    Parameters
+    ----------
+    rotations : array_like, shape (..., 3, 3)
+        Rotation matrices, assumed valid (see validate_poses).
+
+    Returns
+    -------
+    np.ndarray, shape (..., 3)
+        Flex/Ext, UlnD/RadD, Pro/Sup, deg.
     """
     r = np.asarray(rotations, dtype=np.float64)
     lead = r.shape[:-2]
@@ -147,7 +183,18 @@ def cardan_angles(rotations: ArrayLike) -> np.ndarray:
 
 
 def cardan_rotation(angles: ArrayLike) -> np.ndarray:
-    """Rotation matrices (..., 3, 3) of Cardan Z-X-Y angles (..., 3) in degrees (Flex/Ext, UlnD/RadD, Pro/Sup)."""
+    """Rotation matrices of Cardan Z-X-Y angles; an InputError for angles of another shape or not finite.
+
+    Parameters
+    ----------
+    angles : array_like, shape (..., 3)
+        Flex/Ext, UlnD/RadD, Pro/Sup, deg.
+
+    Returns
+    -------
+    np.ndarray, shape (..., 3, 3)
+        The rotation matrices.
+    """
     a = np.asarray(angles, dtype=np.float64)
     if a.ndim < 1 or a.shape[-1] != 3:
         raise InputError(
@@ -165,14 +212,38 @@ def cardan_rotation(angles: ArrayLike) -> np.ndarray:
 
 
 def apply(poses: ArrayLike, points: ArrayLike) -> np.ndarray:
-    """Points (..., 3) mm moved by poses (..., 4, 4): R·p + t, broadcast over leading axes."""
+    """Points moved by poses: R·p + t, broadcast over leading axes.
+
+    Parameters
+    ----------
+    poses : array_like, shape (..., 4, 4)
+        The poses, mm.
+    points : array_like, shape (..., 3)
+        The points, mm.
+
+    Returns
+    -------
+    np.ndarray, shape (..., 3)
+        The moved points, mm.
+    """
     t = np.asarray(poses, dtype=np.float64)
     p = np.asarray(points, dtype=np.float64)
     return (t[..., :3, :3] @ p[..., :, None])[..., 0] + t[..., :3, 3]
 
 
 def invert(poses: ArrayLike) -> np.ndarray:
-    """Inverses of rigid transforms (..., 4, 4): [Rᵀ, −Rᵀt; 0 0 0 1]."""
+    """Inverses of rigid transforms: [Rᵀ, −Rᵀt; 0 0 0 1].
+
+    Parameters
+    ----------
+    poses : array_like, shape (..., 4, 4)
+        Rigid transforms.
+
+    Returns
+    -------
+    np.ndarray, shape (..., 4, 4)
+        Their inverses.
+    """
     t = np.asarray(poses, dtype=np.float64)
     out = np.zeros_like(t)
     rt = np.swapaxes(t[..., :3, :3], -1, -2)
@@ -183,11 +254,21 @@ def invert(poses: ArrayLike) -> np.ndarray:
 
 
 def pose_to_dof(poses: ArrayLike, reference_point: ArrayLike | None = None) -> np.ndarray:
-    """Six DOF (..., 6) of poses (..., 4, 4): displacement T·c − c (mm, RCS) of the reference point c, then Cardan angles (deg).
+    """Six DOF of poses: the displacement of a reference point, then Cardan angles.
 
-    reference_point: (3,) or broadcastable to poses.shape[:-2] + (3,), mm, RCS, neutral pose;
-    None = the RCS origin (the translation column of T). For per-bone points with poses of shape
-    (n_bones, n_frames, 4, 4) pass shape (n_bones, 1, 3).
+    Parameters
+    ----------
+    poses : array_like, shape (..., 4, 4)
+        The poses, mm.
+    reference_point : array_like, shape (3,), optional
+        Or broadcastable to poses.shape[:-2] + (3,), mm, RCS, neutral pose; None = the RCS origin (the
+        translation column of T). For per-bone points with poses of shape (n_bones, n_frames, 4, 4) pass
+        shape (n_bones, 1, 3).
+
+    Returns
+    -------
+    np.ndarray, shape (..., 6)
+        Displacement T·c − c (mm, RCS) of the reference point c, then Cardan angles (deg).
     """
     t = validate_poses(poses)
     c = np.zeros(3) if reference_point is None else validate_points(reference_point)
@@ -195,7 +276,20 @@ def pose_to_dof(poses: ArrayLike, reference_point: ArrayLike | None = None) -> n
 
 
 def dof_to_pose(dof: ArrayLike, reference_point: ArrayLike | None = None) -> np.ndarray:
-    """Poses (..., 4, 4) of six DOF (..., 6) (mm, deg): the inverse of pose_to_dof with the same reference point."""
+    """Poses of six DOF: the inverse of pose_to_dof with the same reference point.
+
+    Parameters
+    ----------
+    dof : array_like, shape (..., 6)
+        Six DOF, mm and deg (`DOF_NAMES`).
+    reference_point : array_like, shape (3,), optional
+        As pose_to_dof's.
+
+    Returns
+    -------
+    np.ndarray, shape (..., 4, 4)
+        The poses.
+    """
     d = np.asarray(dof, dtype=np.float64)
     if d.ndim < 1 or d.shape[-1] != 6:
         raise InputError(f"dof: must have shape (..., 6) ({', '.join(DOF_NAMES)}), but got {d.shape}.")
@@ -215,12 +309,22 @@ def dof_to_pose(dof: ArrayLike, reference_point: ArrayLike | None = None) -> np.
 
 
 def error_transform(model: ArrayLike, experiment: ArrayLike, *, expressed_in: str = "bone") -> np.ndarray:
-    """Error transforms (..., 4, 4) between model and experimental poses of one bone, frame by frame.
+    """Error transforms between model and experimental poses of one bone, frame by frame.
 
-    expressed_in="bone" (default): E = T_exp⁻¹ · T_model, the model bone's pose relative to the
-    experimental bone, in the experimental bone's coordinate system (RCS-aligned in the neutral pose);
-    identical poses give the identity. expressed_in="rcs": E = T_model · T_exp⁻¹, the motion in the
-    RCS that carries the experimental bone onto the model bone.
+    Parameters
+    ----------
+    model, experiment : array_like, shape (..., 4, 4)
+        The model's and the experiment's poses, mm, of one shape.
+    expressed_in : {"bone", "rcs"}, default "bone"
+        "bone": E = T_exp⁻¹ · T_model, the model bone's pose relative to the experimental bone, in the
+        experimental bone's coordinate system (RCS-aligned in the neutral pose); identical poses give the
+        identity. "rcs": E = T_model · T_exp⁻¹, the motion in the RCS that carries the experimental bone
+        onto the model bone.
+
+    Returns
+    -------
+    np.ndarray, shape (..., 4, 4)
+        The error transforms.
     """
     m = validate_poses(model, "model poses")
     e = validate_poses(experiment, "experimental poses")
@@ -239,13 +343,25 @@ def _error_transform(m: np.ndarray, e: np.ndarray, expressed_in: str) -> np.ndar
 def error_dof(
     model: ArrayLike, experiment: ArrayLike, reference_point: ArrayLike | None = None, *, expressed_in: str = "bone"
 ) -> np.ndarray:
-    """Six-DOF error (..., 6) of model vs experimental poses (..., 4, 4) (mm, deg), model minus experiment.
+    """Six-DOF error of model vs experimental poses (mm, deg), model minus experiment.
 
     The rotation DOF are the Cardan Z-X-Y angles of the error transform's rotation; the
-    translation DOF are the displacement of the bone's reference point c (mm, RCS, neutral
-    pose; default the RCS origin; the preprint tracks the centroid):
-    "bone": R_expᵀ · (T_model·c − T_exp·c), angles of R_expᵀ·R_model (experimental bone's axes);
-    "rcs":  T_model·c − T_exp·c, angles of R_model·R_expᵀ (RCS axes).
+    translation DOF are the displacement of the bone's reference point c.
+
+    Parameters
+    ----------
+    model, experiment : array_like, shape (..., 4, 4)
+        The model's and the experiment's poses, mm, of one shape.
+    reference_point : array_like, shape (3,), optional
+        c, mm, RCS, neutral pose; default the RCS origin (the preprint tracks the centroid).
+    expressed_in : {"bone", "rcs"}, default "bone"
+        "bone": R_expᵀ · (T_model·c − T_exp·c), angles of R_expᵀ·R_model (experimental bone's axes);
+        "rcs": T_model·c − T_exp·c, angles of R_model·R_expᵀ (RCS axes).
+
+    Returns
+    -------
+    np.ndarray, shape (..., 6)
+        The error, mm and deg (`DOF_NAMES`).
     """
     m = validate_poses(model, "model poses")
     e = validate_poses(experiment, "experimental poses")
@@ -257,8 +373,22 @@ def error_dof(
 def error_dof_validated(
     model: np.ndarray, experiment: np.ndarray, point: np.ndarray, *, expressed_in: str = "bone"
 ) -> np.ndarray:
-    """`error_dof` of inputs already checked (`validate_poses` of both, one shape; `validate_points`):
-    for callers that validate once and evaluate many times (the cost)."""
+    """`error_dof` of inputs already checked, for callers that validate once and evaluate many times (the cost).
+
+    Parameters
+    ----------
+    model, experiment : np.ndarray, shape (..., 4, 4)
+        Poses, mm, checked by `validate_poses`, of one shape.
+    point : np.ndarray, shape (..., 3)
+        The reference point, mm, checked by `validate_points`.
+    expressed_in : {"bone", "rcs"}, default "bone"
+        As `error_dof`'s.
+
+    Returns
+    -------
+    np.ndarray, shape (..., 6)
+        The error, mm and deg.
+    """
     error = _error_transform(model, experiment, expressed_in)
     c = point if expressed_in == "bone" else apply(experiment, point)
     # not re-validated: a product of two poses within the orthonormality tolerance may exceed it
@@ -266,17 +396,43 @@ def error_dof_validated(
 
 
 def pose_to_dof_validated(poses: np.ndarray, point: np.ndarray) -> np.ndarray:
-    """`pose_to_dof` of poses and a point already checked (`validate_poses`, `validate_points`)."""
+    """`pose_to_dof` of poses and a point already checked (`validate_poses`, `validate_points`).
+
+    Parameters
+    ----------
+    poses : np.ndarray, shape (..., 4, 4)
+        The poses, mm.
+    point : np.ndarray, shape (..., 3)
+        The reference point, mm.
+
+    Returns
+    -------
+    np.ndarray, shape (..., 6)
+        The six DOF, mm and deg.
+    """
     return _dof(poses, point)
 
 
 def rmse(
     model: ArrayLike, experiment: ArrayLike, reference_point: ArrayLike | None = None, *, expressed_in: str = "bone"
 ) -> np.ndarray:
-    """Per-DOF root mean squared error (..., 6) over frames (mm, deg) of poses (..., n_frames, 4, 4).
+    """Per-DOF root mean squared error over frames (mm, deg), as in the preprint's Tables 3–4.
 
-    The RMSE of error_dof over the frame axis (axis −3 of the poses), as in the preprint's Tables 3–4.
-    For per-bone reference points with poses (n_bones, n_frames, 4, 4) pass shape (n_bones, 1, 3).
+    The RMSE of error_dof over the frame axis (axis −3 of the poses).
+
+    Parameters
+    ----------
+    model, experiment : array_like, shape (..., n_frames, 4, 4)
+        The model's and the experiment's poses, mm, of one shape.
+    reference_point : array_like, shape (3,), optional
+        As error_dof's; for per-bone points with poses (n_bones, n_frames, 4, 4) pass shape (n_bones, 1, 3).
+    expressed_in : {"bone", "rcs"}, default "bone"
+        As error_dof's.
+
+    Returns
+    -------
+    np.ndarray, shape (..., 6)
+        The RMSE of each DOF, mm and deg.
     """
     e = validate_poses(experiment, "experimental poses")
     if e.ndim < 3:

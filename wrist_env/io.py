@@ -50,7 +50,15 @@ FORMAT_VERSION = 1
 
 
 def save_dataclass(obj: DataclassInstance, path: str | Path) -> None:
-    """Write `path.npz` and `path.json` for the frozen dataclass `obj`."""
+    """Write `path.npz` and `path.json` for a frozen dataclass.
+
+    Parameters
+    ----------
+    obj : dataclass
+        The frozen dataclass: its array fields go to the `.npz`, the others (JSON-able) to the `.json`.
+    path : str or Path
+        The pair's path; its suffix is replaced by `.npz` and `.json`.
+    """
     path = Path(path)
     arrays, meta = {}, {}
     for f in dataclasses.fields(obj):
@@ -74,8 +82,24 @@ def save_dataclass(obj: DataclassInstance, path: str | Path) -> None:
 
 
 def load_dataclass(cls: type[_D], path: str | Path) -> _D:
-    """Read an instance of `cls` written by `save_dataclass`; `StoreError` naming the file if the
-    pair is damaged, its `.npz` is not the one the `.json` was written with, or a field is missing."""
+    """Read an instance of the dataclass `cls` written by `save_dataclass`.
+
+    Parameters
+    ----------
+    path : str or Path
+        The pair's path; its suffix is replaced by `.npz` and `.json`.
+
+    Returns
+    -------
+    object
+        The instance of `cls`.
+
+    Raises
+    ------
+    StoreError
+        The pair is damaged, its `.npz` is not the one the `.json` was written with, or a field is missing
+        (the message names the file).
+    """
     path = Path(path)
     js, npz = path.with_suffix(".json"), path.with_suffix(".npz")
     for p in (js, npz):
@@ -123,17 +147,50 @@ def load_dataclass(cls: type[_D], path: str | Path) -> _D:
 
 
 def fields_equal(a: DataclassInstance, b: DataclassInstance, scalars: tuple[str, ...], arrays: tuple[str, ...]) -> bool:
-    """Whether `a` and `b` agree on the fields `scalars` (==) and `arrays` (np.array_equal): the `__eq__` of a
-    frozen dataclass of arrays (declared with eq=False: the generated one would compare arrays elementwise)."""
+    """Whether two dataclasses agree on their scalar and array fields.
+
+    The `__eq__` of a frozen dataclass of arrays (declared with eq=False: the generated one would compare
+    arrays elementwise).
+
+    Parameters
+    ----------
+    a, b : dataclass
+        The two instances.
+    scalars : tuple of str
+        The fields compared with ==.
+    arrays : tuple of str
+        The fields compared with `np.array_equal`.
+
+    Returns
+    -------
+    bool
+        Whether every field listed is equal.
+    """
     return all(getattr(a, k) == getattr(b, k) for k in scalars) and all(
         np.array_equal(getattr(a, k), getattr(b, k)) for k in arrays
     )
 
 
 def check_regular(path: str | Path, advice: str = "", what: str = "file") -> None:
-    """`StoreError` naming `path` (and `advice`) if it exists but is not a regular file (after symbolic links):
-    a device such as /dev/zero, a FIFO or a socket would make a read hang or never end. A missing path
-    passes (the read that follows names it)."""
+    """Check that a path, if it exists, is a regular file (after symbolic links).
+
+    A device such as /dev/zero, a FIFO or a socket would make a read hang or never end. A missing path
+    passes (the read that follows names it).
+
+    Parameters
+    ----------
+    path : str or Path
+        The path about to be read.
+    advice : str, default ""
+        What to do about it, appended to the message.
+    what : str, default "file"
+        What the file is, as the message names it.
+
+    Raises
+    ------
+    StoreError
+        It exists but is not a regular file (the message names `path` and `advice`).
+    """
     try:
         mode = os.stat(path).st_mode
     except OSError:
@@ -156,7 +213,18 @@ _KINDS = {
 
 
 def sha256_file(path: str | Path) -> str:
-    """The SHA-256 (hex) of a file's bytes."""
+    """The SHA-256 of a file's bytes.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+
+    Returns
+    -------
+    str
+        The digest, hex.
+    """
     h = hashlib.sha256()
     with open(path, "rb") as fh:
         for block in iter(lambda: fh.read(1 << 20), b""):
@@ -184,9 +252,24 @@ def _fsync_dir(folder: Path) -> None:
 
 
 def atomic_write(path: str | Path, write: Callable[[Path], object]) -> Path:
-    """Write a file whole or not at all: `write(tmp_path)` to a hidden name in the same folder,
-    fsync, `os.replace` onto `path`, fsync the folder. A reader, or a writer killed midway, never
-    sees half a file; a killed writer leaves at most a `.<name>.<hex>.tmp` (`clean_temporary`)."""
+    """Write a file whole or not at all.
+
+    `write(tmp_path)` to a hidden name in the same folder, fsync, `os.replace` onto `path`, fsync the
+    folder. A reader, or a writer killed midway, never sees half a file; a killed writer leaves at most a
+    `.<name>.<hex>.tmp` (`clean_temporary`).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file written.
+    write : callable
+        ``write(tmp_path)`` writes the file's content to the temporary path it is given.
+
+    Returns
+    -------
+    Path
+        `path`.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
@@ -202,8 +285,20 @@ def atomic_write(path: str | Path, write: Callable[[Path], object]) -> Path:
 
 
 def clean_temporary(folder: str | Path, min_age_s: float = 0.0) -> int:
-    """Remove the temporary files killed `atomic_write`s left in `folder` (those at least `min_age_s`
-    old: a live writer's file is younger); returns how many."""
+    """Remove the temporary files left in a folder by killed `atomic_write` calls.
+
+    Parameters
+    ----------
+    folder : str or Path
+        The folder (a missing one has none).
+    min_age_s : float, default 0.0
+        The youngest file removed, s: a live writer's file is younger.
+
+    Returns
+    -------
+    int
+        How many files were removed.
+    """
     folder = Path(folder)
     if not folder.is_dir():
         return 0
@@ -219,20 +314,65 @@ def clean_temporary(folder: str | Path, min_age_s: float = 0.0) -> int:
 
 
 def write_json(path: str | Path, data: object) -> Path:
-    """Strict JSON (no NaN; sorted keys), atomically (`atomic_write`)."""
+    """Write strict JSON (no NaN; sorted keys), atomically (`atomic_write`).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file written.
+    data : object
+        JSON-able data (NumPy scalars, arrays and tuples are written as numbers and lists).
+
+    Returns
+    -------
+    Path
+        `path`.
+    """
     text = json.dumps(data, indent=1, allow_nan=False, sort_keys=True, default=_jsonable) + "\n"
     return atomic_write(path, lambda p: Path(p).write_text(text))
 
 
 def json_sha256(data: object) -> str:
-    """The SHA-256 (hex) of `data` as canonical JSON (sorted keys, no spaces): equal for a dict and the
-    same dict written by `write_json` and read back."""
+    """The SHA-256 of data as canonical JSON (sorted keys, no spaces).
+
+    Equal for a dict and the same dict written by `write_json` and read back.
+
+    Parameters
+    ----------
+    data : object
+        JSON-able data, as `write_json` takes.
+
+    Returns
+    -------
+    str
+        The digest, hex.
+    """
     text = json.dumps(data, sort_keys=True, allow_nan=False, separators=(",", ":"), default=_jsonable)
     return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 
 def read_json(path: str | Path, what: str = "file", advice: str = "") -> dict | list:
-    """The JSON in `path`; `StoreError` naming the file (and `advice`) if it is missing, truncated or garbage."""
+    """The JSON in a file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    what : str, default "file"
+        What the file is, as a message names it.
+    advice : str, default ""
+        What to do about a bad file, appended to a message.
+
+    Returns
+    -------
+    dict or list
+        The JSON read.
+
+    Raises
+    ------
+    StoreError
+        The file is missing, truncated, garbage or not a regular file (the message names it and `advice`).
+    """
     path = Path(path)
     check_regular(path, advice, what)
     try:

@@ -37,8 +37,19 @@ def _module_name(package: Path, path: Path) -> str:
 
 
 def kernel_sources(package: Path) -> dict[str, str]:
-    """The sources (module name → text) of `package`'s modules that mention Numba and of every module of
-    the package they import, directly or through others (an import inside a function counts too)."""
+    """The sources of a package's modules that mention Numba and of every package module they import.
+
+    Parameters
+    ----------
+    package : Path
+        The package's folder.
+
+    Returns
+    -------
+    dict of str to str
+        Module name → source text, for the modules that mention Numba and every module of the package they
+        import, directly or through others (an import inside a function counts too).
+    """
     texts = {_module_name(package, p): p.read_text(encoding="utf-8") for p in sorted(package.rglob("*.py"))}
     todo = [name for name, text in texts.items() if _KERNEL.search(text)]
     found: dict[str, str] = {}
@@ -57,7 +68,18 @@ def kernel_sources(package: Path) -> dict[str, str]:
 
 
 def source_digest(package: Path) -> str:
-    """16 hex digits of SHA-256 over `kernel_sources(package)` (names and texts, in name order)."""
+    """16 hex digits of SHA-256 over `kernel_sources(package)` (names and texts, in name order).
+
+    Parameters
+    ----------
+    package : Path
+        The package's folder.
+
+    Returns
+    -------
+    str
+        The digest, 16 hex digits: the name of the kernels' cache folder.
+    """
     h = hashlib.sha256()
     for name, text in sorted(kernel_sources(package).items()):
         h.update(name.encode())
@@ -90,8 +112,18 @@ def _prune(root: Path, current: Path) -> None:
 
 
 def configure(package: Path | None = None) -> str:
-    """Point Numba's cache at the folder of `package`'s kernel sources (this package by default) unless
-    `NUMBA_CACHE_DIR` is set already; returns the folder Numba caches in."""
+    """Point Numba's cache at the folder of a package's kernel sources, unless `NUMBA_CACHE_DIR` is set already.
+
+    Parameters
+    ----------
+    package : Path, optional
+        The package's folder (this package by default).
+
+    Returns
+    -------
+    str
+        The folder Numba caches in.
+    """
     if os.environ.get("NUMBA_CACHE_DIR"):
         return os.environ["NUMBA_CACHE_DIR"]
     package = Path(__file__).resolve().parent if package is None else Path(package)

@@ -41,7 +41,23 @@ __all__ = [
 
 @dataclass(frozen=True)
 class Ligament:
-    """One Table 2 ligament: name, fibre count (0 for the 2D RSC membrane), stiffness N/mm."""
+    """One ligament of the catalogue: its name, fibre count, stiffness and source.
+
+    Parameters
+    ----------
+    name : str
+        The short name (e.g. "SLIL_v"), as the design variables and per-bundle arrays name it.
+    full_name : str
+        The anatomical name.
+    fibres : int
+        The fibre count (0 for the 2D RSC membrane).
+    stiffness_mean, stiffness_sd : float
+        The stiffness's population mean and SD, N/mm (Table 2's for the design's eleven).
+    injurable : bool
+        Whether the design has an injury scalar for it (`INJURABLE`).
+    source : str
+        The literature the stiffness comes from.
+    """
 
     name: str
     full_name: str

@@ -158,29 +158,83 @@ MIDCARPAL = ("scaphotrapeziotrapezoid", "scaphocapitate", "lunocapitate", "triqu
 class Model:
     """A participant model.
 
-    Bodies (n_bodies, `BONES` order):
-        vertices (V, 3) mm, vertex_offsets (n_bodies + 1,); faces (F, 3) local indices,
-        face_offsets (n_bodies + 1,);
-        vertex_part (V,) index into `BODY_PARTS[body]` of the bone each vertex belongs to;
-        thickness (V,) mm, cartilage thickness per vertex (0 off cartilage);
-        mass (n_bodies,) t; com (n_bodies, 3) mm; inertia (n_bodies, 3, 3) t·mm² about the com, RCS axes;
-        centroid (n_bodies, 3) mm, volume centroid of each body's principal bone alone (the point
-        whose motion the kinematic cost tracks; the lunate's without the triquetrum).
-    Contact grids (one per bone; empty for the radial column; the ulna's its head, closed, with the TFCC):
-        grid_origin (n_bodies, 3) mm; grid_spacing (n_bodies,) mm; grid_shape (n_bodies, 3);
-        grid_values (G,) float32 mm, C-order per bone, grid_offsets (n_bodies + 1,).
-    Contact samples (pair-sorted, n_pairs in `PAIRS` order, bones in `PAIR_BONES`):
-        sample_points (S, 3) mm on the sample bone's cartilage surface; sample_normals (S, 3);
-        sample_area (S,) mm²; sample_thickness (S,) mm, total cartilage thickness of both layers;
-        sample_offsets (n_pairs + 1,).
-    contact_law (5,): tri-linear pressure–strain law [e1, e2, k1, k2, k3] (strain, MPa).
-    Ligament fibres (1D bundles, Table 2 order):
-        fibre_ligament (N,) ligament index; fibre_bones (N, 2) origin, insertion bone;
-        fibre_origin (N, 3), fibre_insertion (N, 3) mm; reference_length (n_ligaments,) mm, the mean
-        neutral fibre length of each bundle (for the RSC, of its longitudinal connectors).
-    RSC membrane:
-        membrane_nodes (M, 3) mm; membrane_bone (M,) attached bone or -1 if free;
-        membrane_connectors (C, 2); membrane_kind (C,) 0 along, 1 across; membrane_length (C,) mm.
+    Per-body arrays are in `BONES` order; ragged ones are concatenated, item i at
+    `x[offsets[i]:offsets[i + 1]]`. Contact grids: one per bone; empty for the radial column; the ulna's
+    its head, closed, with the TFCC. Contact samples: pair-sorted, n_pairs in `PAIRS` order, bones in
+    `PAIR_BONES`. Ligament fibres: 1D bundles, Table 2 order.
+
+    Parameters
+    ----------
+    name : str
+        The participant's name.
+    source_hash : str
+        The hash of the inputs the model was built from (its cache key).
+    vertices : np.ndarray, shape (n_vertices, 3)
+        Every body's vertices, mm.
+    vertex_offsets : np.ndarray, shape (n_bodies + 1,)
+        The offsets of each body's vertices.
+    faces : np.ndarray, shape (n_faces, 3)
+        Triangles, indices local to their body.
+    face_offsets : np.ndarray, shape (n_bodies + 1,)
+        The offsets of each body's faces.
+    vertex_part : np.ndarray, shape (n_vertices,)
+        Index into `BODY_PARTS[body]` of the bone each vertex belongs to.
+    thickness : np.ndarray, shape (n_vertices,)
+        Cartilage thickness per vertex, mm (0 off cartilage).
+    mass : np.ndarray, shape (n_bodies,)
+        Each body's mass, t.
+    com : np.ndarray, shape (n_bodies, 3)
+        Each body's centre of mass, mm.
+    inertia : np.ndarray, shape (n_bodies, 3, 3)
+        Each body's inertia, t·mm², about the com, RCS axes.
+    centroid : np.ndarray, shape (n_bodies, 3)
+        Volume centroid of each body's principal bone alone, mm: the point whose motion the kinematic cost
+        tracks (the lunate's without the triquetrum).
+    grid_origin : np.ndarray, shape (n_bodies, 3)
+        Each contact grid's origin, mm.
+    grid_spacing : np.ndarray, shape (n_bodies,)
+        Each contact grid's spacing, mm.
+    grid_shape : np.ndarray, shape (n_bodies, 3)
+        Each contact grid's (nx, ny, nz).
+    grid_values : np.ndarray, shape (n_grid_values,)
+        Signed distances, float32, mm, C-order per bone.
+    grid_offsets : np.ndarray, shape (n_bodies + 1,)
+        The offsets of each bone's grid values.
+    sample_points, sample_normals : np.ndarray, shape (n_samples, 3)
+        Contact samples on the sample bone's cartilage surface, mm, and their normals.
+    sample_area : np.ndarray, shape (n_samples,)
+        Each sample's area, mm².
+    sample_thickness : np.ndarray, shape (n_samples,)
+        Total cartilage thickness of both layers, mm.
+    sample_offsets : np.ndarray, shape (n_pairs + 1,)
+        The offsets of each pair's samples.
+    contact_law : np.ndarray, shape (5,)
+        Tri-linear pressure–strain law [e1, e2, k1, k2, k3] (strain, MPa).
+    fibre_ligament : np.ndarray, shape (n_fibres,)
+        Each fibre's ligament index.
+    fibre_bones : np.ndarray, shape (n_fibres, 2)
+        Each fibre's origin and insertion bone.
+    fibre_origin, fibre_insertion : np.ndarray, shape (n_fibres, 3)
+        Each fibre's ends, mm.
+    reference_length : np.ndarray, shape (n_ligaments,)
+        The mean neutral fibre length of each bundle, mm (for the RSC, of its longitudinal connectors).
+    membrane_nodes : np.ndarray, shape (n_nodes, 3)
+        The RSC membrane's nodes, mm.
+    membrane_bone : np.ndarray, shape (n_nodes,)
+        Each node's attached bone, or -1 if free.
+    membrane_connectors : np.ndarray, shape (n_connectors, 2)
+        The nodes each connector joins.
+    membrane_kind : np.ndarray, shape (n_connectors,)
+        0 along, 1 across.
+    membrane_length : np.ndarray, shape (n_connectors,)
+        Each connector's length, mm.
+    report : dict, optional
+        The build's report (timings, errors, counts).
+
+    Raises
+    ------
+    InputError
+        Arrays of another body or pair count than this version's (rebuild the model).
     """
 
     name: str
@@ -296,5 +350,16 @@ class Model:
 
 
 def offsets(sizes: ArrayLike) -> np.ndarray:
-    """Offsets (n + 1,) of concatenated items of the given sizes."""
+    """Offsets of concatenated items of the given sizes.
+
+    Parameters
+    ----------
+    sizes : array_like, shape (n,)
+        The items' sizes.
+
+    Returns
+    -------
+    np.ndarray, shape (n + 1,)
+        int64: 0, then the cumulative sizes.
+    """
     return np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)

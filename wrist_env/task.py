@@ -42,7 +42,21 @@ __all__ = [
 
 @dataclass(frozen=True)
 class Evaluation:
-    """The outcome of one design: reward = −cost; `info` is deterministic and NaN-free."""
+    """The outcome of one design.
+
+    Parameters
+    ----------
+    reward : float
+        −cost.
+    cost : float
+        The kinematic cost (0 without reference kinematics).
+    failed : bool
+        Whether the run or its cost failed.
+    info : dict
+        The outputs (`outputs`): deterministic and NaN-free.
+    result : Result
+        The simulation's result.
+    """
 
     reward: float
     cost: float
@@ -53,8 +67,15 @@ class Evaluation:
 
 @dataclass(frozen=True)
 class Evaluations(Sequence):
-    """The outcomes of a batch of designs: each `Evaluation` by index, and as arrays over the batch
-    reward and cost (n,) and failed (n,) bool."""
+    """The outcomes of a batch of designs: each `Evaluation` by index, and arrays over the batch.
+
+    The arrays are `reward` and `cost`, shape (n,), and `failed`, shape (n,) bool.
+
+    Parameters
+    ----------
+    each : tuple of Evaluation
+        The n outcomes, in the batch's order.
+    """
 
     each: tuple[Evaluation, ...]
     reward: np.ndarray = field(init=False)
@@ -78,17 +99,45 @@ REFERENCE_KEYS = ("cost", "error_p75", "rmse", "cost_terms")
 
 
 def has_reference(participant: str, motion: str) -> bool:
-    """Whether the participant's motion has reference kinematics to score against (found without building
-    its model): a trial with the motion's role, or for "idealized" a built-in participant's hidden truth
-    (a folder participant has none: its sweep's reward is 0 and its `REFERENCE_KEYS` are None)."""
+    """Whether the participant's motion has reference kinematics to score against.
+
+    Found without building its model: a trial with the motion's role, or for "idealized" a built-in
+    participant's hidden truth (a folder participant has none: its sweep's reward is 0 and its
+    `REFERENCE_KEYS` are None).
+
+    Parameters
+    ----------
+    participant : str
+        A registered participant.
+    motion : {"calibrate", "validate", "idealized"}
+        The motion.
+
+    Returns
+    -------
+    bool
+        Whether it has a reference.
+    """
     if motion == IDEALIZED:
         return participant in builtin.BUILTIN
     return any(t.role == motion for t in registry.trials(participant).values())
 
 
 def require_reference(participant: str, motion: str) -> None:
-    """ParticipantError naming the participant, the motion and the motions that have a reference, unless
-    `has_reference` (a study of costs and errors means nothing without one)."""
+    """Check that the participant's motion has reference kinematics (`has_reference`).
+
+    Parameters
+    ----------
+    participant : str
+        A registered participant.
+    motion : {"calibrate", "validate", "idealized"}
+        The motion.
+
+    Raises
+    ------
+    ParticipantError
+        It has none, without which a study of costs and errors means nothing (the message names the
+        participant, the motion and the motions that have one).
+    """
     if not has_reference(participant, motion):
         usable = [m for m in MOTIONS if has_reference(participant, m)]
         why = (
@@ -251,14 +300,37 @@ class Task:
 
 
 def cost_poses(poses: np.ndarray) -> np.ndarray:
-    """(n_frames, n_bodies, 4, 4) → (2, n_frames, 4, 4) for the cost's bones."""
+    """The cost's bones' poses of a simulation's poses.
+
+    Parameters
+    ----------
+    poses : np.ndarray, shape (n_frames, n_bodies, 4, 4)
+        Every body's poses, RCS, mm.
+
+    Returns
+    -------
+    np.ndarray, shape (2, n_frames, 4, 4)
+        The poses of `cost.COST_BONES` (scaphoid, lunate).
+    """
     return np.stack([poses[:, BONES.index(b)] for b in COST_BONES])
 
 
 def outputs(result: Result, report: CostReport | None = None) -> dict:
-    """JSON-ready, NaN-free per-frame outputs (a failed run's arrays are zeros, `failed` True) and the cost's
-    `REFERENCE_KEYS`: without a `report` (no reference kinematics) those are None — the same keys for every
-    participant, and a value no one takes for a score (0 would read as a perfect fit; NaN breaks JSON)."""
+    """JSON-ready, NaN-free per-frame outputs and the cost's `REFERENCE_KEYS`.
+
+    Parameters
+    ----------
+    result : Result
+        The simulation's result; a failed run's arrays are zeros, `failed` True.
+    report : CostReport, optional
+        The cost; without one (no reference kinematics) the `REFERENCE_KEYS` are None: the same keys for
+        every participant, and no value taken for a score (0 reads as a perfect fit; NaN breaks JSON).
+
+    Returns
+    -------
+    dict
+        The info of an `Evaluation`: status, poses, contact, bundle forces, energies, steps and the cost's.
+    """
 
     def clean(a):
         return np.nan_to_num(np.asarray(a, dtype=np.float64), nan=0.0)

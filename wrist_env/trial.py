@@ -79,11 +79,19 @@ MIRROR = np.diag([1.0, 1.0, -1.0, 1.0])
 class Trial:
     """One motion trial of a participant.
 
-    name: trial name, e.g. "unresisted". role: "calibrate", "validate" or "other".
-    bones: bone names, a subset of BONES in BONES order.
-    transforms: array of shape (n_bones, n_frames, 4, 4), float64, mm; neutral pose → frame f, RCS.
-    load_n: the total tendon load of each frame (n_frames,), N, where it is known (the built-in trials'
-        truth runs), else None (taken as 0: the bones not prescribed by the trial move unloaded).
+    Parameters
+    ----------
+    name : str
+        The trial's name, e.g. "unresisted".
+    role : str
+        "calibrate", "validate" or "other" (`ROLES`).
+    bones : tuple of str
+        Bone names, a subset of BONES in BONES order.
+    transforms : np.ndarray, shape (n_bones, n_frames, 4, 4)
+        float64, mm; neutral pose → frame f, RCS (`validate_transforms`: a TrialError otherwise); n_frames >= 2.
+    load_n : np.ndarray, shape (n_frames,), optional
+        The total tendon load of each frame, N, where it is known (the built-in trials' truth runs), else
+        None (taken as 0: the bones not prescribed by the trial move unloaded).
     """
 
     name: str
@@ -131,15 +139,45 @@ class Trial:
 
 
 def mirror_trial(trial: Trial) -> Trial:
-    """The trial of the mirror-image wrist (left ↔ right): each transform conjugated by diag(1, 1, −1, 1)."""
+    """The trial of the mirror-image wrist (left ↔ right).
+
+    Parameters
+    ----------
+    trial : Trial
+        The trial.
+
+    Returns
+    -------
+    Trial
+        The same trial, each transform conjugated by diag(1, 1, −1, 1) (`MIRROR`).
+    """
     return Trial(trial.name, trial.role, trial.bones, MIRROR @ trial.transforms @ MIRROR, trial.load_n)
 
 
 def validate_transforms(array: ArrayLike, source: str, bones: tuple[str, ...] | None = None) -> np.ndarray:
-    """The transforms as float64 array of shape (..., 4, 4), or a TrialError naming `source` and the entry.
+    """The transforms, checked, as a float64 array.
 
-    Rules: finite; bottom row 0 0 0 1; rotation orthonormal (max |RᵀR − I| <= 1e-4) and proper
-    (det > 0); translations in mm, not metres, and within `MAX_TRANSLATION_MM`. `bones` names axis 0 of a (n_bones, n_frames, 4, 4) array.
+    Rules: finite; bottom row 0 0 0 1; rotation orthonormal (``max |RᵀR − I| <= 1e-4``) and proper
+    (det > 0); translations in mm, not metres, and within `MAX_TRANSLATION_MM`.
+
+    Parameters
+    ----------
+    array : array_like, shape (..., 4, 4)
+        The transforms, mm.
+    source : str
+        What they are, as a message names it.
+    bones : tuple of str, optional
+        The names of axis 0 of a (n_bones, n_frames, 4, 4) array.
+
+    Returns
+    -------
+    np.ndarray, shape (..., 4, 4)
+        The transforms as float64.
+
+    Raises
+    ------
+    TrialError
+        A rule broken (the message names `source` and the entry).
     """
     shape = np.shape(array)
 
@@ -180,7 +218,31 @@ def read_trial_csv(
     required_bones: tuple[str, ...] = REQUIRED_BONES,
     n_frames: int | None = None,
 ) -> Trial:
-    """A Trial from a CSV of 4×4 transforms (mm, RCS) per bone per frame, or a TrialError naming the file."""
+    """A Trial from a CSV of 4×4 transforms (mm, RCS) per bone per frame (the module docstring's format).
+
+    Parameters
+    ----------
+    path : str or Path
+        The CSV file.
+    name : str
+        The trial's name.
+    role : str
+        Its role (`ROLES`).
+    required_bones : tuple of str, default REQUIRED_BONES
+        The bones the file must have.
+    n_frames : int, optional
+        The number of frames it must have, if given.
+
+    Returns
+    -------
+    Trial
+        The trial, without loads.
+
+    Raises
+    ------
+    TrialError
+        A file missing or not valid (the message names it).
+    """
     path = Path(path)
     if not path.is_file():
         raise TrialError(f"trial file {path} does not exist.")
@@ -263,7 +325,15 @@ def read_trial_csv(
 
 
 def write_trial_csv(trial: Trial, path: str | Path) -> None:
-    """Write the trial as CSV (rows frame-major, bones in BONES order; exact float round trip)."""
+    """Write the trial as CSV (rows frame-major, bones in BONES order; exact float round trip).
+
+    Parameters
+    ----------
+    trial : Trial
+        The trial (its loads are not written).
+    path : str or Path
+        The CSV file.
+    """
     n_bones, n_frames = trial.transforms.shape[:2]
     matrix = trial.transforms[:, :, :3, :].transpose(1, 0, 2, 3).reshape(n_frames * n_bones, 12)
     table = pd.DataFrame(matrix, columns=list(MATRIX_COLUMNS))

@@ -48,8 +48,16 @@ VERSION = 1
 class Instance:
     """One calibration problem: a participant's hidden truth and the trials made from it.
 
-    participant: a built-in participant's name. index: k (0: the shipped truth and trials).
-    truth: the hidden ligament design. trials: {name: Trial}, one with role "calibrate", one "validate".
+    Parameters
+    ----------
+    participant : str
+        A built-in participant's name.
+    index : int
+        The instance, k (0: the shipped truth and trials).
+    truth : Design
+        The hidden ligament design.
+    trials : dict of str to Trial
+        Trial name → Trial, one with role "calibrate", one "validate".
     """
 
     participant: str
@@ -73,16 +81,42 @@ def _check(name: str, k: int) -> None:
 
 
 def seeds(name: str, k: int) -> tuple[np.random.SeedSequence, np.random.SeedSequence]:
-    """(the truth's seed, the tracking noise's seed) of instance k ≥ 1 of participant `name`: the two
-    children of a `SeedSequence` of (`ENTROPY`, the CRC-32 of the name, k)."""
+    """The seeds of instance k ≥ 1 of a participant: its truth's and its tracking noise's.
+
+    They are the two children of a `SeedSequence` of (`ENTROPY`, the CRC-32 of the name, k).
+
+    Parameters
+    ----------
+    name : str
+        The participant.
+    k : int
+        The instance.
+
+    Returns
+    -------
+    truth_seed, noise_seed : np.random.SeedSequence
+        The truth's seed and the tracking noise's seed.
+    """
     root = np.random.SeedSequence([ENTROPY, zlib.crc32(name.encode()), int(k)])
     truth_seed, noise_seed = root.spawn(2)
     return truth_seed, noise_seed
 
 
 def truth(name: str, k: int) -> Design:
-    """Instance k's hidden truth: the shipped one for k = 0, else a draw from the population prior with
-    every ligament intact."""
+    """Instance k's hidden truth.
+
+    Parameters
+    ----------
+    name : str
+        A built-in participant.
+    k : int
+        The instance, 0 ≤ k ≤ `limits.MAX_INSTANCE`.
+
+    Returns
+    -------
+    Design
+        The shipped truth for k = 0, else a draw from the population prior with every ligament intact.
+    """
     _check(name, k)
     if k == 0:
         return builtin.truth(name)
@@ -92,8 +126,21 @@ def truth(name: str, k: int) -> Design:
 
 
 def instance_key(name: str, k: int) -> str:
-    """16 hex digits naming what instance k ≥ 1 is made from: the participant, k, `VERSION` and the
-    source hash of the finer model its trials are simulated on."""
+    """16 hex digits naming what instance k ≥ 1 is made from (its cache folder's key).
+
+    Parameters
+    ----------
+    name : str
+        The participant.
+    k : int
+        The instance.
+
+    Returns
+    -------
+    str
+        A digest of the participant, k, `VERSION` and the source hash of the finer model its trials are
+        simulated on.
+    """
     from wrist_env.participants import synthetic  # the solver, on the first instance made or looked up
 
     text = json.dumps([name, int(k), VERSION, registry.model_source_hash(name, synthetic.HIGH_FIDELITY_BUILD)])

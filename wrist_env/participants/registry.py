@@ -34,17 +34,40 @@ _SOURCES: dict = {}  # name -> the ParticipantSource read once by add_folder
 
 
 def cache_dir() -> Path:
-    """Where built models are cached."""
+    """Where built models are cached.
+
+    Returns
+    -------
+    Path
+        `$WRIST_ENV_CACHE`, default `~/.cache/wrist_env`.
+    """
     return Path(os.environ.get("WRIST_ENV_CACHE", Path.home() / ".cache" / "wrist_env"))
 
 
 def participants() -> tuple[str, ...]:
-    """Names of all known participants: built-in first, then registered folders."""
+    """Names of all known participants.
+
+    Returns
+    -------
+    tuple of str
+        The built-in ones first, then the registered folders'.
+    """
     return builtin.BUILTIN + tuple(n for n in _FOLDERS if n not in builtin.BUILTIN)
 
 
 def require(*names: str) -> None:
-    """`ParticipantError` listing the known participants unless every name is one."""
+    """Check that every name is a known participant.
+
+    Parameters
+    ----------
+    *names : str
+        The names to check.
+
+    Raises
+    ------
+    ParticipantError
+        A name is not a known participant (the message lists the known ones).
+    """
     unknown = [n for n in names if n not in participants()]
     if unknown:
         raise ParticipantError(
@@ -54,7 +77,23 @@ def require(*names: str) -> None:
 
 
 def folder(name: str) -> Path:
-    """The folder a registered participant was read from."""
+    """The folder a registered participant was read from.
+
+    Parameters
+    ----------
+    name : str
+        The participant.
+
+    Returns
+    -------
+    Path
+        Its folder, as given to `add_folder`.
+
+    Raises
+    ------
+    ParticipantError
+        An unknown participant, or a built-in one.
+    """
     require(name)
     if name not in _FOLDERS:
         raise ParticipantError(f"participant {name!r} is built in, not read from a folder")
@@ -62,9 +101,20 @@ def folder(name: str) -> Path:
 
 
 def add_folder(folder: str | Path) -> str:
-    """Validate a participant folder and make it known by its name; returns the name.
+    """Validate a participant folder and make it known by its name.
 
-    The folder is read and checked once, here: edit its files, then add it again."""
+    The folder is read and checked once, here: edit its files, then add it again.
+
+    Parameters
+    ----------
+    folder : str or Path
+        The participant folder (its `participant.toml`, bones and trials).
+
+    Returns
+    -------
+    str
+        The participant's name.
+    """
 
     source = folder_module.load_participant_folder(folder)
     if source.name in builtin.BUILTIN:
@@ -81,8 +131,20 @@ def add_folder(folder: str | Path) -> str:
 
 
 def ensure_folder(folder: str | Path) -> str:
-    """`add_folder` unless this folder is registered already (a worker or a runner given the folders a
-    caller registered: read once, not again); returns its name."""
+    """`add_folder` unless this folder is registered already.
+
+    For a worker or a runner given the folders a caller registered: each is read once, not again.
+
+    Parameters
+    ----------
+    folder : str or Path
+        The participant folder.
+
+    Returns
+    -------
+    str
+        The participant's name.
+    """
     here = folder_module.resolved(folder)  # ParticipantError for a null byte or a symlink loop
     for name, path in _FOLDERS.items():
         if path.resolve() == here:
@@ -91,8 +153,20 @@ def ensure_folder(folder: str | Path) -> str:
 
 
 def bones(name: str, params: BuildParams | None = None) -> dict:
-    """The participant's bones (name -> BoneSurface, RCS mm, neutral pose) for the anatomy
-    variant of `params` (default: `BuildParams()`)."""
+    """The participant's bones for the anatomy variant of the build parameters.
+
+    Parameters
+    ----------
+    name : str
+        The participant.
+    params : BuildParams, optional
+        The build parameters whose anatomy variant is given (default `BuildParams()`).
+
+    Returns
+    -------
+    dict of str to BoneSurface
+        Bone name → surface, RCS mm, neutral pose.
+    """
     params = params or BuildParams()
     if name in builtin.BUILTIN:
         return builtin.bones(name, *params.anatomy)
@@ -106,9 +180,21 @@ def bones(name: str, params: BuildParams | None = None) -> dict:
 
 
 def build_params(name: str, params: BuildParams | None = None) -> BuildParams:
-    """`params` (default `BuildParams()`) with the participant's ulnar variance where `params` leave it None
-    (a value in `params` wins): a built-in's `builtin.ULNAR_VARIANCE_MM`, a folder's participant.toml's
-    `ulnar_variance_mm` if it states one."""
+    """The build parameters with the participant's ulnar variance where they leave it None.
+
+    Parameters
+    ----------
+    name : str
+        The participant.
+    params : BuildParams, optional
+        The build parameters (default `BuildParams()`); a value of their ulnar variance wins.
+
+    Returns
+    -------
+    BuildParams
+        `params` with a built-in's `builtin.ULNAR_VARIANCE_MM`, or a folder's participant.toml's
+        `ulnar_variance_mm` if it states one.
+    """
     params = params or BuildParams()
     if params.ulnar_variance_mm is not None:
         return params
@@ -120,7 +206,18 @@ def build_params(name: str, params: BuildParams | None = None) -> BuildParams:
 
 
 def trials(name: str) -> dict:
-    """The participant's trials {name: Trial}; at least one has role "calibrate"."""
+    """The participant's trials.
+
+    Parameters
+    ----------
+    name : str
+        The participant.
+
+    Returns
+    -------
+    dict of str to Trial
+        Trial name → Trial; at least one has role "calibrate".
+    """
     if name in builtin.BUILTIN:
         return builtin.trials(name)
     require(name)
@@ -128,7 +225,25 @@ def trials(name: str) -> dict:
 
 
 def trial(name: str, role: str) -> Trial:
-    """The participant's first trial with `role` ("calibrate" or "validate")."""
+    """The participant's first trial with a role.
+
+    Parameters
+    ----------
+    name : str
+        The participant.
+    role : str
+        "calibrate" or "validate".
+
+    Returns
+    -------
+    Trial
+        Its first trial with `role`.
+
+    Raises
+    ------
+    ParticipantError
+        It has no trial with `role` (the message lists its trials' roles).
+    """
     found = [t for t in trials(name).values() if t.role == role]
     if not found:
         raise ParticipantError(
@@ -146,9 +261,26 @@ def model_source_hash(name: str, params: BuildParams | None = None) -> str:
 
 
 def load_model(name: str, params: BuildParams | None = None, *, cache: bool = True) -> Model:
-    """The participant's model, built on first use and cached by the hash of its inputs (a built-in
-    participant's shipped model is used when its hash is that of the inputs: `builtin.SHIPPED_MODEL`).
-    A participant folder's stated ulnar variance applies where `params` leave it None (`build_params`)."""
+    """The participant's model, built on first use and cached by the hash of its inputs.
+
+    A built-in participant's shipped model is used when its hash is that of the inputs
+    (`builtin.SHIPPED_MODEL`).
+
+    Parameters
+    ----------
+    name : str
+        The participant.
+    params : BuildParams, optional
+        The build parameters (default `BuildParams()`). A participant folder's stated ulnar variance applies
+        where they leave it None (`build_params`).
+    cache : bool, default True
+        Read and write the cache (`cache_dir`); False builds afresh and caches nothing.
+
+    Returns
+    -------
+    Model
+        The built (or cached, or shipped) model.
+    """
     params = build_params(name, params)
     b = bones(name, params)
     digest = source_hash(name, b, params)
@@ -206,9 +338,21 @@ def _build(name: str, b: dict, params: BuildParams, digest: str) -> Model:
 
 @contextmanager
 def cache_lock(path: Path) -> Iterator[None]:
-    """Hold an flock on `.<name>.lock` beside a cached model (or instance) while making it: processes that
-    need the same uncached one at once (a study's workers, a test session's) make it once; the others wait
-    and load it. Released when the process dies, even by SIGKILL."""
+    """Hold an flock on `.<name>.lock` beside a cached model (or instance) while making it.
+
+    Processes that need the same uncached one at once (a study's workers, a test session's) make it once;
+    the others wait and load it. The lock is released when the process dies, even by SIGKILL.
+
+    Parameters
+    ----------
+    path : Path
+        The cached model's path without its suffix, or the instance's folder.
+
+    Yields
+    ------
+    None
+        While the lock is held.
+    """
     lock = path.parent / f".{path.name}.lock"
     with open(lock, "a+") as handle:
         fcntl.flock(handle, fcntl.LOCK_EX)

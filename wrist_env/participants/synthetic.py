@@ -76,7 +76,27 @@ def cycle() -> np.ndarray:
 
 
 def capitate_motion(task: str, trial: str) -> tuple[np.ndarray, np.ndarray]:
-    """(Cardan Z-X-Y angles (N_FRAMES, 3) deg: flexion, ulnar deviation, pronation; load (N_FRAMES,) N)."""
+    """The capitate's rotations and the tendon load of a task's trial, frame by frame.
+
+    Parameters
+    ----------
+    task : str
+        "flexion-extension", "radial-ulnar deviation" or "grip" (Table 1).
+    trial : str
+        "unresisted" or "resisted" (`TRIALS`).
+
+    Returns
+    -------
+    angles : np.ndarray, shape (N_FRAMES, 3)
+        The capitate's Cardan Z-X-Y angles, deg: flexion, ulnar deviation, pronation.
+    load : np.ndarray, shape (N_FRAMES,)
+        The total tendon load, N.
+
+    Raises
+    ------
+    ValueError
+        An unknown task.
+    """
     phi = cycle()
     half = 0.5 * (1.0 - np.cos(phi))  # 0 → 1 → 0
     angles = np.zeros((N_FRAMES, 3))
@@ -97,10 +117,32 @@ def capitate_motion(task: str, trial: str) -> tuple[np.ndarray, np.ndarray]:
 
 
 def synthetic_trials(name: str, task: str, truth: Design, seed: int) -> tuple[dict[str, Trial], dict]:
-    """Participant `name`'s trials made from `truth` for its `task`, with tracking noise drawn from
-    `np.random.default_rng(seed)`: ({trial name: Trial (every body, `load_n` recorded)}, a record per
-    trial of its task, role, the capitate's angles (deg), loads (N) and solver steps). `TrialsRefused`
-    naming the participant, the trial and the solver's message if the truth's run fails."""
+    """A participant's synthetic trials, made from a hidden truth for its task.
+
+    Parameters
+    ----------
+    name : str
+        The participant, whose model (built at `HIGH_FIDELITY_BUILD`) simulates the truth.
+    task : str
+        Its Table 1 task (see `capitate_motion`).
+    truth : Design
+        The hidden true ligament design.
+    seed : int
+        The seed of the tracking noise (`np.random.default_rng(seed)`).
+
+    Returns
+    -------
+    trials : dict of str to Trial
+        Trial name → Trial (every body, `load_n` recorded).
+    record : dict
+        Per trial: its task, role, the capitate's angles (deg), loads (N), solver steps and largest residual
+        (N).
+
+    Raises
+    ------
+    TrialsRefused
+        The truth's run fails (the message names the participant, the trial and the solver's message).
+    """
     model = load_model(name, HIGH_FIDELITY_BUILD)
     rng = np.random.default_rng(seed)
     trials, record = {}, {}
