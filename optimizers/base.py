@@ -15,8 +15,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
-from wrist_env.design import SPAN_SD, material_prior
+from wrist_env.design import SPAN_SD
 from wrist_env.errors import InputError
+from wrist_env.table2 import material_prior
 
 __all__ = [
     "OptionError",
@@ -226,9 +227,9 @@ def prior_draw(rng: np.random.Generator, lower: np.ndarray, upper: np.ndarray) -
     """A point of the box [lower, upper] drawn from the population prior.
 
     Each coordinate is the box centre plus a normal of SD (upper − lower) / (2·SPAN_SD), truncated at
-    ±SPAN_SD SD — Table 2's normals truncated as `design.sample_materials` draws them, whose ±SPAN_SD SD span
+    ±SPAN_SD SD — Table 2's normals truncated as `table2.sample_materials` draws them, whose ±SPAN_SD SD span
     the box. On the benchmark's box of the 22 normalized materials, [-1, 1]^22, and a fresh
-    `np.random.default_rng(seed)` it is exactly `design.sample_materials(1, seed)[0]`.
+    `np.random.default_rng(seed)` it is exactly `table2.sample_materials(1, seed)[0]`.
 
     Parameters
     ----------

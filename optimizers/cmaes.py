@@ -23,7 +23,7 @@ class CMAES(Optimizer):
 
     Options:
       x0: start mean of the first run (default: where the seed puts it, a draw from the prior,
-        `base.prior_draw`: Table 2's normals truncated at ±3 SD as `design.sample_materials` draws
+        `base.prior_draw`: Table 2's normals truncated at ±3 SD as `table2.sample_materials` draws
         them, from the seeded `self.rng`);
       sigma0: initial step size as a fraction of the box width (default 0.3);
         with unequal widths it is passed as sigma0 = fraction and

@@ -84,7 +84,7 @@ class NelderMead(Optimizer):
     """`scipy.optimize.minimize(method="Nelder-Mead", bounds=...)`, one point per ask, restarted until the budget.
 
     The first run starts where the seed puts it: at a draw from the prior (`base.prior_draw`: Table 2's
-    normals truncated at ±3 SD, as `design.sample_materials` draws them) from the seeded `self.rng`,
+    normals truncated at ±3 SD, as `table2.sample_materials` draws them) from the seeded `self.rng`,
     so each seed is another run (before issue 55 every seed started at the box centre, the population
     design, and gave the same run).
 

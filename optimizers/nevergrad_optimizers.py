@@ -10,7 +10,7 @@ Each drives one Nevergrad optimizer through its ask/tell API on a bounded
 `nevergrad.p.Array` whose random state is seeded with the calibrator's seed, so a
 run is deterministic for a seed (the benchmark resumes a cut-short cell by replay).
 Its init is `x0`, by default where the seed puts it: a draw from the prior
-(`base.prior_draw`: Table 2's normals truncated at ±3 SD, as `design.sample_materials`
+(`base.prior_draw`: Table 2's normals truncated at ±3 SD, as `table2.sample_materials`
 draws them) from the seeded `self.rng` — so NGOpt, which runs a deterministic method
 (COBYLA) one point at a time for small budgets, gives another run for each seed. A batch is `batch_size`
 candidates asked before any is told (`num_workers` of the optimizer; default

@@ -28,7 +28,7 @@ Sampler options: "optuna-tpe" multivariate (default True, as Optuna ≥ 4
 for one objective), n_ei_candidates (24); "optuna-cmaes" popsize (default
 4 + ⌊3 ln dim⌋), sigma0, use_separable_cma, restart_strategy, x0 (the start mean;
 default a draw from the prior, `base.prior_draw`: Table 2's normals truncated at ±3 SD as
-`design.sample_materials` draws them, from the seeded `self.rng` — Optuna's default, the box
+`table2.sample_materials` draws them, from the seeded `self.rng` — Optuna's default, the box
 centre, would start every seed at the population design); "optuna-gp"
 deterministic_objective (default False).
 

@@ -15,8 +15,8 @@ from wrist_env.frames import (
     invert,
     pose_to_dof,
     rmse,
-    validate_poses,
 )
+from wrist_env.pose_checks import validate_poses
 
 
 def pose(rotation=np.eye(3), translation=(0.0, 0.0, 0.0)) -> np.ndarray:

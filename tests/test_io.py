@@ -155,7 +155,7 @@ def test_read_json_refuses_what_is_not_a_regular_file(tmp_path, special):
 
 @pytest.mark.timeout(30)
 def test_a_model_whose_cached_json_is_a_device_is_refused(tmp_path):
-    """`Model.load` (the registry's cache, `registry.cache_dir()`) reads through `load_dataclass`."""
+    """`Model.load` (the registry's cache, `cache.cache_dir()`) reads through `load_dataclass`."""
     from wrist_env.model import Model
 
     (tmp_path / "P1-abc.json").symlink_to("/dev/zero")

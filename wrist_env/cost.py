@@ -35,14 +35,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from wrist_env.errors import InputError
-from wrist_env.frames import (
-    DOF_NAMES,
-    DOF_UNITS,
-    error_dof_validated,
-    pose_to_dof_validated,
-    validate_points,
-    validate_poses,
-)
+from wrist_env.frames import DOF_NAMES, DOF_UNITS, error_dof_validated, pose_to_dof_validated
+from wrist_env.pose_checks import validate_points, validate_poses
 
 __all__ = [
     "COST_BONES",

@@ -26,10 +26,10 @@ import pandas as pd
 from numpy.typing import ArrayLike
 
 from wrist_env.errors import TrialError
-from wrist_env.frames import validate_poses
 from wrist_env.limits import MAX_TRIAL_FRAMES
 from wrist_env.model import BONES, CARPALS
 from wrist_env.motions import TRIAL_MOTIONS
+from wrist_env.pose_checks import validate_poses
 
 __all__ = [
     "ROLES",

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from wrist_env import design, ligaments
+from wrist_env import design, ligaments, table2
 from wrist_env.builder.warp import random_warp
 
 OUT = Path(__file__).resolve().parents[2] / "wrist_env" / "participants" / "data"
@@ -32,7 +32,7 @@ def main() -> None:
         warp = random_warp(row["seed"], amplitude_mm=0.8, width_mm=15.0, n_centres=6, extent_mm=25.0)
         warp = type(warp).from_dict({**warp.as_dict(), "scale": row["scale"]})
         truth_seed = row["seed"] + 1
-        materials = design.sample_materials(1, truth_seed)[0]
+        materials = table2.sample_materials(1, truth_seed)[0]
         action = np.concatenate([materials, np.ones(len(ligaments.INJURABLE))])
         truth = design.from_action(action)
         folder = OUT / name
@@ -41,7 +41,7 @@ def main() -> None:
         info.update(name=name, warp=warp.as_dict(), truth_seed=truth_seed)
         (folder / "participant.json").write_text(json.dumps(info, indent=2) + "\n")
         (folder / "truth.json").write_text(json.dumps(truth.as_dict(), indent=2) + "\n")
-        print(f"{name}: scale {row['scale']}, truth z-scores {np.round(design.z_scores(truth), 2).tolist()}")
+        print(f"{name}: scale {row['scale']}, truth z-scores {np.round(table2.z_scores(truth), 2).tolist()}")
 
 
 if __name__ == "__main__":

@@ -29,7 +29,7 @@ import time
 import numpy as np
 from numba import get_num_threads, njit
 
-from wrist_env import design
+from wrist_env import design, table2
 from wrist_env.participants import registry
 from wrist_env.participants.registry import load_model
 from wrist_env.solver import arrays
@@ -61,7 +61,7 @@ def calibration_trial(name: str, model):
 
 def monte_carlo_designs(n: int, seed: int = 0):
     rng = np.random.default_rng(seed)
-    materials = design.sample_materials(n, seed)
+    materials = table2.sample_materials(n, seed)
     injury = np.where(rng.random((n, 5)) < 0.3, -0.5, 0.5)
     return [design.from_action(np.r_[m, i]) for m, i in zip(materials, injury)]
 

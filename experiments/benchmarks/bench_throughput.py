@@ -33,6 +33,7 @@ PROBE = """
 import json, sys, time
 import numpy as np
 from wrist_env import design
+from wrist_env import table2
 from wrist_env.participants import registry
 from wrist_env.solver.drivers import idealized, trial_driver
 from wrist_env.solver.simulate import simulate, simulate_batch
@@ -41,7 +42,7 @@ name = sys.argv[1]
 BENCHMARK = 3 * 11 * 5 * 300  # participants x calibrators x seeds x budget: `wrist-bench benchmark`'s defaults
 model = registry.load_model(name)
 rng = np.random.default_rng(0)
-materials = design.sample_materials(64, 0)
+materials = table2.sample_materials(64, 0)
 injury = np.where(rng.random((64, 5)) < 0.3, -0.5, 0.5)
 designs = [design.from_action(np.r_[m, i]) for m, i in zip(materials, injury)]
 pop = design.population()

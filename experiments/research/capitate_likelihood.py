@@ -42,7 +42,7 @@ from scipy.spatial.transform import Rotation
 from scipy.special import gammaln, logsumexp
 from scipy.stats import gamma
 
-from wrist_env import design
+from wrist_env import design, table2
 from wrist_env.identification import likelihood
 from wrist_env.identification.map import map_estimate
 from wrist_env.model import BONES, CAPITATE
@@ -183,11 +183,11 @@ def marginal(t: Task, d: design.Design, drivers: list) -> dict[str, float]:
 
 def rows(name: str) -> tuple[list[dict], list[dict]]:
     t = task(name, "calibrate")
-    z_truth = design.z_scores(builtin.truth(name))
+    z_truth = table2.z_scores(builtin.truth(name))
     map_z, *_ = map_estimate(t)
     values, check, drivers = {}, [], noisy_drivers(t, max(MARGINAL_DRAWS))
     for label, z in (("truth", z_truth), ("MAP", map_z)):
-        d = design.with_z(design.population(), z)
+        d = table2.with_z(design.population(), z)
         run = t.evaluate(d).result
         r, D = likelihood.residuals(t, run.poses), response(t, d, run)
         prior = float(likelihood.log_prior(z))

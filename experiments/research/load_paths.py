@@ -60,7 +60,7 @@ from wrist_env.builder.warp import Warp
 from wrist_env.errors import BuildError
 from wrist_env.ligaments import ALL_LIGAMENT_NAMES
 from wrist_env.model import BODY_PARTS, BONES, CAPITATE, MIDCARPAL, PAIR_BONES, PAIRS, Model
-from wrist_env.participants import builtin, registry
+from wrist_env.participants import builtin, cache, registry
 from wrist_env.participants.registry import load_model
 from wrist_env.solver import drivers
 from wrist_env.solver import simulate as sim
@@ -299,7 +299,7 @@ def shifted_model(name: str, shift_mm: float, axis: np.ndarray) -> Model:
     v.setflags(write=False)
     bones["capitate"] = dataclasses.replace(cap, vertices=v)
     digest = source_hash(name, bones, params)
-    path = registry.cache_dir() / f"{name}-{digest}"
+    path = cache.cache_dir() / f"{name}-{digest}"
     if path.with_suffix(".json").exists():
         return Model.load(path)
     model = build_model(name, bones, params, digest=digest, progress=False)

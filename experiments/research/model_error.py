@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from wrist_env import design
+from wrist_env import design, table2
 from wrist_env.frames import cardan_rotation
 from wrist_env.identification import likelihood
 from wrist_env.identification.map import map_estimate
@@ -66,8 +66,8 @@ def rows(name: str) -> list[dict]:
     capitate, clean = run.poses[:, CAPITATE], cost_poses(run.poses)
     map_z, *_ = map_estimate(calibration)
     out = []
-    for label, z in (("truth", design.z_scores(builtin.truth(name))), ("MAP", map_z)):
-        d = design.with_z(design.population(), z)
+    for label, z in (("truth", table2.z_scores(builtin.truth(name))), ("MAP", map_z)):
+        d = table2.with_z(design.population(), z)
 
         def residuals(driven: np.ndarray) -> np.ndarray:
             return likelihood.residuals(

@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 from scipy.stats import chi2
 
-from wrist_env import design
+from wrist_env import design, table2
 from wrist_env.identification.posterior import Posterior
 from wrist_env.identification.study import against_truth
 from wrist_env.participants import builtin
@@ -31,7 +31,7 @@ RUNS = Path(__file__).resolve().parents[2] / "leaderboards/posterior/steps1200/r
 def spread(post: Posterior) -> dict:
     """One run's row: `against_truth` with the χ²₂₂ quantiles and the samples' 90th-percentile deficit."""
     dim = post.samples.shape[1]
-    at = against_truth(post, design.z_scores(builtin.truth(post.participant)))
+    at = against_truth(post, table2.z_scores(builtin.truth(post.participant)))
     return {
         "participant": post.participant,
         "seed": post.seed,

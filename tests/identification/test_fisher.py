@@ -4,7 +4,7 @@ finite-difference Jacobian against the simulator itself, and the command."""
 import numpy as np
 import pytest
 
-from wrist_env import design
+from wrist_env import design, table2
 from wrist_env.cli import main
 from wrist_env.identification import fisher, likelihood
 from wrist_env.participants import builtin
@@ -45,7 +45,7 @@ def test_the_jacobian_predicts_the_simulated_change(p1_calibrate):
         moves.append(dz * 0.2 / np.sqrt(np.mean(dz**2)))
     from wrist_env.solver.simulate import simulate_batch
 
-    designs = [truth] + [design.with_z(truth, design.z_scores(truth) + dz) for dz in moves]
+    designs = [truth] + [table2.with_z(truth, table2.z_scores(truth) + dz) for dz in moves]
     runs = simulate_batch(task.model, designs, task.driver, prepared=task.prepared)
     base = cost_poses(runs[0].poses)
     misses = []
@@ -72,7 +72,7 @@ def test_the_command_writes_tables_and_a_figure(tmp_path, capsys):
 
 def test_with_z_inverts_z_scores():
     truth = builtin.truth("P2")
-    np.testing.assert_allclose(design.z_scores(design.with_z(truth, design.z_scores(truth))), design.z_scores(truth))
-    assert np.array_equal(design.with_z(truth, np.zeros(22)).injury, truth.injury)
+    np.testing.assert_allclose(table2.z_scores(table2.with_z(truth, table2.z_scores(truth))), table2.z_scores(truth))
+    assert np.array_equal(table2.with_z(truth, np.zeros(22)).injury, truth.injury)
     with pytest.raises(Exception, match="shape"):
-        design.with_z(truth, np.zeros(21))
+        table2.with_z(truth, np.zeros(21))

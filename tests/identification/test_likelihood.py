@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from wrist_env import design
+from wrist_env import design, table2
 from wrist_env.bench import RunLog, calibrate
 from wrist_env.frames import error_dof
 from wrist_env.identification import likelihood
@@ -45,7 +45,7 @@ def test_map_objective_is_the_misfit_over_the_noise_plus_the_prior(built):
     built("P1")
     t = task("P1", "calibrate")
     z = np.linspace(-1, 1, design.N_MATERIAL)
-    d = design.with_z(design.population(), z)
+    d = table2.with_z(design.population(), z)
     e = t.evaluate(d)
     misfit = 0.0
     for b, bone in enumerate(("scaphoid", "lunate")):

@@ -5,7 +5,8 @@ import pytest
 
 import optimizers
 from optimizers.base import prior_draw
-from wrist_env.design import N_MATERIAL, sample_materials
+from wrist_env.design import N_MATERIAL
+from wrist_env.table2 import sample_materials
 
 LOWER, UPPER = -np.ones(N_MATERIAL), np.ones(N_MATERIAL)
 
@@ -26,7 +27,7 @@ def test_nelder_mead_seeds_start_at_different_points():
 
 @pytest.mark.parametrize("seed", [0, 3])
 def test_nelder_mead_starts_at_the_seeds_draw_from_the_prior(seed):
-    """On the benchmark's box the start is `design.sample_materials(1, seed)`, the draw instances use."""
+    """On the benchmark's box the start is `table2.sample_materials(1, seed)`, the draw instances use."""
     np.testing.assert_array_equal(first_point("nelder-mead", seed), sample_materials(1, seed)[0])
 
 

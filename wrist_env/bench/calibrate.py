@@ -34,6 +34,7 @@ from numpy.typing import ArrayLike
 import optimizers
 from optimizers.optuna_storage import open_url
 from wrist_env import design as design_vars
+from wrist_env import table2
 from wrist_env.bench.log import RunLog
 from wrist_env.bench.replay import REPLAY_TOLERANCE as REPLAY_TOLERANCE  # `X as X`: re-exported from here
 from wrist_env.bench.replay import Logged, Replayed
@@ -146,7 +147,7 @@ class CalibrationRun:
                 "best_cost": self.calibrate["cost"] if prior else float(r.fun),
                 "x": [float(v) for v in r.x],
                 "design": self.design.as_dict(),
-                "z_scores": dict(zip(design_vars.NAMES[:N_MATERIAL], design_vars.z_scores(self.design).tolist())),
+                "z_scores": dict(zip(design_vars.NAMES[:N_MATERIAL], table2.z_scores(self.design).tolist())),
                 "calibrate": self.calibrate,
                 "validate": self.validate,
                 "recovery_z": self.recovery_z,
@@ -199,9 +200,7 @@ def simulate(calibration: Task, x: np.ndarray, prior: bool) -> Simulated:
     cost = evaluations.cost
     objective = cost
     if prior:
-        objective = np.array(
-            [map_objective(calibration, e, design_vars.z_scores(d)) for e, d in zip(evaluations, designs)]
-        )
+        objective = np.array([map_objective(calibration, e, table2.z_scores(d)) for e, d in zip(evaluations, designs)])
     rmse = np.stack([rmse_vector(e.info) for e in evaluations])
     return Simulated(objective, cost, evaluations.failed, rmse, [unsettled_frames(e) for e in evaluations])
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from wrist_env import design as design_vars
+from wrist_env import table2
 from wrist_env.cost import COST_BONES
 from wrist_env.design import Design
 from wrist_env.frames import DOF_NAMES
@@ -28,7 +29,7 @@ def rmse_vector(info: dict) -> np.ndarray:
 
 def recovery_error(calibrated: Design, truth: Design) -> float:
     """Parameter-recovery error: RMS over the 22 materials of z(calibrated) − z(truth), Table 2 SD units."""
-    dz = design_vars.z_scores(calibrated) - design_vars.z_scores(truth)
+    dz = table2.z_scores(calibrated) - table2.z_scores(truth)
     return float(np.sqrt(np.mean(dz**2)))
 
 

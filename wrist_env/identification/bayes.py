@@ -37,7 +37,7 @@ import time
 
 import numpy as np
 
-from wrist_env import design
+from wrist_env import design, table2
 from wrist_env.cost import COST_BONES
 from wrist_env.errors import ParticipantError
 from wrist_env.frames import pose_to_dof
@@ -130,7 +130,7 @@ def calibrate(
     draws = samples[rng.choice(len(samples), min(PREDICTIVE_DRAWS, len(samples)), replace=False)]
     predictive, observed, noise = [], [], None
     for motion, t in (("calibrate", calibration), ("validate", held_out)):
-        evaluations = t.evaluate_batch([design.with_z(design.population(), z) for z in draws])
+        evaluations = t.evaluate_batch([table2.with_z(design.population(), z) for z in draws])
         counter[0] += len(draws)
         ok = [e for e in evaluations if not e.failed]
         dof = np.stack([_dof(t, cost_poses(e.result.poses)) for e in ok])

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from wrist_env import design
+from wrist_env import design, table2
 from wrist_env.identification.likelihood import residuals
 from wrist_env.motions import TRIAL_MOTIONS
 from wrist_env.participants import builtin
@@ -63,13 +63,13 @@ def spectrum(fisher: np.ndarray) -> Spectrum:
 def jacobian(task: Task, center: design.Design, step: float = STEP_Z) -> np.ndarray:
     """∂(residuals)/∂z at `center`, shape (2 · n_frames · 6, 22), by central differences of `step` SD."""
 
-    z0 = design.z_scores(center)
+    z0 = table2.z_scores(center)
     designs = [center]
     for i in range(design.N_MATERIAL):
         for sign in (1.0, -1.0):
             z = z0.copy()
             z[i] += sign * step
-            designs.append(design.with_z(center, z))
+            designs.append(table2.with_z(center, z))
     runs = simulate_batch(task.model, designs, task.driver, prepared=task.prepared)
     failed = [k for k, r in enumerate(runs) if not r.ok]
     if failed:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import least_squares
 
-from wrist_env import design
+from wrist_env import design, table2
 from wrist_env.identification import likelihood
 from wrist_env.identification.settings import MAP_STARTS
 from wrist_env.task import Task
@@ -28,7 +28,7 @@ def map_estimate(
     n = 2 * calibration.reference.shape[1] * 6
 
     def stacked(Z):
-        evaluations = calibration.evaluate_batch([design.with_z(base, z) for z in Z])
+        evaluations = calibration.evaluate_batch([table2.with_z(base, z) for z in Z])
         runs[0] += len(Z)
         out = []
         for z, e in zip(Z, evaluations):

@@ -9,7 +9,7 @@ from collections.abc import Callable
 import emcee
 import numpy as np
 
-from wrist_env import design
+from wrist_env import design, table2
 from wrist_env.identification import likelihood
 from wrist_env.identification.settings import PRIOR_REFRESH
 from wrist_env.task import Task
@@ -21,7 +21,7 @@ def log_likelihood(calibration: Task, counter: list | None = None) -> Callable[[
 
     def log_like(Z):
         Z = np.atleast_2d(Z)
-        evaluations = calibration.evaluate_batch([design.with_z(base, z) for z in Z])
+        evaluations = calibration.evaluate_batch([table2.with_z(base, z) for z in Z])
         if counter is not None:
             counter[0] += len(Z)
         return np.array(
@@ -57,7 +57,7 @@ def prior_refresh(coords: np.ndarray, random) -> tuple[np.ndarray, np.ndarray]:
     n, dim = coords.shape
     rows, which = np.arange(n), random.randint(dim, size=n)
     old = coords[rows, which]
-    new = design.material_prior(likelihood.BOUND_Z).rvs(size=n, random_state=random)
+    new = table2.material_prior(likelihood.BOUND_Z).rvs(size=n, random_state=random)
     factors = np.where(np.abs(old) <= likelihood.BOUND_Z, 0.5 * (new**2 - old**2), -np.inf)
     out = coords.copy()
     out[rows, which] = new

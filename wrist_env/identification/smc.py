@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.stats import multivariate_t
 
-from wrist_env import design
+from wrist_env import table2
 from wrist_env.identification import likelihood
 
 START_DF = 5
@@ -30,7 +30,7 @@ class DefensiveStart:
 
     def __init__(self, mean: np.ndarray, cov: np.ndarray):
         self.student = multivariate_t(mean, START_SCALE**2 * cov, df=START_DF)
-        self.prior = design.material_prior(likelihood.BOUND_Z)
+        self.prior = table2.material_prior(likelihood.BOUND_Z)
         inside = likelihood.in_box(self.student.rvs(100_000, random_state=np.random.default_rng(0)))
         self.log_inside = np.log(max(inside.mean(), 1e-5))  # the truncated t's normalizer, Monte Carlo
 
@@ -75,7 +75,7 @@ def sample_smc(
             out = np.asarray(self.model(inputs), dtype=np.float64)
             return np.where(np.isfinite(out), out, FAILED_LOG_LIKELIHOOD)
 
-    priors = [design.material_prior(likelihood.BOUND_Z) for _ in range(dim)]
+    priors = [table2.material_prior(likelihood.BOUND_Z) for _ in range(dim)]
     mcmc = VectorMCMC(log_like, None, priors, log_like_func=Batched)
     names = [f"z{i}" for i in range(dim)]
     path = GeometricPath(proposal=start)

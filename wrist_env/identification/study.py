@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from wrist_env import design
+from wrist_env import table2
 from wrist_env.errors import StoreError
 from wrist_env.figures.posterior import plot_intervals, plot_predictive
 from wrist_env.identification.bayes import _tasks, calibrate
@@ -54,7 +54,7 @@ def study(
     suffix = ("" if trials == "built-in" else f"_{trials}") + ("" if sampler == "emcee" else f"_{sampler}")
     rows, posteriors = [], {}
     for participant in participants:
-        truth = design.z_scores(builtin.truth(participant)) if participant in builtin.BUILTIN else None
+        truth = table2.z_scores(builtin.truth(participant)) if participant in builtin.BUILTIN else None
         for seed in seeds:
             path = out / f"posterior_{participant}_seed{seed}{suffix}.npz"
             loaded = path.exists()
@@ -94,7 +94,7 @@ def study(
     report.mkdir(parents=True, exist_ok=True)
     table.to_csv(report / f"coverage{suffix}.csv", index=False)
     for participant, posts in posteriors.items():
-        truth = design.z_scores(builtin.truth(participant)) if participant in builtin.BUILTIN else None
+        truth = table2.z_scores(builtin.truth(participant)) if participant in builtin.BUILTIN else None
         plot_intervals(posts, truth, report / f"posterior_intervals_{participant}{suffix}.png")
         plot_predictive(posts[0], report / f"posterior_predictive_{participant}{suffix}.png")
     return table

@@ -38,12 +38,13 @@ import pyarrow as pa
 from numpy.typing import ArrayLike
 
 from wrist_env import design
-from wrist_env.design import N_DESIGN, N_MATERIAL, NAMES, SPAN_SD, material_prior
+from wrist_env.design import N_DESIGN, N_MATERIAL, NAMES, SPAN_SD
 from wrist_env.errors import DesignError
 from wrist_env.ligaments import INJURABLE, LIGAMENT_NAMES
 from wrist_env.montecarlo.config import EXCLUDE_ABOVE_MPA, TEAR_PROBABILITY
 from wrist_env.participants import registry
 from wrist_env.solver.settings import DEFAULT_LOADS
+from wrist_env.table2 import material_prior
 from wrist_env.task import task
 
 if TYPE_CHECKING:

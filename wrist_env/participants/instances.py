@@ -2,13 +2,13 @@
 
 Instance 0 is a built-in participant's shipped truth and trials (`builtin.truth`, `builtin.trials`).
 Instance k ≥ 1 draws its hidden truth from the population prior — Table 2's normals truncated at
-±3 SD, as the Monte Carlo sampler draws materials (`design.sample_materials`), every ligament intact
+±3 SD, as the Monte Carlo sampler draws materials (`table2.sample_materials`), every ligament intact
 (a calibration problem, not an injury) — and makes its calibrate and validate trials as the
 built-ins' are made (`synthetic.synthetic_trials`: the participant's task, the finer model, the
 tracking noise). Both draws are seeded from (participant, k) alone (`seeds`), so instance k of a
 participant is the same problem on every machine, as COCO's instances are.
 
-An instance is made once and cached beside the models (`registry.cache_dir()/instances/`), in a
+An instance is made once and cached beside the models (`cache.cache_dir()/instances/`), in a
 folder named by what it is made from (`instance_key`: the participant, k, the finer model's source
 hash and `VERSION`), holding `truth.json`, the trials as CSV (`trial` format) and `instance.json`;
 processes needing one at once make it once (a lock). A draw whose truth cannot make a trial is
@@ -28,12 +28,12 @@ from pathlib import Path
 
 import numpy as np
 
-from wrist_env import design
+from wrist_env import design, table2
 from wrist_env.design import Design
 from wrist_env.errors import ParticipantError
 from wrist_env.io import read_json, write_json
 from wrist_env.limits import MAX_INSTANCE
-from wrist_env.participants import builtin, registry
+from wrist_env.participants import builtin, cache, registry
 from wrist_env.trial import Trial, read_trial_csv, write_trial_csv
 
 __all__ = ["ENTROPY", "VERSION", "Instance", "instance", "instance_key", "seeds", "truth"]
@@ -120,7 +120,7 @@ def truth(name: str, k: int) -> Design:
     _check(name, k)
     if k == 0:
         return builtin.truth(name)
-    materials = design.sample_materials(1, seeds(name, k)[0])[0]
+    materials = table2.sample_materials(1, seeds(name, k)[0])[0]
     injury = [design.INTACT_INJURY[n] for n in design.NAMES[design.N_MATERIAL :]]
     return design.from_action(np.r_[materials, injury])
 
@@ -148,7 +148,7 @@ def instance_key(name: str, k: int) -> str:
 
 
 def _folder(name: str, k: int) -> Path:
-    return registry.cache_dir() / "instances" / f"{name}-{k}-{instance_key(name, k)}"
+    return cache.cache_dir() / "instances" / f"{name}-{k}-{instance_key(name, k)}"
 
 
 def _load(folder: Path, name: str, k: int) -> Instance:
@@ -221,7 +221,7 @@ def instance(name: str, k: int = 0) -> Instance:
     folder = _folder(name, k)
     if not (folder / "instance.json").is_file():
         folder.parent.mkdir(parents=True, exist_ok=True)
-        with registry.cache_lock(folder):
+        with cache.cache_lock(folder):
             if not (folder / "instance.json").is_file():
                 _make(folder, name, k)
     return _load(folder, name, k)

@@ -7,11 +7,7 @@ the annotations and the builder version.
 
 from __future__ import annotations
 
-import fcntl
-import os
 import warnings
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -24,6 +20,7 @@ from wrist_env.model import BONES, OPTIONAL_BONES, SUPPLIED, Model
 from wrist_env.participants import builtin
 from wrist_env.participants import folder as folder_module  # by module: tests count its reads
 from wrist_env.participants.bone_mesh import solid_mask
+from wrist_env.participants.cache import cache_dir, cache_lock, cached, check_cache
 
 if TYPE_CHECKING:
     from wrist_env.solver.settings import SolverSettings
@@ -31,17 +28,6 @@ if TYPE_CHECKING:
 
 _FOLDERS: dict[str, Path] = {}
 _SOURCES: dict = {}  # name -> the ParticipantSource read once by add_folder
-
-
-def cache_dir() -> Path:
-    """Where built models are cached.
-
-    Returns
-    -------
-    Path
-        `$WRIST_ENV_CACHE`, default `~/.cache/wrist_env`.
-    """
-    return Path(os.environ.get("WRIST_ENV_CACHE", Path.home() / ".cache" / "wrist_env"))
 
 
 def participants() -> tuple[str, ...]:
@@ -285,7 +271,7 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
     b = bones(name, params)
     digest = source_hash(name, b, params)
     path = cache_dir() / f"{name}-{digest}"
-    model = _cached(path, name, digest) if cache else None
+    model = cached(path, name, digest) if cache else None
     if model is not None:
         return model
     if cache and builtin.shipped_source_hash(name) == digest:
@@ -297,7 +283,7 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
         return _build(name, b, params, digest)
     check_cache(path)  # before a build of minutes, not after
     with cache_lock(path):  # another process building this model: wait for it, then load what it saved
-        model = _cached(path, name, digest, quiet=True)
+        model = cached(path, name, digest, quiet=True)
         if model is None:
             model = _build(name, b, params, digest)
             try:
@@ -305,24 +291,6 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
             except OSError as e:  # the build is not lost: the model is used uncached
                 warnings.warn(f"{path}: the built model could not be cached ({type(e).__name__}: {e})", stacklevel=2)
     return model
-
-
-def _cached(path: Path, name: str, digest: str, *, quiet: bool = False) -> Model | None:
-    """The model cached at `path` if it is there whole and is `name`'s of source hash `digest`; else None
-    (damage warned about, naming the file, unless `quiet`)."""
-    if not path.with_suffix(".json").exists():
-        return None
-    try:
-        model = Model.load(path)
-        if model.name != name or model.source_hash != digest:
-            raise StoreError(
-                f"{path.with_suffix('.json')} holds {model.name!r} {model.source_hash}, not {name!r} {digest}"
-            )
-        return model
-    except StoreError as e:
-        if not quiet:
-            warnings.warn(f"rebuilding a damaged cached model: {e}", stacklevel=2)
-        return None
 
 
 def _build(name: str, b: dict, params: BuildParams, digest: str) -> Model:
@@ -334,32 +302,6 @@ def _build(name: str, b: dict, params: BuildParams, digest: str) -> Model:
         if name in _FOLDERS:  # name the folder's file
             raise BuildError(f"{_FOLDERS[name] / 'participant.toml'}: {e}") from e
         raise
-
-
-@contextmanager
-def cache_lock(path: Path) -> Iterator[None]:
-    """Hold an flock on `.<name>.lock` beside a cached model (or instance) while making it.
-
-    Processes that need the same uncached one at once (a study's workers, a test session's) make it once;
-    the others wait and load it. The lock is released when the process dies, even by SIGKILL.
-
-    Parameters
-    ----------
-    path : Path
-        The cached model's path without its suffix, or the instance's folder.
-
-    Yields
-    ------
-    None
-        While the lock is held.
-    """
-    lock = path.parent / f".{path.name}.lock"
-    with open(lock, "a+") as handle:
-        fcntl.flock(handle, fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(handle, fcntl.LOCK_UN)
 
 
 def warm_solver(settings: SolverSettings | None = None) -> None:
@@ -379,29 +321,12 @@ def warm_solver(settings: SolverSettings | None = None) -> None:
     warm(load_model("P1"), settings)
 
 
-def check_cache(path: Path) -> None:
-    """`StoreError` naming the folder or file unless a model can be cached at `path` (`.npz` + `.json`)."""
-    advice = "set WRIST_ENV_CACHE to a writable folder, or load with cache=False"
-    for p in (path.with_suffix(".npz"), path.with_suffix(".json")):
-        if p.is_dir():
-            raise StoreError(f"{p}: a folder where the cached model goes; remove it, or {advice}")
-    probe = path.parent / f".{path.name}.probe.tmp"  # a temporary name `io.clean_temporary` knows
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        probe.write_bytes(b"")
-        probe.unlink()
-    except OSError as e:
-        raise StoreError(f"{path.parent}: the model cache cannot be written ({e.strerror or e}); {advice}") from None
-
-
 __all__ = [
-    "cache_lock",
     "BONES",
     "add_folder",
     "ensure_folder",
     "bones",
     "build_params",
-    "cache_dir",
     "folder",
     "load_model",
     "participants",
