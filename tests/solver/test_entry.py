@@ -119,3 +119,42 @@ def test_the_second_process_imports_this_package_not_one_in_the_working_folder(t
     assert done.returncode == 0, done.stderr[-2000:]
     assert Path(done.stdout.strip()).resolve().parents[2] == Path(wrist_env.__file__).resolve().parents[1]
     assert command[1:] == ["-m", "wrist_env.solver.parts", "smooth", str(tmp_path / "model")]
+
+
+def test_the_second_process_gets_the_simulated_model_and_its_copy_is_removed(built, monkeypatch):
+    """From an empty cache, `compiling` saves the simulated model for the second process (whose command names
+    it), and removes the copy when the block ends; a model that cannot be saved starts no process, and the
+    entry point compiles here alone."""
+    from wrist_env.model import Model
+    from wrist_env.solver import precompile
+
+    model = built("P1")
+    settings = settings_tuple(SolverSettings(), EXPERIMENTAL)
+    started = []
+
+    class Process:
+        def __init__(self, command, **_):
+            started.append(command)
+            self.saved = Model.load(command[-1])  # the file is there while the process runs
+
+        def terminate(self):
+            pass
+
+        def wait(self):
+            return 0
+
+    monkeypatch.setattr(precompile, "_wanted", lambda entry: True)
+    monkeypatch.setattr(precompile.subprocess, "Popen", Process)
+    with precompile.compiling(settings, model) as entry:
+        assert entry is kernel.run_preconditioned
+    (command,) = started
+    assert command[-2] == "smooth" and command[-3] == "wrist_env.solver.parts"
+    assert not Path(command[-1]).parent.exists()
+
+    class Unsaveable:
+        def save(self, path):
+            raise OSError(28, "No space left on device")
+
+    with precompile.compiling(settings, Unsaveable()) as entry:
+        assert entry is kernel.run_preconditioned
+    assert len(started) == 1

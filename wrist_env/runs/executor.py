@@ -147,7 +147,7 @@ class Inline(Executor):
 
 class Processes(Executor):
     """Tasks on `workers` spawned local processes with `threads` Numba threads each (default ⌊cores / workers⌋),
-    started after `warm()`, if given, ran here (it compiles the kernels the tasks call: each worker then loads them
+    started after `warm()`, if given, has run here (it compiles the kernels the tasks call: each worker then loads them
     from Numba's cache instead of compiling them)."""
 
     def __init__(self, workers: int, threads: int | None = None, warm: Callable[[], object] | None = None):

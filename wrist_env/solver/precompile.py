@@ -19,6 +19,7 @@ compiles, this module only decides whether to start it, and starts it.
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -56,11 +57,20 @@ def _wanted(entry) -> bool:
     return preconditioned and not entry.signatures and (os.cpu_count() or 1) >= 2 and cold(entry)
 
 
-def _start(smooth: bool, model: Model, folder: Path) -> subprocess.Popen:
-    """The second process, on `model` saved into `folder`."""
-    model.save(folder / "model")
-    command, home = helper_command(smooth, folder / "model")
-    return subprocess.Popen(command, cwd=home, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+def _start(smooth: bool, model: Model) -> tuple[subprocess.Popen, Path] | None:
+    """(the second process, on `model` saved for it into a new temporary folder; that folder), or None where the
+    model cannot be saved or the process started (this process then compiles the parts itself, as on one core)."""
+    try:
+        folder = Path(tempfile.mkdtemp(prefix="wrist_env_parts_"))
+    except OSError:
+        return None
+    try:
+        model.save(folder / "model")
+        command, home = helper_command(smooth, folder / "model")
+        return subprocess.Popen(command, cwd=home, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL), folder
+    except OSError:
+        shutil.rmtree(folder, ignore_errors=True)
+        return None
 
 
 def helper_command(smooth: bool, model: Path) -> tuple[list[str], Path]:
@@ -77,13 +87,12 @@ def compiling(settings, model: Model):
     entry point, with the parts compiling in a second process meanwhile where `wanted` says so; that process
     ends when the block ends (by then its work is done, or done here too), and the model's copy with it."""
     entry = kernel.entry(settings)
-    if not _wanted(entry):
+    started = _start(bool(settings.smooth_normals), model) if _wanted(entry) else None
+    try:
         yield entry
-        return
-    with tempfile.TemporaryDirectory(prefix="wrist_env_parts_") as folder:
-        helper = _start(bool(settings.smooth_normals), model, Path(folder))
-        try:
-            yield entry
-        finally:
+    finally:
+        if started is not None:
+            helper, folder = started
             helper.terminate()
             helper.wait()
+            shutil.rmtree(folder, ignore_errors=True)
