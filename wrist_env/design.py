@@ -295,7 +295,7 @@ def to_action(design: Design) -> np.ndarray:
     Parameters
     ----------
     design : Design
-        The design.
+        The physical design: materials in N/mm and l_ref / l0, injury scalars.
 
     Returns
     -------
@@ -376,7 +376,7 @@ def ligament_arrays(design: Design) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     Parameters
     ----------
     design : Design
-        The design.
+        The design whose 11 ligaments are listed first; its torn ones are those with injury < 0.
 
     Returns
     -------

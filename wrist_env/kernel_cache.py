@@ -73,7 +73,7 @@ def source_digest(package: Path) -> str:
     Parameters
     ----------
     package : Path
-        The package's folder.
+        The package's folder (`wrist_env/`), whose kernels' sources are hashed.
 
     Returns
     -------

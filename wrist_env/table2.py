@@ -20,7 +20,7 @@ def z_scores(design: Design) -> np.ndarray:
     Parameters
     ----------
     design : Design
-        The design.
+        The design whose 22 materials are scored (its injury scalars are not).
 
     Returns
     -------

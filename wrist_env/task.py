@@ -110,7 +110,7 @@ def has_reference(participant: str, motion: str) -> bool:
     participant : str
         A registered participant.
     motion : {"calibrate", "validate", "idealized"}
-        The motion.
+        A trial's role, or the idealized sweep.
 
     Returns
     -------

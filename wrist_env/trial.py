@@ -144,7 +144,7 @@ def mirror_trial(trial: Trial) -> Trial:
     Parameters
     ----------
     trial : Trial
-        The trial.
+        A trial in the RCS of one side (left or right).
 
     Returns
     -------

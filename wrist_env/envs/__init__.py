@@ -51,7 +51,7 @@ def register_participant(folder: str | Path) -> tuple[str, ...]:
     Parameters
     ----------
     folder : str or Path
-        The participant folder.
+        The participant folder (participant.toml, bone meshes, trial CSVs).
 
     Returns
     -------

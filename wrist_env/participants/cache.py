@@ -35,7 +35,7 @@ def cached(path: Path, name: str, digest: str, *, quiet: bool = False) -> Model 
     path : Path
         The cached model's path without its suffixes.
     name : str
-        The participant.
+        The participant the model must be built for.
     digest : str
         The source hash the model must have (`builder.digest.source_hash`).
     quiet : bool, default False

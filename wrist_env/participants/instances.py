@@ -88,9 +88,9 @@ def seeds(name: str, k: int) -> tuple[np.random.SeedSequence, np.random.SeedSequ
     Parameters
     ----------
     name : str
-        The participant.
+        The participant, whose name (not its model) seeds the draw.
     k : int
-        The instance.
+        The instance, ≥ 1.
 
     Returns
     -------
@@ -131,9 +131,9 @@ def instance_key(name: str, k: int) -> str:
     Parameters
     ----------
     name : str
-        The participant.
+        A built-in participant: its high-fidelity model's source hash enters the key.
     k : int
-        The instance.
+        The instance, ≥ 1.
 
     Returns
     -------

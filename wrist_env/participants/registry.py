@@ -68,7 +68,7 @@ def folder(name: str) -> Path:
     Parameters
     ----------
     name : str
-        The participant.
+        A participant registered from a folder (`add_folder`).
 
     Returns
     -------
@@ -124,7 +124,7 @@ def ensure_folder(folder: str | Path) -> str:
     Parameters
     ----------
     folder : str or Path
-        The participant folder.
+        A participant folder, registered in this process or not.
 
     Returns
     -------
@@ -144,7 +144,7 @@ def bones(name: str, params: BuildParams | None = None) -> dict:
     Parameters
     ----------
     name : str
-        The participant.
+        A built-in participant or a registered folder's.
     params : BuildParams, optional
         The build parameters whose anatomy variant is given (default `BuildParams()`).
 
@@ -171,7 +171,7 @@ def build_params(name: str, params: BuildParams | None = None) -> BuildParams:
     Parameters
     ----------
     name : str
-        The participant.
+        A built-in participant or a registered folder's (whose participant.toml may state its ulnar variance).
     params : BuildParams, optional
         The build parameters (default `BuildParams()`); a value of their ulnar variance wins.
 
@@ -197,7 +197,7 @@ def trials(name: str) -> dict:
     Parameters
     ----------
     name : str
-        The participant.
+        A built-in participant or a registered folder's.
 
     Returns
     -------
@@ -216,7 +216,7 @@ def trial(name: str, role: str) -> Trial:
     Parameters
     ----------
     name : str
-        The participant.
+        A built-in participant or a registered folder's.
     role : str
         "calibrate" or "validate".
 
@@ -255,7 +255,7 @@ def load_model(name: str, params: BuildParams | None = None, *, cache: bool = Tr
     Parameters
     ----------
     name : str
-        The participant.
+        A built-in participant (P1–P3) or a registered folder's (`add_folder`).
     params : BuildParams, optional
         The build parameters (default `BuildParams()`). A participant folder's stated ulnar variance applies
         where they leave it None (`build_params`).
