@@ -28,6 +28,7 @@ source_suffix = {".md": "markdown", ".rst": "restructuredtext"}  # .rst: the pag
 exclude_patterns = ["_build", "speed", "examples"]
 myst_heading_anchors = 4
 myst_enable_extensions = ["dollarmath"]
+smartquotes_action = "qe"  # quotes and ellipses; not dashes: a docstring's `--json` stays two hyphens
 autodoc_member_order = "bysource"
 autodoc_typehints = "description"
 autodoc_type_aliases = {"ArrayLike": "ArrayLike", "DTypeLike": "DTypeLike"}  # not numpy's expanded unions

@@ -67,7 +67,7 @@ def material_prior(truncate_sd: float = SPAN_SD):
     Returns
     -------
     scipy.stats frozen distribution
-        Table 2's normal, N(0, 1), truncated at ±`truncate_sd` (frozen).
+        Table 2's normal, N(0, 1), truncated at ± `truncate_sd` (frozen).
     """
     from scipy.stats import truncnorm  # here: scipy.stats takes 0.5 s to import
 

@@ -21,7 +21,7 @@ VARIANCE_WHY = "mm, + ulna plus; adults measure about -4 to +5"
 
 
 def check_ulnar_variance(variance_mm: object, name: str = "ulnar_variance_mm") -> float:
-    """The ulnar variance (mm) as a float if it is finite and within ±`MAX_ULNAR_VARIANCE_MM`; `InputError`
+    """The ulnar variance (mm) as a float if it is finite and within ± `MAX_ULNAR_VARIANCE_MM`; `InputError`
     naming the value."""
     return check_float(name, variance_mm, -MAX_ULNAR_VARIANCE_MM, MAX_ULNAR_VARIANCE_MM, VARIANCE_WHY)
 
@@ -61,7 +61,7 @@ class BuildParams:
     until `anatomy.ulnar_variance`'s corner rule gives it, before anything of the build is made from it
     (`anatomy.ulnar_variance.seat_ulna`). None: where the participant's bones put it (a participant
     folder may state it: participant.toml's `ulnar_variance_mm`, `registry.build_params`). Within
-    ±`limits.MAX_ULNAR_VARIANCE_MM`; left out of `builder.digest.source_hash` when None, so the default
+    ± `limits.MAX_ULNAR_VARIANCE_MM`; left out of `builder.digest.source_hash` when None, so the default
     parameters keep their models' keys. A built-in participant is seated at the adult mean
     (`participants.builtin.ULNAR_VARIANCE_MM`)."""
     tfc_disc_mm: float | None = None
@@ -74,7 +74,7 @@ class BuildParams:
     ulnar_osteotomy_mm: float = 0.0
     """An ulnar osteotomy (mm, + lengthening, − shortening): the ulna moved along the radius' long axis after
     its TFCC layer is made at its seat, the disc unchanged, as Werner et al. 1986 changed the variance of
-    cadaver wrists. Within ±`limits.MAX_ULNAR_VARIANCE_MM`."""
+    cadaver wrists. Within ± `limits.MAX_ULNAR_VARIANCE_MM`."""
 
     def __post_init__(self):
         check_fossa_sweep(self.fossa_sweep_deg)  # refused before anything is built or cached from it

@@ -4,7 +4,7 @@ Each grid holds the signed distance (mm, positive outside) to one bone's
 displaced surface (bone with its cartilage), sampled on a regular grid in
 that bone's own frame (the RCS in the neutral pose). Exact distances come
 from libigl, signed by the fast winding number (robust where a displaced
-cartilage rim folds); values are clamped to ±`band_mm`.
+cartilage rim folds); values are clamped to ± `band_mm`.
 """
 
 from __future__ import annotations

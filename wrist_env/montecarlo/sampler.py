@@ -60,7 +60,7 @@ def monte_carlo_from_unit(
 ) -> np.ndarray:
     """Normalized actions of shape (n, 27) from points `u` of shape (n, 27) in [0, 1).
 
-    Materials (the first 22 columns): Table 2's normals truncated at ±`truncate_sd` by
+    Materials (the first 22 columns): Table 2's normals truncated at ± `truncate_sd` by
     inverse CDF, in action units (z / SPAN_SD). Injury scalars (the last 5): torn
     (`TORN_ACTION`) where u < `tear_probability`, else intact (`INTACT_ACTION`).
     """
