@@ -38,6 +38,6 @@ from wrist_env.validation.simulations import Simulations, run_simulations
 __all__ = [
     "CHECKS", "EXTENSION_30_DEG", "LOAD_MODES", "NEUTRAL_LOAD_N", "RAINBOW_LUNATE", "RAINBOW_SCAPHOID",
     "SL_DISSOCIATION_MM", "SLIL", "SOURCES", "ULNAR_SHARE_PCT", "VIEGAS_1993", "Check", "CheckSpec", "Report",
-    "Simulations", "at_angle", "format_table", "largest_rotation_deg", "load_shares_pct", "run_chain", "run_simulations", "sl_gap_mm", "slope", "surface_gap_mm", "validate",
-    "with_tears",
+    "Simulations", "at_angle", "format_table", "largest_rotation_deg", "load_shares_pct", "run_chain",
+    "run_simulations", "sl_gap_mm", "slope", "surface_gap_mm", "validate", "with_tears",
 ]  # fmt: skip

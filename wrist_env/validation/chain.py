@@ -96,12 +96,13 @@ def _share_pct(articulation: str) -> Callable[[Simulations], float]:
     return share
 
 
-def _column_rotation_deg(s: Simulations) -> float:
-    return largest_rotation_deg(s.intact.poses, TRAPEZIUM)
+def _rotation_deg(body: int) -> Callable[[Simulations], float]:
+    """The intact sweep's largest rotation (deg) of `body` relative to the capitate (`largest_rotation_deg`)."""
 
+    def rotation(s: Simulations) -> float:
+        return largest_rotation_deg(s.intact.poses, body)
 
-def _hamate_rotation_deg(s: Simulations) -> float:
-    return largest_rotation_deg(s.intact.poses, HAMATE)
+    return rotation
 
 
 def _sl_gap_growth_mm(s: Simulations) -> float:
@@ -196,7 +197,7 @@ CHECKS: tuple[CheckSpec, ...] = (
         "deg",
         _AKHBARI,
         "sweep",
-        _column_rotation_deg,
+        _rotation_deg(TRAPEZIUM),
     ),
     CheckSpec(
         "hamate_rotation_deg",
@@ -206,7 +207,7 @@ CHECKS: tuple[CheckSpec, ...] = (
         f"{_AKHBARI}; the capitohamate joint rotates ~9 deg under 0.5 N m with its ligaments intact (Ritt et al. "
         "1996, J Hand Surg Br 21:451)",
         "sweep",
-        _hamate_rotation_deg,
+        _rotation_deg(HAMATE),
     ),
     CheckSpec(
         "sl_gap_growth_mm",
